@@ -1,0 +1,289 @@
+#include "hairis/table_file.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/hash.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "hairis/math.h"
+
+namespace hairis {
+
+namespace {
+
+using OIIO::TypeDesc;
+
+constexpr int kChannels = 4;
+
+std::string sha1_of(const std::vector<float> &pixels) {
+    OIIO::SHA1 sha(pixels.data(), pixels.size() * sizeof(float));
+    return sha.digest();
+}
+
+std::string join_ints(const std::vector<int> &values) {
+    std::string out;
+    for (size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + std::to_string(values[i]);
+    return out;
+}
+
+// Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
+int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
+
+std::vector<float> pixels_of(const TableSet &t) {
+    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const int bands = int(t.n_h_values.size());
+    std::vector<float> px(size_t(width) * height * kChannels);
+    for (int r = 0; r < t.theta_r_count(); ++r) {
+        for (int i = 0; i < t.theta_i_count; ++i) {
+            const size_t row = size_t(r) * t.theta_i_count + i;
+            for (int j = 0; j < width; ++j) {
+                float *p = &px[(row * width + j) * kChannels];
+                p[0] = t.direct_at(r, i, j);
+                p[1] = bands ? t.multiple_at(r, band_of_column(j, width, bands), i) : 0.0f;
+                p[2] = 0.0f;
+                p[3] = 1.0f;
+            }
+        }
+    }
+    return px;
+}
+
+Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+
+}  // namespace
+
+std::string canonical_parameters(const std::vector<std::pair<std::string, double>> &params) {
+    std::string out;
+    char value[64];
+    for (const auto &[name, v] : params) {
+        std::snprintf(value, sizeof value, "%.9g", v);
+        if (!out.empty()) out += ';';
+        out += name + "=" + value;
+    }
+    return out;
+}
+
+Status TableSet::validate() const {
+    if (model != "chiang2016" && model != "marschner2003")
+        return file_error("model must be \"chiang2016\" or \"marschner2003\" (got \"" + model + "\")");
+    if (source != "exact" && source != "gaussian")
+        return file_error("source must be \"exact\" or \"gaussian\" (got \"" + source + "\")");
+    if (Status s = first_error(check::count_in_range("theta_r_count", theta_r_count(), 1, kMaxThetaRCount),
+                               check::count_in_range("theta_i_count", theta_i_count, 2, kMaxGridAxis),
+                               check::count_in_range("phi_count", phi_count, 1, kMaxGridAxis),
+                               check::count_in_range("n_h count", (long long)n_h_values.size(), 0, phi_count)))
+        return file_error(s->message);
+    const long long cells = (long long)theta_r_count() * theta_i_count * phi_count;
+    if (cells > kMaxTableCells)
+        return file_error("table has " + std::to_string(cells) + " cells; at most " +
+                          std::to_string(kMaxTableCells) + " are allowed");
+    for (int r = 0; r < theta_r_count(); ++r) {
+        const float t = theta_r_nodes[r];
+        if (!std::isfinite(t) || std::fabs(t) > float(kHalfPi) + 1e-6f)
+            return file_error("theta_r node " + std::to_string(r) + " must be finite and in [-pi/2, pi/2]");
+        if (r > 0 && !(t > theta_r_nodes[r - 1]))
+            return file_error("theta_r nodes must be strictly increasing (node " + std::to_string(r) + ")");
+    }
+    for (size_t k = 0; k < n_h_values.size(); ++k) {
+        if (n_h_values[k] < 1 || n_h_values[k] > 1024)
+            return file_error("n_h values must be in [1, 1024] (got " + std::to_string(n_h_values[k]) + ")");
+        if (k > 0 && n_h_values[k] <= n_h_values[k - 1])
+            return file_error("n_h values must be strictly increasing");
+    }
+    if (direct.size() != size_t(cells))
+        return file_error("direct table holds " + std::to_string(direct.size()) + " values; the grid needs " +
+                          std::to_string(cells));
+    const size_t multiple_size = size_t(theta_r_count()) * n_h_values.size() * theta_i_count;
+    if (multiple.size() != multiple_size)
+        return file_error("multiple table holds " + std::to_string(multiple.size()) +
+                          " values; the grid needs " + std::to_string(multiple_size));
+    for (const std::vector<float> *v : {&direct, &multiple})
+        for (size_t n = 0; n < v->size(); ++n)
+            if (!std::isfinite((*v)[n]) || (*v)[n] < 0.0f)
+                return file_error(std::string(v == &direct ? "direct" : "multiple") + " table value " +
+                                  std::to_string(n) + " is negative, NaN or infinite");
+    for (const auto &[name, value] : parameters)
+        if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
+            return file_error("parameter \"" + name + "\" must have a plain name and a finite value");
+    return std::nullopt;
+}
+
+Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
+    if (Status s = t.validate()) return *s;
+    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const std::vector<float> px = pixels_of(t);
+
+    OIIO::ImageSpec spec(width, height, kChannels, TypeDesc::FLOAT);
+    spec.channelnames = {"R", "G", "B", "A"};
+    spec.alpha_channel = 3;
+    spec.attribute("compression", "zip");
+    spec.attribute("hairis:format_version", kTableFormatVersion);
+    spec.attribute("hairis:model", t.model);
+    spec.attribute("hairis:source", t.source);
+    spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
+    spec.attribute("hairis:theta_r_count", t.theta_r_count());
+    spec.attribute("hairis:theta_i_count", t.theta_i_count);
+    spec.attribute("hairis:phi_count", t.phi_count);
+    spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
+                   t.theta_r_nodes.data());
+    spec.attribute("hairis:n_h_values", join_ints(t.n_h_values));
+    spec.attribute("hairis:pixel_sha1", sha1_of(px));
+
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("openexr");
+    if (!out) return file_error("OpenImageIO has no OpenEXR writer: " + OIIO::geterror());
+    if (!out->set_ioproxy(&proxy) || !out->open("tables.exr", spec) ||
+        !out->write_image(TypeDesc::FLOAT, px.data()) || !out->close())
+        return file_error("encoding the EXR failed: " + out->geterror());
+    return bytes;
+}
+
+Expected<TableSet> decode_table_exr(const void *data, size_t size) {
+    if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
+    OIIO::Filesystem::IOMemReader proxy(data, size);
+    auto in = OIIO::ImageInput::create("openexr");
+    if (!in) return file_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
+    // OIIO 2.4 takes the in-memory proxy through the open() configuration.
+    OIIO::ImageSpec config, opened;
+    void *proxy_pointer = &proxy;
+    config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy_pointer);
+    if (!in->open("tables.exr", opened, config)) {
+        std::string why = in->geterror();
+        return file_error("not a readable OpenEXR file" + (why.empty() ? std::string() : ": " + why));
+    }
+    const OIIO::ImageSpec &spec = in->spec();
+
+    const int version = spec.get_int_attribute("hairis:format_version", -1);
+    if (version == -1) return file_error("no hairis:format_version attribute: not a hairis table file");
+    if (version != kTableFormatVersion)
+        return file_error("format version " + std::to_string(version) + " is not supported (this build reads version " +
+                          std::to_string(kTableFormatVersion) + ")");
+    if (spec.nchannels != kChannels || spec.channelnames != std::vector<std::string>{"R", "G", "B", "A"})
+        return file_error("expected 4 channels R, G, B, A (got " + std::to_string(spec.nchannels) + ")");
+    if (spec.format != TypeDesc::FLOAT)
+        return file_error("pixels must be 32-bit float (got " + std::string(spec.format.c_str()) + ")");
+
+    TableSet t;
+    t.model = spec.get_string_attribute("hairis:model");
+    t.source = spec.get_string_attribute("hairis:source");
+    const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
+    t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
+    t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
+    if (Status s = first_error(check::count_in_range("theta_r_count", theta_r_count, 1, kMaxThetaRCount),
+                               check::count_in_range("theta_i_count", t.theta_i_count, 2, kMaxGridAxis),
+                               check::count_in_range("phi_count", t.phi_count, 1, kMaxGridAxis)))
+        return file_error(s->message);
+    if (spec.width != t.phi_count || spec.height != theta_r_count * t.theta_i_count || spec.depth != 1 ||
+        spec.x != 0 || spec.y != 0)
+        return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                          " but the metadata needs " + std::to_string(t.phi_count) + "x" +
+                          std::to_string(theta_r_count * t.theta_i_count));
+
+    const OIIO::ParamValue *nodes = spec.find_attribute("hairis:theta_r_nodes");
+    if (!nodes || nodes->type().basetype != TypeDesc::FLOAT || nodes->type().basevalues() * size_t(nodes->nvalues()) != size_t(theta_r_count))
+        return file_error("hairis:theta_r_nodes must hold " + std::to_string(theta_r_count) + " floats");
+    const float *node_values = static_cast<const float *>(nodes->data());
+    t.theta_r_nodes.assign(node_values, node_values + theta_r_count);
+
+    const std::string n_h_text = spec.get_string_attribute("hairis:n_h_values");
+    if (!n_h_text.empty()) {
+        std::stringstream in_text(n_h_text);
+        std::string item;
+        while (std::getline(in_text, item, ',')) {
+            char *end = nullptr;
+            const long v = std::strtol(item.c_str(), &end, 10);
+            if (item.empty() || *end != '\0' || v < 1 || v > 1024)
+                return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + n_h_text + "\")");
+            t.n_h_values.push_back(int(v));
+        }
+    }
+
+    const std::string parameters = spec.get_string_attribute("hairis:parameters");
+    std::stringstream param_text(parameters);
+    std::string item;
+    while (std::getline(param_text, item, ';')) {
+        const size_t eq = item.find('=');
+        char *end = nullptr;
+        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
+        t.parameters.emplace_back(item.substr(0, eq), v);
+    }
+
+    const size_t width = size_t(spec.width), height = size_t(spec.height);
+    std::vector<float> px(width * height * kChannels);
+    if (!in->read_image(0, 0, 0, kChannels, TypeDesc::FLOAT, px.data()))
+        return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+    in->close();
+
+    const std::string sha = spec.get_string_attribute("hairis:pixel_sha1");
+    if (sha != sha1_of(px))
+        return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
+
+    const int bands = int(t.n_h_values.size());
+    if (bands > t.phi_count) return file_error("more n_h values than phi columns");
+    t.direct.resize(size_t(theta_r_count) * t.theta_i_count * t.phi_count);
+    t.multiple.assign(size_t(theta_r_count) * bands * t.theta_i_count, 0.0f);
+    for (size_t row = 0; row < height; ++row) {
+        const int r = int(row / size_t(t.theta_i_count)), i = int(row % size_t(t.theta_i_count));
+        for (size_t j = 0; j < width; ++j) {
+            const float *p = &px[(row * width + j) * kChannels];
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3]))
+                return file_error("pixel (" + std::to_string(j) + ", " + std::to_string(row) + ") holds NaN or infinity");
+            t.direct[row * width + j] = p[0];
+            if (bands) {
+                const int k = band_of_column(int(j), t.phi_count, bands);
+                float &m = t.multiple[(size_t(r) * bands + k) * t.theta_i_count + i];
+                const bool band_start = j == 0 || band_of_column(int(j) - 1, t.phi_count, bands) != k;
+                if (band_start) m = p[1];
+                else if (p[1] != m)
+                    return file_error("G channel differs inside the n_h band at pixel (" + std::to_string(j) + ", " +
+                                      std::to_string(row) + ")");
+            }
+            if (p[2] != 0.0f || p[3] != 1.0f)
+                return file_error("B must be 0 and A must be 1 at pixel (" + std::to_string(j) + ", " +
+                                  std::to_string(row) + ")");
+        }
+    }
+    if (Status s = t.validate()) return *s;
+    return t;
+}
+
+Expected<TableSet> read_table_file(const std::string &path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return file_error("cannot open \"" + path + "\" for reading");
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    if (file.bad()) return file_error("cannot read \"" + path + "\"");
+    Expected<TableSet> t = decode_table_exr(bytes.data(), bytes.size());
+    if (!t) return Error{t.error().message + " (in \"" + path + "\")"};
+    return t;
+}
+
+Status write_table_file(const TableSet &tables, const std::string &path) {
+    Expected<std::vector<unsigned char>> bytes = encode_table_exr(tables);
+    if (!bytes) return bytes.error();
+    const std::string temp = path + ".tmp-hairis";
+    {
+        std::ofstream file(temp, std::ios::binary | std::ios::trunc);
+        if (!file) return file_error("cannot write \"" + temp + "\" (is the folder writable?)");
+        file.write(reinterpret_cast<const char *>(bytes.value().data()), std::streamsize(bytes.value().size()));
+        file.close();
+        if (!file) {
+            std::remove(temp.c_str());
+            return file_error("writing \"" + temp + "\" failed (disk full?)");
+        }
+    }
+    if (std::rename(temp.c_str(), path.c_str()) != 0) {
+        std::remove(temp.c_str());
+        return file_error("cannot rename \"" + temp + "\" to \"" + path + "\"");
+    }
+    return std::nullopt;
+}
+
+}  // namespace hairis
