@@ -120,23 +120,27 @@ Chi2Result chi2_direction_test(const std::function<std::optional<Vec3>(Sample3)>
         observed[size_t(ix) * ny + iy] += 1.0;
     }
 
-    // Expected counts: Simpson quadrature of the pdf over each cell in (sin θ, φ), where
-    // dω = d(sin θ) dφ.
+    // Expected counts: Simpson quadrature of the pdf over each cell. A cell spans
+    // [x0, x1] in sin θ; integrating over θ with dω = cos θ dθ dφ keeps the integrand smooth
+    // for densities that are per dθ dφ divided by cos θ (singular at the poles in sin θ).
     const int n = options.simpson_points | 1;
-    const std::vector<double> wx = simpson_weights(n, cell_x);
     const std::vector<double> wp = simpson_weights(n, cell_phi);
     std::vector<double> expected(observed.size(), 0.0);
     double integral = 0.0;
     for (int ix = 0; ix < nx; ++ix) {
+        const double t0 = std::asin(std::clamp(-1.0 + cell_x * ix, -1.0, 1.0));
+        const double t1 = std::asin(std::clamp(-1.0 + cell_x * (ix + 1), -1.0, 1.0));
+        const std::vector<double> wt = simpson_weights(n, t1 - t0);
         for (int iy = 0; iy < ny; ++iy) {
             double cell = 0.0;
             for (int a = 0; a < n; ++a) {
-                const double x = -1.0 + cell_x * (ix + double(a) / (n - 1));
-                const double r = std::sqrt(std::max(0.0, 1.0 - x * x));
+                const double theta = t0 + (t1 - t0) * double(a) / (n - 1);
+                const double x = std::sin(theta), r = std::cos(theta);
                 for (int b = 0; b < n; ++b) {
                     const double phi = -kPi + cell_phi * (iy + double(b) / (n - 1));
                     const Vec3 w{float(x), float(r * std::cos(phi)), float(r * std::sin(phi))};
-                    cell += wx[a] * wp[b] * pdf(w);
+                    const double value = r > 0.0 ? pdf(w) * r : 0.0;
+                    cell += wt[a] * wp[b] * value;
                 }
             }
             expected[size_t(ix) * ny + iy] = cell * double(options.sample_count);
