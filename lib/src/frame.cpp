@@ -16,7 +16,8 @@ FiberFrame FiberFrame::from_tangent_and_view(Vec3 tangent, Vec3 wo) {
 }
 
 FiberAngles angles_of(Vec3 l) {
-    return {safe_asin(l.x), std::atan2(l.z, l.y)};
+    // atan2 rather than asin(x): near the poles x rounds to ±1 while y and z still carry θ.
+    return {std::atan2(l.x, std::hypot(l.y, l.z)), std::atan2(l.z, l.y)};
 }
 
 Vec3 direction_of(float theta, float phi) {

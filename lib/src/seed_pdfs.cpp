@@ -36,10 +36,12 @@ double sigma_multiple_of(const SeedPdfParams &p, int n_h) {
 }
 
 // Per steradian from per dθ dφ.
-double per_steradian(double density, double theta_i) {
-    const double c = std::cos(theta_i);
-    return c > 0.0 ? density / c : 0.0;
+double per_steradian(double density, double cos_theta_i) {
+    return cos_theta_i > 0.0 ? density / cos_theta_i : 0.0;
 }
+
+// cos θ of a unit local direction, accurate near the poles.
+double cos_theta_of(Vec3 w) { return std::hypot(double(w.y), double(w.z)); }
 
 }  // namespace
 
@@ -50,7 +52,9 @@ TruncatedNormal::TruncatedNormal(double mean, double sigma, double lo, double hi
 }
 
 double TruncatedNormal::pdf(double x) const {
-    if (x < lo_ || x > hi_ || !(mass_ > 0.0)) return 0.0;
+    // Angles that went through float may land a rounding error past the bounds.
+    constexpr double kSlack = 1e-6;
+    if (x < lo_ - kSlack || x > hi_ + kSlack || !(mass_ > 0.0)) return 0.0;
     const double z = (x - mean_) / sigma_;
     return std::exp(-0.5 * z * z) / (sigma_ * std::sqrt(kTwoPi) * mass_);
 }
@@ -79,14 +83,15 @@ double seed_direct_pdf(const SeedPdfParams &p, double theta_r, double theta_i, d
     const double psi = wrap_angle(phi - kPi);
     return per_steradian(longitudinal(theta_r, p.sigma_longitudinal).pdf(theta_i) *
                              azimuthal(p, theta_r).pdf(psi),
-                         theta_i);
+                         std::cos(theta_i));
 }
 
 double seed_multiple_pdf(const SeedPdfParams &p, double theta_r, double theta_i, int n_h) {
     const double sigma = sigma_multiple_of(p, n_h);
     if (sigma <= 0.0) return 0.0;
     const double sigma_prime = sigma + std::fabs(theta_r) * kInvPi;
-    return per_steradian(longitudinal(theta_r, sigma_prime).pdf(theta_i) * kInvTwoPi, theta_i);
+    return per_steradian(longitudinal(theta_r, sigma_prime).pdf(theta_i) * kInvTwoPi,
+                         std::cos(theta_i));
 }
 
 Expected<GaussianSampler> GaussianSampler::create(const SeedPdfParams &params,
@@ -128,10 +133,12 @@ float GaussianSampler::pdf(Vec3 wi, Vec3 wo, float) const {
     const double phi = wrap_angle(double(i.phi) - double(o.phi));
     const double w = multiple_weight_;
     const double sigma_prime = sigma_multiple_ + std::fabs(double(o.theta)) * kInvPi;
+    const double cos_theta_i = cos_theta_of(wi);
     const double multiple =
-        per_steradian(longitudinal(o.theta, sigma_prime).pdf(i.theta) * kInvTwoPi, i.theta);
-    const double direct = seed_direct_pdf(params_, o.theta, i.theta, phi);
-    return float((1.0 - w) * direct + w * multiple);
+        longitudinal(o.theta, sigma_prime).pdf(i.theta) * kInvTwoPi;
+    const double direct = longitudinal(o.theta, params_.sigma_longitudinal).pdf(i.theta) *
+                          azimuthal(params_, o.theta).pdf(wrap_angle(phi - kPi));
+    return float(per_steradian((1.0 - w) * direct + w * multiple, cos_theta_i));
 }
 
 }  // namespace hairis
