@@ -122,6 +122,9 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.channelnames = {"R", "G", "B", "A"};
     spec.alpha_channel = 3;
     spec.attribute("compression", "zip");
+    // OpenImageIO stamps the current time unless told otherwise; a fixed stamp keeps the
+    // bytes a function of the tables alone (deterministic bakes).
+    spec.attribute("DateTime", "1970:01:01 00:00:00");
     spec.attribute("hairis:format_version", kTableFormatVersion);
     spec.attribute("hairis:model", t.model);
     spec.attribute("hairis:source", t.source);
