@@ -100,7 +100,11 @@ int run_figures(const FiguresFlags &flags) {
     const std::string script = script_env ? script_env : HAIRIS_FIGURES_SCRIPT;
     if (!std::filesystem::exists(script))
         return fail("the plotting script \"" + script + "\" is missing (set HAIRIS_FIGURES_SCRIPT)");
-    const std::string command = "python3 " + quoted(script) + " " + quoted(flags.output) + " --model " +
+    // Debian's python3 has Debian's matplotlib; a python3 earlier on PATH (pyenv, venv) may not.
+    const char *python_env = std::getenv("HAIRIS_PYTHON");
+    const std::string python = python_env ? python_env
+                               : std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string command = quoted(python) + " " + quoted(script) + " " + quoted(flags.output) + " --model " +
                                 quoted(model.value()->name() + " (" + flags.fiber.preset + ")");
     const int status = std::system(command.c_str());
     if (status != 0)
