@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/quadrature/gauss.hpp>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -24,6 +25,40 @@ std::vector<double> simpson_weights(int n, double width) {
         w[i] = c * step / 3.0;
     }
     return w;
+}
+
+// Quadrature nodes and weights over [a, b]. Without breakpoints: composite Simpson. With
+// breakpoints: 7-point Gauss–Legendre on each piece between those inside — an open rule, so
+// no node sits on a jump (where the pdf may take either side's value) and a density that
+// is constant between breakpoints is integrated exactly.
+struct Node {
+    double x, w;
+};
+std::vector<Node> split_nodes(double a, double b, const std::vector<double> &breaks, int n) {
+    std::vector<double> edges = {a};
+    for (double t : breaks)
+        if (t > a && t < b) edges.push_back(t);
+    edges.push_back(b);
+    std::sort(edges.begin(), edges.end());
+    std::vector<Node> nodes;
+    if (breaks.empty()) {
+        const std::vector<double> w = simpson_weights(n, b - a);
+        for (int i = 0; i < n; ++i) nodes.push_back({a + (b - a) * double(i) / (n - 1), w[size_t(i)]});
+        return nodes;
+    }
+    using Rule = boost::math::quadrature::gauss<double, 7>;
+    for (size_t k = 0; k + 1 < edges.size(); ++k) {
+        const double lo = edges[k], hi = edges[k + 1];
+        if (!(hi > lo)) continue;
+        const double mid = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
+        // Boost stores the non-negative abscissae; the rule is symmetric.
+        for (size_t i = 0; i < Rule::abscissa().size(); ++i) {
+            const double x = Rule::abscissa()[i], w = Rule::weights()[i] * half;
+            nodes.push_back({mid + half * x, w});
+            if (x != 0.0) nodes.push_back({mid - half * x, w});
+        }
+    }
+    return nodes;
 }
 
 // Pools cells with expected counts under 5 (smallest first, as Mitsuba's chi2 does) and
@@ -124,23 +159,22 @@ Chi2Result chi2_direction_test(const std::function<std::optional<Vec3>(Sample3)>
     // [x0, x1] in sin θ; integrating over θ with dω = cos θ dθ dφ keeps the integrand smooth
     // for densities that are per dθ dφ divided by cos θ (singular at the poles in sin θ).
     const int n = options.simpson_points | 1;
-    const std::vector<double> wp = simpson_weights(n, cell_phi);
     std::vector<double> expected(observed.size(), 0.0);
     double integral = 0.0;
     for (int ix = 0; ix < nx; ++ix) {
         const double t0 = std::asin(std::clamp(-1.0 + cell_x * ix, -1.0, 1.0));
         const double t1 = std::asin(std::clamp(-1.0 + cell_x * (ix + 1), -1.0, 1.0));
-        const std::vector<double> wt = simpson_weights(n, t1 - t0);
+        const std::vector<Node> theta_nodes = split_nodes(t0, t1, options.theta_breaks, n);
         for (int iy = 0; iy < ny; ++iy) {
+            const double p0 = -kPi + cell_phi * iy, p1 = p0 + cell_phi;
+            const std::vector<Node> phi_nodes = split_nodes(p0, p1, options.phi_breaks, n);
             double cell = 0.0;
-            for (int a = 0; a < n; ++a) {
-                const double theta = t0 + (t1 - t0) * double(a) / (n - 1);
-                const double x = std::sin(theta), r = std::cos(theta);
-                for (int b = 0; b < n; ++b) {
-                    const double phi = -kPi + cell_phi * (iy + double(b) / (n - 1));
-                    const Vec3 w{float(x), float(r * std::cos(phi)), float(r * std::sin(phi))};
-                    const double value = r > 0.0 ? pdf(w) * r : 0.0;
-                    cell += wt[a] * wp[b] * value;
+            for (const Node &a : theta_nodes) {
+                const double x = std::sin(a.x), r = std::cos(a.x);
+                if (r <= 0.0) continue;
+                for (const Node &b : phi_nodes) {
+                    const Vec3 w{float(x), float(r * std::cos(b.x)), float(r * std::sin(b.x))};
+                    cell += a.w * b.w * pdf(w) * r;
                 }
             }
             expected[size_t(ix) * ny + iy] = cell * double(options.sample_count);

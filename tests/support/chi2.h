@@ -11,6 +11,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "hairis/math.h"
 
@@ -29,6 +30,10 @@ struct Chi2Options {
     double significance = 0.01;        ///< before the Šidák correction
     int test_count = 1;                ///< number of χ² tests in the family (Šidák)
     std::uint64_t seed = 0x5eed;       ///< random-number seed, fixed for reproducibility
+    /// Angles (θ in [−π/2, π/2], φ in [−π, π]) where the pdf may jump, e.g. a table's cell
+    /// edges: each cell's quadrature is split there, so piecewise-constant densities are
+    /// integrated exactly.
+    std::vector<double> theta_breaks, phi_breaks;
 };
 
 struct Chi2Result {
