@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <iostream>
 
@@ -52,10 +54,16 @@ int run_bake(const BakeFlags &flags) {
         return kExitFailure;
     }
     const auto start = std::chrono::steady_clock::now();
+    // For the CLI tests: deliver a real SIGINT to ourselves after N progress reports, so the
+    // interrupted path is tested deterministically (no timing races).
+    const char *interrupt_env = std::getenv("HAIRIS_TEST_INTERRUPT_AFTER");
+    const long interrupt_after = interrupt_env ? std::strtol(interrupt_env, nullptr, 10) : -1;
+    long reports = 0;
     Expected<TableSet> tables = [&] {
         ProgressBar bar(!flags.quiet);
         return bake_tables(*model.value(), parameters.value(), flags.bake, [&](float f) {
             bar.update(f);
+            if (interrupt_after >= 0 && reports++ == interrupt_after) std::raise(SIGINT);
             return !interrupted();
         });
     }();

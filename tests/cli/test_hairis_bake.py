@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""CLI tests of hairis-bake: every subcommand, its outputs, determinism and its errors.
+
+Usage: test_hairis_bake.py PATH/TO/hairis-bake
+"""
+import os
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import tempfile
+import unittest
+
+BAKE = None
+SMALL = ["--theta-r", "5", "--theta-i", "16", "--phi", "16", "--quadrature", "1", "--n-h", "1,2"]
+
+
+def run(*args, env=None):
+    full_env = dict(os.environ)
+    full_env.update(env or {})
+    return subprocess.run([BAKE, *args], capture_output=True, text=True, env=full_env, timeout=600)
+
+
+class HairisBakeTest(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="hairis_cli_")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def assert_no_output(self, name):
+        leftovers = [f for f in os.listdir(self.dir) if f.startswith(name)]
+        self.assertEqual(leftovers, [], "a failed command left files behind")
+
+    # --- help ---------------------------------------------------------------------------
+    def test_help_on_every_subcommand(self):
+        for sub in [[], ["bake"], ["inspect"], ["figures"], ["fits"]]:
+            r = run(*sub, "--help")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("Usage", r.stdout)
+
+    # --- bake and inspect -----------------------------------------------------------------
+    def test_bake_then_inspect(self):
+        out = self.path("t.exr")
+        r = run("bake", *SMALL, "--output", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(os.path.getsize(out) > 0)
+        r = run("inspect", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for text in ["chiang2016", "theta_r nodes:   5", "theta_i cells:   16", "n_h values:      1 2",
+                     "valid:           yes"]:
+            self.assertIn(text, r.stdout)
+
+    def test_bake_is_deterministic_whatever_the_thread_count(self):
+        a, b = self.path("a.exr"), self.path("b.exr")
+        self.assertEqual(run("bake", *SMALL, "--threads", "1", "-q", "-o", a).returncode, 0)
+        self.assertEqual(run("bake", *SMALL, "--threads", "2", "-q", "-o", b).returncode, 0)
+        with open(a, "rb") as fa, open(b, "rb") as fb:
+            self.assertEqual(fa.read(), fb.read(), "the same bake gave different bytes")
+
+    def test_presets_param_file_and_set(self):
+        params = self.path("fiber.txt")
+        with open(params, "w") as f:
+            f.write("# a dark Principled Hair fiber\nparametrization = melanin\nmelanin = 0.9\n")
+        out = self.path("p.exr")
+        r = run("bake", *SMALL, "--param-file", params, "--set", "roughness=0.4", "-q", "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = run("inspect", out)
+        self.assertIn("roughness          0.40", r.stdout)
+        for preset, model in [("blonde", "marschner2003"), ("brunette", "marschner2003")]:
+            out = self.path(preset + ".exr")
+            r = run("bake", "--preset", preset, "--theta-r", "3", "--theta-i", "8", "--phi", "8",
+                    "--quadrature", "1", "--n-h", "1", "-q", "-o", out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn(model, run("inspect", out).stdout)
+
+    def test_gaussian_source(self):
+        out = self.path("g.exr")
+        self.assertEqual(run("bake", *SMALL, "--source", "gaussian", "-q", "-o", out).returncode, 0)
+        self.assertIn("gaussian", run("inspect", out).stdout)
+
+    # --- errors ------------------------------------------------------------------------------
+    def test_bad_flags_name_the_flag(self):
+        out = self.path("bad.exr")
+        cases = [
+            (["bake", "--theta-i", "0", "-o", out], "--theta-i"),
+            (["bake", "--preset", "ginger", "-o", out], "--preset"),
+            (["bake", "--source", "magic", "-o", out], "--source"),
+            (["bake", "--n-h", "4,2", "-o", out], "strictly increasing"),
+            (["bake", "--set", "ior=0.5", "-o", out], "ior"),
+            (["bake", "--set", "shinyness=1", "-o", out], "unknown parameter"),
+            (["bake"], "--output"),
+            (["frobnicate"], "frobnicate"),
+        ]
+        for args, fragment in cases:
+            r = run(*args)
+            self.assertNotEqual(r.returncode, 0, args)
+            self.assertIn(fragment, r.stderr + r.stdout, args)
+        self.assert_no_output("bad.exr")
+
+    def test_bad_parameter_file(self):
+        params = self.path("fiber.txt")
+        with open(params, "w") as f:
+            f.write("roughness = lots\n")
+        r = run("bake", "--param-file", params, "-o", self.path("x.exr"))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("line 1: roughness must be a finite number", r.stderr)
+        r = run("bake", "--param-file", self.path("missing.txt"), "-o", self.path("x.exr"))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--param-file", r.stderr)
+        self.assert_no_output("x.exr")
+
+    def test_unwritable_output(self):
+        locked = self.path("locked")
+        os.mkdir(locked)
+        os.chmod(locked, stat.S_IRUSR | stat.S_IXUSR)
+        target = os.path.join(locked, "t.exr")
+        r = run("bake", *SMALL, "-q", "-o", target)
+        if os.geteuid() == 0:
+            # root writes anywhere; use a path whose folder does not exist instead
+            target = self.path("no/such/dir/t.exr")
+            r = run("bake", *SMALL, "-q", "-o", target)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("cannot write", r.stderr)
+        self.assertFalse(os.path.exists(target))
+
+    def test_inspect_missing_and_corrupt(self):
+        r = run("inspect", self.path("missing.exr"))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("cannot open", r.stderr)
+        good = self.path("good.exr")
+        self.assertEqual(run("bake", *SMALL, "-q", "-o", good).returncode, 0)
+        with open(good, "rb") as f:
+            data = bytearray(f.read())
+        truncated = self.path("truncated.exr")
+        with open(truncated, "wb") as f:
+            f.write(data[: len(data) // 2])
+        r = run("inspect", truncated)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("invalid", r.stderr)
+        for k in range(len(data) - 64, len(data) - 32):
+            data[k] ^= 0x5A
+        corrupt = self.path("corrupt.exr")
+        with open(corrupt, "wb") as f:
+            f.write(data)
+        r = run("inspect", corrupt)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("invalid", r.stderr)
+
+    def test_interrupted_bake_leaves_no_file(self):
+        out = self.path("interrupted.exr")
+        r = run("bake", "--theta-r", "8", "--theta-i", "16", "--phi", "16", "-q", "-o", out,
+                env={"HAIRIS_TEST_INTERRUPT_AFTER": "2"})
+        self.assertEqual(r.returncode, 130, r.stderr)
+        self.assertIn("interrupted", r.stderr)
+        self.assert_no_output("interrupted.exr")
+
+    def test_existing_output_survives_a_failed_bake(self):
+        out = self.path("keep.exr")
+        self.assertEqual(run("bake", *SMALL, "-q", "-o", out).returncode, 0)
+        with open(out, "rb") as f:
+            before = f.read()
+        r = run("bake", *SMALL, "-q", "-o", out, env={"HAIRIS_TEST_INTERRUPT_AFTER": "1"})
+        self.assertNotEqual(r.returncode, 0)
+        with open(out, "rb") as f:
+            self.assertEqual(f.read(), before)
+
+    # --- figures and fits ---------------------------------------------------------------------
+    def test_fits(self):
+        out = self.path("fits")
+        r = run("fits", "--preset", "cycles-default", "--theta-i", "60", "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(out, "fits.md")) as f:
+            text = f.read()
+        self.assertIn("Table 1", text)
+        self.assertIn("Table 2", text)
+        with open(os.path.join(out, "fits_multiple.csv")) as f:
+            rows = f.read().strip().splitlines()
+        self.assertEqual(len(rows), 1 + 5 * 7)
+
+    def test_figures(self):
+        out = self.path("figures")
+        r = run("figures", "--preset", "cycles-default", "--theta-i", "24", "--phi", "32", "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for name in ["figure1.png", "figure2.png", "figure3.png", "figure4.png", "fits.md"]:
+            path = os.path.join(out, name)
+            self.assertTrue(os.path.getsize(path) > 0, name)
+        with open(os.path.join(out, "figure1.png"), "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+
+    def test_figures_unwritable(self):
+        r = run("figures", "-o", "/proc/hairis/figures")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("cannot create", r.stderr)
+
+
+if __name__ == "__main__":
+    BAKE = sys.argv.pop(1)
+    unittest.main(verbosity=2)
