@@ -1,0 +1,87 @@
+// Google Benchmark: sample+pdf per strategy and fiber evaluation, one thread.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "hairis/frame.h"
+#include "hairis/marschner.h"
+#include "study_common.h"
+
+namespace hairis::bench {
+namespace {
+
+const StudySetup &setup() {
+    static const StudySetup s = make_setup();
+    return s;
+}
+
+struct Queries {
+    std::vector<Vec3> views;
+    std::vector<float> h, u;
+    explicit Queries(int count) : views(size_t(count)), h(size_t(count)), u(3 * size_t(count)) {
+        std::mt19937_64 rng(7);
+        std::uniform_real_distribution<float> d(0.0f, 1.0f);
+        for (size_t k = 0; k < views.size(); ++k) {
+            views[k] = direction_of(float(kPi) * (d(rng) - 0.5f), -float(kHalfPi));
+            h[k] = 2.0f * d(rng) - 1.0f;
+            for (size_t j = 0; j < 3; ++j) u[3 * k + j] = d(rng);
+        }
+    }
+};
+
+void sample_and_pdf(benchmark::State &state, int which) {
+    const auto samplers = all_samplers(setup());
+    const DirectionSampler &s = *samplers[size_t(which)].sampler;
+    state.SetLabel(samplers[size_t(which)].name);
+    const Queries q(4096);
+    size_t k = 0;
+    for (auto _ : state) {
+        const auto smp = s.sample(q.views[k], q.h[k], q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
+        float pdf = smp ? s.pdf(smp->wi, q.views[k], q.h[k]) : 0.0f;
+        benchmark::DoNotOptimize(pdf);
+        k = (k + 1) & 4095;
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(sample_and_pdf, uniform, 0);
+BENCHMARK_CAPTURE(sample_and_pdf, analytic, 1);
+BENCHMARK_CAPTURE(sample_and_pdf, gaussian, 3);
+BENCHMARK_CAPTURE(sample_and_pdf, table_direct, 4);
+BENCHMARK_CAPTURE(sample_and_pdf, table_mixture, 5);
+
+void chiang_near_field(benchmark::State &state) {
+    const Queries q(4096);
+    size_t k = 0;
+    for (auto _ : state) {
+        Rgb f = setup().fiber->f_cos_near(direction_of(0.3f, 1.0f + q.u[k]), q.views[k], q.h[k]);
+        benchmark::DoNotOptimize(f);
+        k = (k + 1) & 4095;
+    }
+}
+BENCHMARK(chiang_near_field);
+
+void chiang_far_field(benchmark::State &state) {
+    const Queries q(4096);
+    size_t k = 0;
+    for (auto _ : state) {
+        Rgb f = setup().fiber->f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
+        benchmark::DoNotOptimize(f);
+        k = (k + 1) & 4095;
+    }
+}
+BENCHMARK(chiang_far_field);
+
+void marschner_far_field(benchmark::State &state) {
+    static const MarschnerFiber m = MarschnerFiber::create(MarschnerParams::blonde()).value();
+    const Queries q(4096);
+    size_t k = 0;
+    for (auto _ : state) {
+        Rgb f = m.f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
+        benchmark::DoNotOptimize(f);
+        k = (k + 1) & 4095;
+    }
+}
+BENCHMARK(marschner_far_field);
+
+}  // namespace
+}  // namespace hairis::bench

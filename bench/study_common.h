@@ -1,0 +1,56 @@
+// Shared setup of the benchmarks and studies: the Cycles-default fiber, its default tables
+// and every strategy built from them.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hairis/bake.h"
+#include "hairis/fiber_spec.h"
+#include "hairis/strategies.h"
+
+namespace hairis::bench {
+
+struct StudySetup {
+    FiberSpec spec;
+    std::shared_ptr<const ChiangFiber> fiber;
+    TableSet tables;
+    SamplingTables sampling;
+};
+
+inline StudySetup make_setup(const std::string &preset = "cycles-default", BakeOptions options = {}) {
+    StudySetup s;
+    s.spec = FiberSpec::preset(preset).value();
+    s.fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(to_chiang_params(s.spec.node).value()).value());
+    s.tables = bake_tables(*s.fiber, s.spec.parameters().value(), options).value();
+    s.sampling = SamplingTables::from(s.tables).value();
+    return s;
+}
+
+/// The strategies compared, with the label used in tables: the mixture weight w of the
+/// multiple-scattering part is 0 for the "direct" variants.
+struct NamedSampler {
+    std::string name;
+    std::shared_ptr<const DirectionSampler> sampler;
+};
+
+inline std::vector<NamedSampler> all_samplers(const StudySetup &s, float mixture_weight = 0.25f, int n_h = 2) {
+    auto make = [&](StrategyKind kind, float w) {
+        StrategyInputs in;
+        in.chiang = s.fiber;
+        in.tables = &s.sampling;
+        in.multiple_weight = w;
+        in.n_h = n_h;
+        return make_sampler(kind, in).value();
+    };
+    return {{"uniform", make(StrategyKind::Uniform, 0.0f)},
+            {"analytic", make(StrategyKind::Analytic, 0.0f)},
+            {"gaussian (w=0)", make(StrategyKind::Gaussian, 0.0f)},
+            {"gaussian (w=" + std::to_string(mixture_weight).substr(0, 4) + ")", make(StrategyKind::Gaussian, mixture_weight)},
+            {"table (w=0)", make(StrategyKind::Table, 0.0f)},
+            {"table (w=" + std::to_string(mixture_weight).substr(0, 4) + ")", make(StrategyKind::Table, mixture_weight)}};
+}
+
+}  // namespace hairis::bench
