@@ -32,6 +32,15 @@ int main(int argc, char **argv) {
     hairis::cli::add_figures_command(app, exit_code);
     hairis::cli::add_fits_command(app, exit_code);
     hairis::cli::install_interrupt_handlers();
+    // CLI11 would only say "A subcommand is required": name the word and the choices.
+    bool known = argc < 2 || argv[1][0] == '-';
+    for (const CLI::App *sub : app.get_subcommands([](CLI::App *) { return true; }))
+        known = known || sub->get_name() == argv[1];
+    if (!known) {
+        std::cerr << "hairis-bake: unknown subcommand \"" << argv[1]
+                  << "\"; use one of bake, inspect, figures, fits (see --help)\n";
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError &e) {

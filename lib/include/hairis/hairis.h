@@ -4,9 +4,16 @@
  * Blender add-on (through ctypes). Conventions:
  *  - Functions that can fail return an int status (HAIRIS_OK = 0, otherwise an error code) or a
  *    handle that is NULL on failure; hairis_last_error() then describes what is wrong and what
- *    is allowed. Nothing aborts the process on bad input.
+ *    is allowed. Nothing aborts the process on bad input. Every function (except
+ *    hairis_last_error) sets the calling thread's last error, "" on success; getters and
+ *    _defaults given NULL set it and return "" (or nothing). Invalid arguments (NULL, not
+ *    finite, out of range, unknown enum values) give HAIRIS_ERROR_INVALID_ARGUMENT with a
+ *    message naming the argument; a C++ exception never escapes (HAIRIS_ERROR_INTERNAL).
  *  - Directions are unit 3-vectors in the fiber frame (x along the tangent, Cycles 3.4's frame:
  *    see lib/include/hairis/frame.h), packed as 3 floats each. Batches are arrays of n items.
+ *    Directions must be finite and of unit length within 1e-3, offsets h finite and in
+ *    [-1, 1]. A batch is checked whole before anything is written: on error the outputs are
+ *    untouched. n = 0 with NULL arrays is a no-op (HAIRIS_OK).
  *  - Handles are opaque and owned by the caller, released with the matching _destroy call.
  *  - Handles may be used from several threads for reading (eval, sample, pdf, render) at once.
  */
@@ -98,7 +105,8 @@ typedef int (*hairis_progress_fn)(void *user, float progress);
 HAIRIS_API int hairis_api_version(void);
 /** The library's version string, e.g. "0.1.0". */
 HAIRIS_API const char *hairis_version_string(void);
-/** The last error on the calling thread, or "" when the last call succeeded. Never NULL. */
+/** The last error on the calling thread, or "" when the last call succeeded. Never NULL; valid
+ * until the next hairis call on this thread. */
 HAIRIS_API const char *hairis_last_error(void);
 
 /* ---- Fibers ----------------------------------------------------------------------------- */
@@ -115,7 +123,11 @@ HAIRIS_API hairis_fiber *hairis_fiber_create_marschner(const hairis_marschner_pa
 HAIRIS_API void hairis_fiber_destroy(hairis_fiber *fiber);
 /** "chiang2016" or "marschner2003". */
 HAIRIS_API const char *hairis_fiber_model(const hairis_fiber *fiber);
-/** The fiber's parameters as "name=value;..." (what table metadata records). */
+/** The fiber's parameters as "name=value;..." (what table metadata records). For Chiang
+ * fibers these are the mapped closure parameters, so nodes that scatter alike give the same
+ * string. Marschner's float fields are widened through their shortest decimal form
+ * (1.55f -> 1.55), so values typed as decimals match a hairis-bake parameter file; angles in
+ * radians cannot reproduce a preset defined in degrees to the 9 digits the metadata keeps. */
 HAIRIS_API const char *hairis_fiber_parameters(const hairis_fiber *fiber);
 /**
  * Evaluates f(ω_i, ω_o)·|cos θ_i| (RGB) for n direction pairs. `h` holds n offsets for the
@@ -139,7 +151,9 @@ typedef struct hairis_bake_options {
 
 /** Fills `options` with the default table resolution. */
 HAIRIS_API void hairis_bake_options_defaults(hairis_bake_options *options);
-/** Bakes tables for a fiber; NULL on error or cancel (hairis_last_error says which). */
+/** Bakes tables for a fiber; NULL on error or cancel (hairis_last_error says which: after a
+ * cancel it is exactly "cancelled"). `progress` (may be NULL) is called on the calling
+ * thread; its returning non-zero cancels within one theta_r slice. */
 HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber,
                                              const hairis_bake_options *options,
                                              hairis_progress_fn progress, void *user);
@@ -155,7 +169,8 @@ HAIRIS_API void hairis_tables_destroy(hairis_tables *tables);
 HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables);
 /** The fiber parameters the tables were baked for, "name=value;...". */
 HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables);
-/** 1 when the tables were baked for exactly this fiber's parameters, else 0. */
+/** 1 when the tables were baked for exactly this fiber's parameters (same model, same
+ * parameter string), else 0 (also for NULL arguments, with the last error set). */
 HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hairis_fiber *fiber);
 
 /* ---- Sampling --------------------------------------------------------------------------- */
@@ -163,7 +178,9 @@ HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hair
 /**
  * A direction sampler. `fiber` is needed for ANALYTIC (Chiang only), `tables` for TABLE.
  * `multiple_weight` ∈ [0, 1] is the one-sample mixture weight of the multiple-scattering
- * distribution (TABLE and GAUSSIAN), `n_h` selects which multiple distribution.
+ * distribution (TABLE and GAUSSIAN), `n_h` selects which multiple distribution: one of the
+ * tables' n_h values (TABLE), one of 1, 2, 4, 8, 16 (GAUSSIAN), ignored otherwise. The sampler
+ * keeps what it samples from: it stays valid after `fiber` and `tables` are destroyed.
  */
 HAIRIS_API hairis_sampler *hairis_sampler_create(hairis_strategy strategy,
                                                  const hairis_fiber *fiber,
@@ -178,7 +195,7 @@ HAIRIS_API void hairis_sampler_destroy(hairis_sampler *sampler);
  */
 HAIRIS_API int hairis_sample(const hairis_sampler *sampler, size_t n, const float *wo,
                              const float *h, const float *u, float *wi_out, float *pdf_out);
-/** The solid-angle density with which hairis_sample produces each wi. */
+/** The solid-angle density with which hairis_sample produces each wi (h may be NULL: h = 0). */
 HAIRIS_API int hairis_pdf(const hairis_sampler *sampler, size_t n, const float *wi,
                           const float *wo, const float *h, float *pdf_out);
 
@@ -230,6 +247,10 @@ HAIRIS_API void hairis_scene_destroy(hairis_scene *scene);
 /**
  * Adds a hair material from a Principled Hair node; `tables` (may be NULL) are used by the
  * TABLE strategy and must match the node's parameters. Returns the material index, or −1.
+ * The scene keeps the tables' data (the tables handle may be destroyed). The match is checked
+ * by hairis_render, for the TABLE strategy only: a hair material without tables, with tables
+ * baked for other parameters, or without settings.n_h fails with HAIRIS_ERROR_INVALID_TABLE
+ * naming the material index.
  */
 HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene,
                                               const hairis_principled_hair *node,
@@ -240,12 +261,13 @@ HAIRIS_API int hairis_scene_add_diffuse_material(hairis_scene *scene, const floa
 /**
  * Adds hair curves drawn as round Catmull-Rom curves (Cycles' "3D Curves"): curve c has points
  * first[c] .. first[c+1]−1 (first has curve_count+1 entries), positions xyz in world space,
- * one radius per point.
+ * one radius per point. `material` must already be in the scene (hair or diffuse).
  */
 HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t curve_count,
                                        const uint32_t *first, size_t point_count,
                                        const float *positions, const float *radii);
-/** Adds a triangle mesh in world space; `materials` holds one material index per triangle. */
+/** Adds a triangle mesh in world space; `materials` holds one material index per triangle
+ * (diffuse materials already in the scene). */
 HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                                      const float *positions, size_t triangle_count,
                                      const uint32_t *indices, const int32_t *materials);
@@ -263,12 +285,17 @@ HAIRIS_API int hairis_scene_add_area_light(hairis_scene *scene, const float ligh
 HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const float color[3], float strength);
 /** The camera. */
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const hairis_camera *camera);
-/** Fills `settings` with defaults. */
+/** Fills `settings` with defaults: the add-on's (64 samples, 12 bounces, TABLE, weight 0.25,
+ * n_h 2, seed 0, all threads). */
 HAIRIS_API void hairis_render_settings_defaults(hairis_render_settings *settings);
 /**
  * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
  * wants). progress may be NULL; returning non-zero from it cancels (HAIRIS_ERROR_CANCELLED,
- * promptly). stats may be NULL.
+ * promptly; rgba then holds the average of the samples finished so far, and stats are filled).
+ * progress is only called on the calling thread. stats may be NULL; stats->seconds covers the
+ * whole call. A scene without camera or without geometry is refused. Each call builds the
+ * scene anew (the scene keeps its own copy of the geometry), so a scene can be rendered again
+ * with other settings, also from several threads at once. The camera does not clip.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const hairis_render_settings *settings,
                              float *rgba, hairis_progress_fn progress, void *user,

@@ -1,0 +1,267 @@
+"""The Hairis render engine: export, check or bake tables, render through the C API.
+
+The engine keeps no global state: everything a render needs (the loaded library, exported
+arrays, tables, the native scene) lives in local variables of :meth:`render` and is released
+before it returns. Failures are reported with ``self.report({'ERROR'}, ...)`` and
+``error_set`` (so ``bpy.ops.render.render()`` raises and the image editor shows the message);
+Blender keeps running.
+"""
+
+import os
+import time
+import traceback
+
+import bpy
+import numpy as np
+
+from . import export, native, tables
+
+DUMP_ENV = "HAIRIS_EXPORT_DUMP"
+"""When set, each render writes its exported scene to this ``.npz`` path (debugging, tests)."""
+
+
+class RenderFailed(Exception):
+    """A render cannot proceed; the message is shown to the user."""
+
+
+class ProgressReporter:
+    """The C progress callback: forwards progress to ``update_progress``, cancels on
+    ``test_break()``.
+
+    ``update_progress`` is rate-limited to every ``interval`` seconds; ``test_break`` is asked
+    on every call so a cancel is seen at the next callback. ``start``/``end`` map [0, 1] onto
+    a part of the progress bar.
+    """
+
+    def __init__(self, engine, start=0.0, end=1.0, interval=0.1, clock=time.monotonic):
+        self.engine = engine
+        self.start = start
+        self.end = end
+        self.interval = interval
+        self.clock = clock
+        self.last = None
+
+    def __call__(self, progress):
+        now = self.clock()
+        progress = min(max(float(progress), 0.0), 1.0)
+        if self.last is None or progress >= 1.0 or now - self.last >= self.interval:
+            self.engine.update_progress(self.start + (self.end - self.start) * progress)
+            self.last = now
+        return bool(self.engine.test_break())
+
+
+def camera_struct(camera):
+    """A ``native.Camera`` from :class:`export.CameraData`."""
+    struct = native.Camera()
+    struct.camera_to_world[:] = [float(v) for v in np.asarray(camera.camera_to_world).reshape(-1)]
+    struct.orthographic = 1 if camera.orthographic else 0
+    struct.frame[:] = [float(v) for v in np.asarray(camera.frame).reshape(-1)]
+    struct.width = int(camera.width)
+    struct.height = int(camera.height)
+    return struct
+
+
+def render_settings(library, settings):
+    """A ``native.RenderSettings`` from ``scene.hairis``."""
+    struct = library.render_settings_defaults()
+    struct.samples = int(settings.samples)
+    struct.max_bounces = int(settings.max_bounces)
+    struct.strategy = native.STRATEGIES[settings.strategy]
+    struct.multiple_weight = float(settings.multiple_weight)
+    struct.n_h = int(settings.n_h)
+    struct.seed = int(settings.seed)
+    struct.threads = int(settings.threads)
+    return struct
+
+
+def build_native_scene(library, data, hair_tables):
+    """A ``native.Scene`` holding everything in ``data`` (SceneData).
+
+    ``hair_tables`` maps a hair material's index in ``data.materials`` to its Tables (or
+    lacks it: no tables). The caller closes the returned scene.
+    """
+    scene = library.scene()
+    try:
+        indices = []
+        for i, material in enumerate(data.materials):
+            if material.kind == "HAIR":
+                node = tables.principled_struct(library, material.hair)
+                try:
+                    indices.append(scene.add_hair_material(node, hair_tables.get(i)))
+                except native.HairisError as error:
+                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                        from error
+            else:
+                indices.append(scene.add_diffuse_material(material.albedo, material.emission))
+        remap = np.array(indices or [0], dtype=np.int32)
+        for curves in data.curves:
+            scene.add_curves(int(remap[curves.material]), curves.first, curves.positions,
+                             curves.radii)
+        for mesh in data.meshes:
+            scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
+        for light in data.lights:
+            if light.kind == "SUN":
+                scene.add_sun(light.direction, light.color, light.strength, light.angle)
+            elif light.kind == "POINT":
+                scene.add_point_light(light.position, light.color, light.strength, light.radius)
+            elif light.kind == "AREA":
+                scene.add_area_light(light.matrix, light.shape, light.size_x, light.size_y,
+                                     light.color, light.strength)
+        scene.set_world(data.world_color, data.world_strength)
+        scene.set_camera(camera_struct(data.camera))
+    except BaseException:
+        scene.close()
+        raise
+    return scene
+
+
+class HairisRenderEngine(bpy.types.RenderEngine):
+    """Hairis: a hair path tracer with importance-sampled fiber scattering."""
+
+    bl_idname = "HAIRIS"
+    bl_label = "Hairis"
+    bl_use_preview = False
+    bl_use_shading_nodes_custom = False
+    bl_use_eevee_viewport = True
+
+    def render(self, depsgraph):
+        """Renders one view layer of ``depsgraph`` into the Combined pass."""
+        width, height = self.resolution_x, self.resolution_y
+        result = self.begin_result(0, 0, width, height)
+        try:
+            pixels = None
+            try:
+                pixels = self._render(depsgraph, width, height)
+            except native.HairisCancelled as cancelled:
+                pixels = getattr(cancelled, "rgba", None)
+                self.update_stats("", "Cancelled")
+            except (RenderFailed, export.ExportError, tables.TableError,
+                    native.HairisError) as error:
+                self._fail(str(error))
+            except Exception as error:  # noqa: BLE001 - Blender must keep running
+                traceback.print_exc()
+                self._fail("Hairis internal error: %s: %s (details in the console)"
+                           % (type(error).__name__, error))
+            if pixels is not None:
+                try:
+                    rect = result.layers[0].passes["Combined"].rect
+                    rect.foreach_set(np.ascontiguousarray(pixels, np.float32).reshape(-1, 4))
+                except Exception as error:  # noqa: BLE001
+                    self._fail("Hairis could not write the render result: %s" % error)
+        finally:
+            self.end_result(result)
+
+    def _fail(self, message):
+        self.report({"ERROR"}, message)
+        try:
+            self.error_set(message)
+        except AttributeError:  # error_set is missing before Blender 2.9x
+            pass
+        self.update_stats("", "Error: " + message)
+
+    def _render(self, depsgraph, width, height):
+        scene = depsgraph.scene
+        settings = scene.hairis
+        if scene.render.use_border:
+            raise RenderFailed("Render Region is not supported by Hairis: disable Output "
+                               "Properties > Format > Render Region")
+
+        self.update_stats("", "Exporting scene")
+        data = export.export_scene(depsgraph, self.camera_override)
+        dump = os.environ.get(DUMP_ENV)
+        if dump:
+            data.save_npz(dump)
+        for warning in data.warnings:
+            self.report({"WARNING"}, warning)
+        if (data.camera.width, data.camera.height) != (width, height):
+            raise RenderFailed("render size %d×%d differs from the exported camera's %d×%d"
+                               % (width, height, data.camera.width, data.camera.height))
+        if self.test_break():
+            return None
+
+        library = native.load_library()
+        hair_tables = self._resolve_tables(library, data, settings)
+        try:
+            with build_native_scene(library, data, hair_tables) as native_scene:
+                self.update_stats("", "Rendering %d samples (%s)"
+                                  % (settings.samples, settings.strategy.lower()))
+                rgba, stats = native_scene.render(render_settings(library, settings),
+                                                  ProgressReporter(self))
+        finally:
+            for table in hair_tables.values():
+                table.close()
+        peak = stats.peak_memory_bytes / (1024.0 * 1024.0)
+        self.update_memory_stats(memory_used=peak, memory_peak=peak)
+        self.update_stats("", "Rendered in %.2f s" % stats.seconds)
+        if stats.dropped_samples:
+            self.report({"WARNING"}, "%d samples with NaN or infinite values were dropped"
+                        % stats.dropped_samples)
+        return rgba
+
+    def _resolve_tables(self, library, data, settings):
+        """Tables per hair material index: current ones, auto-baked ones, or an error.
+
+        Only the TABLE strategy uses tables (the others get none). It refuses materials
+        without current tables unless Auto Bake is on, never rendering them silently wrong.
+        """
+        found = {}
+        problems = []
+        if settings.strategy != "TABLE":
+            return found
+        try:
+            for index, material in data.hair_materials():
+                node = tables.principled_struct(library, material.hair)
+                try:
+                    fiber = library.fiber_principled(node)
+                except native.HairisError as error:
+                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                        from error
+                with fiber:
+                    if material.source is not None:
+                        status = tables.check_material(library, material.source, fiber)
+                    else:
+                        status = tables.TableStatus("MISSING", "material %r has no sampling "
+                                                    "tables" % material.name)
+                    if status.ok:
+                        found[index] = status.tables
+                    elif settings.auto_bake:
+                        found[index] = self._auto_bake(library, material, fiber, settings,
+                                                       status)
+                    else:
+                        problems.append(status.message)
+        except BaseException:
+            for table in found.values():
+                table.close()
+            raise
+        if problems:
+            for table in found.values():
+                table.close()
+            raise RenderFailed(
+                "the Table strategy needs current sampling tables: %s. Bake them (Material "
+                "Properties > Hairis Sampling Tables > Bake) or enable Auto Bake"
+                % "; ".join(problems))
+        return found
+
+    def _auto_bake(self, library, material, fiber, settings, status):
+        cached = tables.cached_tables(library, fiber)
+        if cached is not None:
+            self.report({"INFO"}, "%s: using tables auto-baked earlier in this session"
+                        % status.message)
+            return cached
+        self.update_stats("", "Baking sampling tables for %s" % material.name)
+        options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads)
+        baked = library.bake_tables(fiber, options, ProgressReporter(self))
+        tables.write_cache(baked, fiber)
+        self.report({"INFO"}, "%s: baked them for this render (Bake Sampling Tables stores them "
+                    "with the .blend)" % status.message)
+        return baked
+
+
+def register():
+    """Registers the engine."""
+    bpy.utils.register_class(HairisRenderEngine)
+
+
+def unregister():
+    """Unregisters the engine."""
+    bpy.utils.unregister_class(HairisRenderEngine)

@@ -1,0 +1,842 @@
+"""Scene export: the evaluated depsgraph → plain numpy arrays (:class:`SceneData`).
+
+Nothing here needs the native library, so the export can be tested on its own. All bulk
+data moves with ``foreach_get`` into numpy and is transformed in numpy; the only per-point
+calls left are ``ParticleSystem.co_hair``, which is the one accessor Blender 3.4's Python API
+has for the evaluated particle path cache (see :func:`export_particle_hair`).
+
+Rules follow Cycles 3.4 (``intern/cycles/blender/curves.cpp``, ``object.cpp``, ``light.cpp``):
+
+- particle hair: systems of type HAIR drawn as PATH whose modifier is enabled for the
+  depsgraph's mode; ``2**render_step + 1`` keys per strand (``display_step`` in the viewport,
+  plus ``kink_extra_steps`` for spiral kink); only the children when there are any, else the
+  parents; radius ``radius_scale·0.5·(tip + (root − tip)·shape(1 − t))`` with t the
+  object-space arc-length fraction, 0 at the tip with ``use_close_tip``; material slot
+  ``settings.material``;
+- Curves objects: the ``radius`` point attribute, 0.005 without it; material slot 1;
+- curve radii scale with the cube root of the object matrix's determinant (Hair::apply_transform).
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+
+DEFAULT_CURVES_RADIUS = 0.005
+"""Cycles' radius for Curves without a ``radius`` attribute."""
+
+DEFAULT_ALBEDO = (0.8, 0.8, 0.8)
+"""Cycles' default surface (no material): a 0.8 grey diffuse."""
+
+PARAMETRIZATIONS = {"ABSORPTION": 0, "MELANIN": 1, "COLOR": 2}
+"""Principled Hair BSDF ``parametrization`` → hairis_parametrization."""
+
+HAIR_INPUTS = (
+    # (hairis_principled_hair field, node input name, number of components)
+    ("color", "Color", 3),
+    ("melanin", "Melanin", 1),
+    ("melanin_redness", "Melanin Redness", 1),
+    ("tint", "Tint", 3),
+    ("absorption_coefficient", "Absorption Coefficient", 3),
+    ("roughness", "Roughness", 1),
+    ("radial_roughness", "Radial Roughness", 1),
+    ("coat", "Coat", 1),
+    ("ior", "IOR", 1),
+    ("offset", "Offset", 1),
+    ("random_color", "Random Color", 1),
+    ("random_roughness", "Random Roughness", 1),
+    ("random", "Random", 1),
+)
+"""Every input of the Principled Hair BSDF node and the C struct field it fills."""
+
+HAIR_NODE_IDNAME = "ShaderNodeBsdfHairPrincipled"
+
+GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+"""Object types exported as triangle meshes (through ``Object.to_mesh``)."""
+
+
+class ExportError(Exception):
+    """The scene cannot be rendered as it is (no camera, unsupported camera, ...)."""
+
+
+@dataclass
+class HairParameters:
+    """A Principled Hair BSDF node's values, field for field as ``hairis_principled_hair``."""
+
+    parametrization: int = PARAMETRIZATIONS["COLOR"]
+    color: tuple = (0.017513, 0.005763, 0.002059)
+    melanin: float = 0.8
+    melanin_redness: float = 1.0
+    tint: tuple = (1.0, 1.0, 1.0)
+    absorption_coefficient: tuple = (0.245531, 0.52, 1.365)
+    roughness: float = 0.3
+    radial_roughness: float = 0.3
+    coat: float = 0.0
+    ior: float = 1.55
+    offset: float = math.radians(2.0)
+    random_color: float = 0.0
+    random_roughness: float = 0.0
+    random: float = 0.0
+
+    def as_dict(self):
+        """The values keyed by C field name."""
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
+
+
+@dataclass
+class MaterialData:
+    """One scene material: ``kind`` is 'HAIR' (``hair`` set) or 'DIFFUSE'."""
+
+    name: str
+    kind: str
+    hair: HairParameters = None
+    albedo: tuple = DEFAULT_ALBEDO
+    emission: tuple = (0.0, 0.0, 0.0)
+    material_name: str = None
+    """The Blender material it came from (None for the default material)."""
+    source: object = None
+    """The original ``bpy.types.Material`` (None for the default material)."""
+
+
+@dataclass
+class CurvesData:
+    """Hair curves in world space: curve c has points ``first[c] .. first[c+1]−1``."""
+
+    name: str
+    source: str
+    """'PARTICLES' or 'CURVES'."""
+    material: int
+    first: np.ndarray
+    positions: np.ndarray
+    radii: np.ndarray
+
+    @property
+    def curve_count(self):
+        """Number of curves."""
+        return int(self.first.size - 1)
+
+    @property
+    def point_count(self):
+        """Number of points."""
+        return int(self.positions.shape[0])
+
+
+@dataclass
+class MeshData:
+    """A world-space triangle mesh with one scene material index per triangle."""
+
+    name: str
+    positions: np.ndarray
+    indices: np.ndarray
+    materials: np.ndarray
+
+
+@dataclass
+class LightData:
+    """A light: ``kind`` 'SUN', 'POINT' or 'AREA'; unused fields keep their defaults."""
+
+    name: str
+    kind: str
+    color: tuple
+    strength: float = 0.0
+    """Sun strength in W/m², or point/area power in W."""
+    direction: tuple = (0.0, 0.0, 1.0)
+    angle: float = 0.0
+    position: tuple = (0.0, 0.0, 0.0)
+    radius: float = 0.0
+    matrix: np.ndarray = None
+    """Row-major 4×4 light-to-world (area lights)."""
+    shape: str = "SQUARE"
+    size_x: float = 0.0
+    size_y: float = 0.0
+
+
+@dataclass
+class CameraData:
+    """The camera: row-major camera-to-world without scale, view_frame corners, resolution."""
+
+    name: str
+    camera_to_world: np.ndarray
+    orthographic: bool
+    frame: np.ndarray
+    width: int
+    height: int
+
+
+@dataclass
+class SceneData:
+    """Everything a render needs, as plain Python and numpy values."""
+
+    materials: list = field(default_factory=list)
+    curves: list = field(default_factory=list)
+    meshes: list = field(default_factory=list)
+    lights: list = field(default_factory=list)
+    world_color: tuple = (0.0, 0.0, 0.0)
+    world_strength: float = 0.0
+    camera: CameraData = None
+    warnings: list = field(default_factory=list)
+
+    def warn(self, message):
+        """Records a warning once."""
+        if message not in self.warnings:
+            self.warnings.append(message)
+
+    def hair_materials(self):
+        """(index, MaterialData) of every hair material."""
+        return [(i, m) for i, m in enumerate(self.materials) if m.kind == "HAIR"]
+
+    def save_npz(self, path):
+        """Writes the arrays and a summary to an ``.npz`` file (debugging and tests)."""
+        arrays = {}
+        for i, curves in enumerate(self.curves):
+            arrays["curves%d_first" % i] = curves.first
+            arrays["curves%d_positions" % i] = curves.positions
+            arrays["curves%d_radii" % i] = curves.radii
+            arrays["curves%d_material" % i] = np.array(curves.material)
+            arrays["curves%d_name" % i] = np.array(curves.name)
+            arrays["curves%d_source" % i] = np.array(curves.source)
+        for i, mesh in enumerate(self.meshes):
+            arrays["mesh%d_positions" % i] = mesh.positions
+            arrays["mesh%d_indices" % i] = mesh.indices
+            arrays["mesh%d_materials" % i] = mesh.materials
+            arrays["mesh%d_name" % i] = np.array(mesh.name)
+        for i, material in enumerate(self.materials):
+            arrays["material%d_kind" % i] = np.array(material.kind)
+            arrays["material%d_name" % i] = np.array(material.name)
+            if material.hair is not None:
+                for key, value in material.hair.as_dict().items():
+                    arrays["material%d_hair_%s" % (i, key)] = np.array(value)
+        arrays["world"] = np.array(tuple(self.world_color) + (self.world_strength,))
+        if self.camera is not None:
+            arrays["camera_to_world"] = self.camera.camera_to_world
+            arrays["camera_frame"] = self.camera.frame
+            arrays["camera_size"] = np.array([self.camera.width, self.camera.height])
+        arrays["counts"] = np.array([len(self.curves), len(self.meshes), len(self.materials),
+                                     len(self.lights)])
+        np.savez(path, **arrays)
+
+
+# ---- Small helpers ---------------------------------------------------------------------------
+
+def _matrix(matrix):
+    """A mathutils 4×4 matrix as a float64 numpy array (row-major)."""
+    return np.array([tuple(row) for row in matrix], dtype=np.float64)
+
+
+def _transform_points(matrix, points):
+    """Applies a 4×4 numpy matrix to (n, 3) points."""
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def _uniform_scale(matrix):
+    """Cycles' radius scale for a transform: cbrt(|det(M3×3)|)."""
+    return float(abs(np.linalg.det(matrix[:3, :3])) ** (1.0 / 3.0))
+
+
+def _rgb(value):
+    return tuple(float(v) for v in tuple(value)[:3])
+
+
+def render_resolution(scene):
+    """The output size in pixels: resolution × percentage / 100 (integer, as Blender)."""
+    render = scene.render
+    width = render.resolution_x * render.resolution_percentage // 100
+    height = render.resolution_y * render.resolution_percentage // 100
+    return int(width), int(height)
+
+
+def is_render_depsgraph(depsgraph):
+    """True for a final-render depsgraph (F12), False for the viewport's."""
+    return getattr(depsgraph, "mode", "VIEWPORT") == "RENDER"
+
+
+# ---- Node trees ------------------------------------------------------------------------------
+
+def _follow_link(socket):
+    """The (node, socket) feeding ``socket``, through reroutes; (None, None) if unlinked."""
+    seen = set()
+    while socket is not None and socket.is_linked:
+        links = [link for link in socket.links if getattr(link, "is_valid", True)
+                 and not getattr(link, "is_muted", False)]
+        if not links:
+            return None, None
+        link = links[0]
+        node = link.from_node
+        if node.as_pointer() in seen:
+            return None, None
+        seen.add(node.as_pointer())
+        if node.type == "REROUTE":
+            socket = node.inputs[0] if len(node.inputs) else None
+            continue
+        if getattr(node, "mute", False):
+            # A muted node passes its internal link through, or outputs nothing.
+            through = [internal.from_socket for internal in node.internal_links
+                       if internal.to_socket == link.from_socket]
+            if not through:
+                return None, None
+            socket = through[0]
+            continue
+        return node, link.from_socket
+    return None, None
+
+
+def output_node(node_tree):
+    """The active output node Cycles would use (target CYCLES, else ALL)."""
+    if node_tree is None:
+        return None
+    node = None
+    getter = getattr(node_tree, "get_output_node", None)
+    if getter is not None:
+        for target in ("CYCLES", "ALL"):
+            try:
+                node = getter(target)
+            except (TypeError, ValueError):
+                node = None
+            if node is not None:
+                return node
+    for node in node_tree.nodes:
+        if node.type in {"OUTPUT_MATERIAL", "OUTPUT_WORLD", "OUTPUT_LIGHT"}:
+            if getattr(node, "is_active_output", True):
+                return node
+    return None
+
+
+def _input(node, name):
+    """The node input called ``name`` (by name or identifier), preferring enabled sockets."""
+    found = None
+    for socket in node.inputs:
+        if socket.name == name or socket.identifier == name:
+            if getattr(socket, "enabled", True):
+                return socket
+            found = found or socket
+    return found
+
+
+def surface_node(material):
+    """The shader node connected to the active material output's Surface, or None."""
+    if material is None or not material.use_nodes or material.node_tree is None:
+        return None
+    output = output_node(material.node_tree)
+    if output is None:
+        return None
+    surface = _input(output, "Surface")
+    if surface is None:
+        return None
+    node, _ = _follow_link(surface)
+    return node
+
+
+def hair_node(material):
+    """The Principled Hair BSDF connected to the material output, or None."""
+    node = surface_node(material)
+    if node is not None and node.bl_idname == HAIR_NODE_IDNAME:
+        return node
+    return None
+
+
+def is_hair_material(material):
+    """True for a material whose output is fed by a Principled Hair BSDF."""
+    return hair_node(material) is not None
+
+
+def _socket_value(socket, components):
+    value = socket.default_value
+    if components == 1:
+        return float(value)
+    values = tuple(float(v) for v in tuple(value)[:components])
+    if len(values) != components:
+        raise ValueError("input %r has %d components, expected %d"
+                         % (socket.name, len(values), components))
+    return values
+
+
+def read_hair_node(node, material_name="?"):
+    """Reads a Principled Hair BSDF node: returns (HairParameters, warnings, error or None).
+
+    Reads every input's unlinked value by name, defensively: a linked input is a warning
+    (hairis uses its unlinked value), a missing input or a model other than Chiang (Blender
+    4.x's ``model`` setting) is an error for this material.
+    """
+    warnings = []
+    model = getattr(node, "model", "CHIANG")
+    if model != "CHIANG":
+        return None, warnings, ("material %r: the Principled Hair BSDF model %r is not supported "
+                                "(hairis implements the Chiang model)" % (material_name, model))
+    parametrization = getattr(node, "parametrization", None)
+    if parametrization not in PARAMETRIZATIONS:
+        return None, warnings, ("material %r: unknown Principled Hair parametrization %r"
+                                % (material_name, parametrization))
+    values = {"parametrization": PARAMETRIZATIONS[parametrization]}
+    for field_name, input_name, components in HAIR_INPUTS:
+        socket = _input(node, input_name)
+        if socket is None:
+            return None, warnings, ("material %r: the Principled Hair BSDF has no %r input "
+                                    "(unsupported Blender version?)" % (material_name, input_name))
+        if socket.is_linked:
+            warnings.append("material %r: input %r of the Principled Hair BSDF is linked; hairis "
+                            "uses its unlinked value" % (material_name, input_name))
+        try:
+            values[field_name] = _socket_value(socket, components)
+        except (TypeError, ValueError) as error:
+            return None, warnings, "material %r: %s" % (material_name, error)
+    random = _input(node, "Random")
+    randomized = values["random_roughness"] > 0.0 or (
+        values["random_color"] > 0.0 and values["parametrization"] == PARAMETRIZATIONS["MELANIN"])
+    if randomized and not random.is_linked:
+        # Cycles feeds an unlinked Random with a per-strand random number (the socket shows
+        # "Default"); hairis_principled_hair has one value for every strand.
+        warnings.append("material %r: Cycles varies Random Color/Random Roughness per strand "
+                        "when Random is unlinked; hairis uses Random = %g for every strand"
+                        % (material_name, values["random"]))
+    return HairParameters(**values), warnings, None
+
+
+def read_surface_material(material):
+    """A non-hair material as (albedo, emission, warnings): Principled/Diffuse/Emission."""
+    warnings = []
+    name = material.name
+    if not material.use_nodes or material.node_tree is None:
+        return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
+    node = surface_node(material)
+    if node is None:
+        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), warnings  # Cycles: black surface
+    kind = node.bl_idname
+
+    def value(socket_name, components=3, default=None):
+        socket = _input(node, socket_name)
+        if socket is None:
+            return default
+        if socket.is_linked:
+            warnings.append("material %r: input %r of %s is linked (textures are not supported); "
+                            "hairis uses its unlinked value" % (name, socket_name, node.name))
+        return _socket_value(socket, components)
+
+    if kind == "ShaderNodeBsdfPrincipled":
+        albedo = value("Base Color", 3, DEFAULT_ALBEDO)
+        emission = value("Emission", 3, (0.0, 0.0, 0.0))
+        strength = value("Emission Strength", 1, 1.0)
+        return albedo, tuple(e * strength for e in emission), warnings
+    if kind == "ShaderNodeBsdfDiffuse":
+        return value("Color", 3, DEFAULT_ALBEDO), (0.0, 0.0, 0.0), warnings
+    if kind == "ShaderNodeEmission":
+        color = value("Color", 3, (1.0, 1.0, 1.0))
+        strength = value("Strength", 1, 1.0)
+        return (0.0, 0.0, 0.0), tuple(c * strength for c in color), warnings
+    warnings.append("material %r: %s is not supported on meshes; using its viewport colour as a "
+                    "diffuse albedo" % (name, node.bl_label or kind))
+    return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
+
+
+# ---- The exporter ----------------------------------------------------------------------------
+
+class _Exporter:
+    """One export pass over a depsgraph (a fresh instance per export: no shared state)."""
+
+    def __init__(self, depsgraph, camera=None):
+        self.depsgraph = depsgraph
+        self.camera_object = camera
+        self.scene = depsgraph.scene
+        self.background = is_render_depsgraph(depsgraph)
+        self.data = SceneData()
+        self._material_index = {}
+        self._default_index = None
+        self._mesh_cache = {}
+
+    # -- materials --
+
+    def default_material(self):
+        """The scene index of the default grey diffuse material."""
+        if self._default_index is None:
+            self._default_index = len(self.data.materials)
+            self.data.materials.append(MaterialData(name="(default)", kind="DIFFUSE"))
+        return self._default_index
+
+    def material(self, material, for_hair):
+        """The scene index for a Blender material on hair (``for_hair``) or on a surface."""
+        if material is None:
+            return self.default_material()
+        key = (material.name_full, for_hair)
+        index = self._material_index.get(key)
+        if index is not None:
+            return index
+        node = hair_node(material)
+        if node is not None:
+            if not for_hair:
+                self.data.warn("material %r: Principled Hair BSDF on a mesh is not supported; "
+                               "rendering it as grey diffuse" % material.name)
+                data = MaterialData(name=material.name, kind="DIFFUSE",
+                                    material_name=material.name, source=material.original)
+            else:
+                params, warnings, error = read_hair_node(node, material.name)
+                for warning in warnings:
+                    self.data.warn(warning)
+                if error is not None:
+                    raise ExportError(error)
+                data = MaterialData(name=material.name, kind="HAIR", hair=params,
+                                    material_name=material.name, source=material.original)
+        else:
+            albedo, emission, warnings = read_surface_material(material)
+            for warning in warnings:
+                self.data.warn(warning)
+            if for_hair:
+                self.data.warn("material %r on hair has no Principled Hair BSDF; hairis renders "
+                               "the strands as diffuse" % material.name)
+            data = MaterialData(name=material.name, kind="DIFFUSE", albedo=albedo,
+                                emission=emission, material_name=material.name,
+                                source=material.original)
+        index = len(self.data.materials)
+        self.data.materials.append(data)
+        self._material_index[key] = index
+        return index
+
+    @staticmethod
+    def slot_material(obj, slot_index):
+        """The material in slot ``slot_index`` (clamped like Cycles), or None."""
+        slots = obj.material_slots
+        if len(slots) == 0:
+            return None
+        slot_index = min(max(int(slot_index), 0), len(slots) - 1)
+        return slots[slot_index].material
+
+    # -- objects --
+
+    def run(self):
+        """Exports camera, world and every object instance; returns the SceneData."""
+        self.export_camera()
+        self.export_world()
+        use_hair = getattr(self.depsgraph.view_layer, "use_strand", True)
+        for instance in self.depsgraph.object_instances:
+            obj = instance.object
+            kind = obj.type
+            matrix = _matrix(instance.matrix_world)
+            if kind == "LIGHT":
+                self.export_light(obj, matrix)
+            elif kind == "CURVES":
+                if use_hair:
+                    self.export_curves_object(obj, matrix)
+            elif kind in GEOMETRY_TYPES:
+                show_self = getattr(instance, "show_self", True)
+                show_particles = getattr(instance, "show_particles", True)
+                if show_self:
+                    self.export_mesh(obj, matrix, instance.is_instance)
+                if show_particles and use_hair and len(getattr(obj, "particle_systems", ())):
+                    if instance.is_instance:
+                        self.data.warn("object %r: particle hair on instances is not exported"
+                                       % obj.name)
+                    else:
+                        export_particle_hair(self, obj)
+            elif kind in {"VOLUME", "POINTCLOUD", "GPENCIL"}:
+                self.data.warn("object %r: %s objects are not supported" % (obj.name, kind.lower()))
+        return self.data
+
+    def export_camera(self):
+        """The scene camera (``view_frame`` corners, matrix without scale, resolution)."""
+        scene = self.scene
+        camera = self.camera_object or scene.camera
+        if camera is None:
+            raise ExportError("the scene has no camera")
+        camera = camera.evaluated_get(self.depsgraph)
+        if camera.type != "CAMERA":
+            raise ExportError("the scene camera %r is not a camera object" % camera.name)
+        cam = camera.data
+        if cam.type == "PANO":
+            raise ExportError("camera %r: panoramic cameras are not supported" % camera.name)
+        width, height = render_resolution(scene)
+        if width < 1 or height < 1:
+            raise ExportError("the output resolution %d×%d is empty" % (width, height))
+        frame = np.array([tuple(v) for v in cam.view_frame(scene=scene)], dtype=np.float32)
+        matrix = _matrix(camera.matrix_world)
+        axes = matrix[:3, :3]
+        norms = np.linalg.norm(axes, axis=0)
+        if np.any(norms == 0):
+            raise ExportError("camera %r has a zero scale" % camera.name)
+        matrix[:3, :3] = axes / norms
+        if cam.dof.use_dof:
+            self.data.warn("camera %r: depth of field is not supported" % camera.name)
+        self.data.camera = CameraData(name=camera.name, camera_to_world=matrix.astype(np.float32),
+                                      orthographic=cam.type == "ORTHO", frame=frame,
+                                      width=width, height=height)
+
+    def export_world(self):
+        """Background colour·strength of a Background node, or ``world.color``."""
+        world = self.scene.world
+        if world is None:
+            return
+        if not world.use_nodes or world.node_tree is None:
+            self.data.world_color = _rgb(world.color)
+            self.data.world_strength = 1.0
+            return
+        output = output_node(world.node_tree)
+        surface = _input(output, "Surface") if output is not None else None
+        node, _ = _follow_link(surface) if surface is not None else (None, None)
+        if node is None:
+            return  # Cycles: black
+        if node.bl_idname != "ShaderNodeBackground":
+            self.data.warn("world %r: %s is not supported; using the world colour"
+                           % (world.name, node.bl_label or node.bl_idname))
+            self.data.world_color = _rgb(world.color)
+            self.data.world_strength = 1.0
+            return
+        color = _input(node, "Color")
+        strength = _input(node, "Strength")
+        for socket in (color, strength):
+            if socket is not None and socket.is_linked:
+                self.data.warn("world %r: input %r of the Background is linked (environment "
+                               "textures are not supported); hairis uses its unlinked value"
+                               % (world.name, socket.name))
+        self.data.world_color = _rgb(color.default_value) if color else (0.0, 0.0, 0.0)
+        self.data.world_strength = float(strength.default_value) if strength else 1.0
+
+    def export_light(self, obj, matrix):
+        """Sun, point and area lights; spot lights are reported and skipped."""
+        light = obj.data
+        color = _rgb(light.color)
+        if getattr(light, "use_nodes", False) and light.node_tree is not None:
+            self.data.warn("light %r: light node trees are ignored" % obj.name)
+        kind = light.type
+        if kind == "SUN":
+            direction = matrix[:3, 2]
+            norm = np.linalg.norm(direction)
+            if norm == 0:
+                self.data.warn("light %r has a zero scale; skipped" % obj.name)
+                return
+            self.data.lights.append(LightData(
+                name=obj.name, kind="SUN", color=color, strength=float(light.energy),
+                direction=tuple(float(v) for v in direction / norm), angle=float(light.angle)))
+        elif kind == "POINT":
+            self.data.lights.append(LightData(
+                name=obj.name, kind="POINT", color=color, strength=float(light.energy),
+                position=tuple(float(v) for v in matrix[:3, 3]),
+                radius=float(light.shadow_soft_size)))
+        elif kind == "AREA":
+            size_y = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
+            self.data.lights.append(LightData(
+                name=obj.name, kind="AREA", color=color, strength=float(light.energy),
+                matrix=matrix.astype(np.float32), shape=light.shape, size_x=float(light.size),
+                size_y=float(size_y)))
+        else:
+            self.data.warn("light %r: %s lights are not supported; skipped"
+                           % (obj.name, kind.lower()))
+
+    def export_mesh(self, obj, matrix, is_instance):
+        """A triangle mesh from ``to_mesh`` + ``loop_triangles``, transformed in numpy."""
+        key = obj.name_full if is_instance else None
+        local = self._mesh_cache.get(key) if key is not None else None
+        if local is None:
+            local = self._triangulate(obj)
+            if key is not None:
+                self._mesh_cache[key] = local
+        if local is None:
+            return
+        positions, indices, slots = local
+        slot_count = len(obj.material_slots)
+        slots = np.clip(slots, 0, max(slot_count - 1, 0))
+        materials = np.empty(slots.size, np.int32)
+        for slot in np.unique(slots):  # only the slots triangles use
+            materials[slots == slot] = self.material(self.slot_material(obj, slot),
+                                                     for_hair=False)
+        self.data.meshes.append(MeshData(
+            name=obj.name, positions=_transform_points(matrix, positions).astype(np.float32),
+            indices=indices, materials=materials.astype(np.int32)))
+
+    @staticmethod
+    def _triangulate(obj):
+        """(positions, triangle indices, triangle material slots) in object space, or None."""
+        try:
+            mesh = obj.to_mesh()
+        except RuntimeError:
+            return None
+        if mesh is None:
+            return None
+        try:
+            mesh.calc_loop_triangles()
+            vertex_count = len(mesh.vertices)
+            triangle_count = len(mesh.loop_triangles)
+            if vertex_count == 0 or triangle_count == 0:
+                return None
+            positions = np.empty(vertex_count * 3, np.float32)
+            mesh.vertices.foreach_get("co", positions)
+            indices = np.empty(triangle_count * 3, np.int32)
+            mesh.loop_triangles.foreach_get("vertices", indices)
+            slots = np.empty(triangle_count, np.int32)
+            mesh.loop_triangles.foreach_get("material_index", slots)
+        finally:
+            obj.to_mesh_clear()
+        return (positions.reshape(-1, 3).astype(np.float64),
+                indices.reshape(-1, 3).astype(np.uint32), slots)
+
+    def export_curves_object(self, obj, matrix):
+        """A Curves object (Blender 3.3+ hair): positions, offsets, radius via foreach_get."""
+        curves = obj.data
+        curve_count = len(curves.curves)
+        point_count = len(curves.points)
+        if curve_count == 0 or point_count == 0:
+            return
+        offsets = np.empty(curve_count + 1, np.int32)
+        offset_data = curves.curve_offset_data
+        if len(offset_data) == curve_count + 1:
+            offset_data.foreach_get("value", offsets)
+        else:  # defensive: build them from the curve slices
+            starts = np.empty(curve_count, np.int32)
+            curves.curves.foreach_get("first_point_index", starts)
+            offsets[:-1] = starts
+            offsets[-1] = point_count
+        positions = np.empty(point_count * 3, np.float32)
+        position_data = getattr(curves, "position_data", None)
+        if position_data is None:
+            position_data = curves.attributes["position"].data
+        position_data.foreach_get("vector", positions)
+        radii = np.full(point_count, DEFAULT_CURVES_RADIUS, np.float32)
+        radius = curves.attributes.get("radius")
+        if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
+            radius.data.foreach_get("value", radii)
+        positions = positions.reshape(-1, 3).astype(np.float64)
+        world = _transform_points(matrix, positions)
+        radii = radii.astype(np.float64) * _uniform_scale(matrix)
+        first, world, radii, dropped = _drop_short_curves(offsets, world, radii)
+        if dropped:
+            self.data.warn("object %r: %d curves with fewer than 2 points skipped"
+                           % (obj.name, dropped))
+        if first.size < 2:
+            return
+        material = self.material(self.slot_material(obj, 0), for_hair=True)
+        self.data.curves.append(CurvesData(
+            name=obj.name, source="CURVES", material=material, first=first,
+            positions=world.astype(np.float32), radii=radii.astype(np.float32)))
+
+
+def _drop_short_curves(offsets, positions, radii):
+    """Removes curves with fewer than 2 points; returns (first uint32, positions, radii, n)."""
+    offsets = np.asarray(offsets, dtype=np.int64)
+    counts = np.diff(offsets)
+    keep = counts >= 2
+    dropped = int(np.count_nonzero(~keep))
+    if dropped:
+        point_keep = np.repeat(keep, counts)
+        positions = positions[point_keep]
+        radii = radii[point_keep]
+        counts = counts[keep]
+    first = np.zeros(counts.size + 1, np.uint32)
+    np.cumsum(counts, out=first[1:])
+    return first, positions, radii, dropped
+
+
+def shape_radius(time, shape, root, tip):
+    """Cycles' ``shaperadius``: the strand radius at arc-length fraction ``time`` ∈ [0, 1]."""
+    radius = 1.0 - np.asarray(time, dtype=np.float64)
+    if shape < 0.0:
+        radius = np.power(radius, 1.0 + shape)
+    elif shape > 0.0:
+        exponent = 1.0 / (1.0 - shape) if shape < 1.0 else np.inf
+        with np.errstate(over="ignore"):
+            radius = np.power(radius, exponent)
+    return radius * (root - tip) + tip
+
+
+def _particle_modifier(obj, psys):
+    for modifier in obj.modifiers:
+        if modifier.type == "PARTICLE_SYSTEM" and modifier.particle_system is not None \
+                and modifier.particle_system.name == psys.name:
+            return modifier
+    return None
+
+
+def particle_hair_points(obj, psys, first_particle, curve_count, key_count):
+    """World positions (curve_count, key_count, 3) of strands from the path cache.
+
+    Blender 3.4's Python API has no bulk accessor for the evaluated path cache:
+    ``ParticleHairKey`` holds only the parents' edit keys (``co_local`` in each strand's
+    hair space, and ``foreach_get("co")`` on evaluated keys crashes 3.4), and the Curves
+    conversion is an operator that edits ``bpy.data``. So this is the one per-point call:
+    ``co_hair`` streamed by a generator straight into ``np.fromiter`` (no Python list or
+    Vector per point is kept; about 1–3 µs per point). Everything after it is numpy.
+    """
+    co_hair = psys.co_hair
+    stream = (c for particle in range(first_particle, first_particle + curve_count)
+              for step in range(key_count)
+              for c in co_hair(obj, particle_no=particle, step=step))
+    count = curve_count * key_count * 3
+    points = np.fromiter(stream, dtype=np.float32, count=count)
+    return points.reshape(curve_count, key_count, 3).astype(np.float64)
+
+
+def export_particle_hair(exporter, obj):
+    """Exports every rendered hair particle system of the evaluated object ``obj``."""
+    data = exporter.data
+    matrix = _matrix(obj.matrix_world)
+    try:
+        inverse = np.linalg.inv(matrix)
+    except np.linalg.LinAlgError:
+        data.warn("object %r has a singular matrix; its particle hair is skipped" % obj.name)
+        return
+    scale = _uniform_scale(matrix)
+    for psys in obj.particle_systems:
+        settings = psys.settings
+        if settings.type != "HAIR" or settings.render_type != "PATH":
+            continue
+        modifier = _particle_modifier(obj, psys)
+        if modifier is not None:
+            enabled = modifier.show_render if exporter.background else modifier.show_viewport
+            if not enabled:
+                continue
+        parent_count = len(psys.particles)
+        child_count = len(psys.child_particles)
+        if not exporter.background:
+            child_count = int(child_count * settings.display_percentage / 100.0)
+        if settings.child_type == "NONE" or child_count == 0:
+            first_particle, curve_count = 0, parent_count + child_count
+        else:
+            first_particle, curve_count = parent_count, child_count
+        if curve_count == 0:
+            continue
+        steps = settings.render_step if exporter.background else settings.display_step
+        key_count = (1 << steps) + 1
+        if settings.kink == "SPIRAL":
+            key_count += settings.kink_extra_steps
+        points = particle_hair_points(obj, psys, first_particle, curve_count, key_count)
+        # co_hair gives (0, 0, 0) where the cache has no key: repeat the previous key, as
+        # Cycles does, and drop strands with no key at all.
+        valid = np.any(points != 0.0, axis=2)
+        present = valid.any(axis=1)
+        if not present.all():
+            points, valid = points[present], valid[present]
+            curve_count = points.shape[0]
+            if curve_count == 0:
+                continue
+        index = np.where(valid, np.arange(key_count)[None, :], 0)
+        np.maximum.accumulate(index, axis=1, out=index)
+        points = np.take_along_axis(points, index[:, :, None], axis=1)
+        # Arc-length fraction in object space, as Cycles.
+        local = _transform_points(inverse, points.reshape(-1, 3)).reshape(points.shape)
+        segment = np.linalg.norm(np.diff(local, axis=1), axis=2)
+        length = np.concatenate([np.zeros((curve_count, 1)), np.cumsum(segment, axis=1)], axis=1)
+        total = length[:, -1:]
+        time = np.divide(length, total, out=np.zeros_like(length), where=total > 0.0)
+        half = settings.radius_scale * 0.5
+        radii = shape_radius(time, settings.shape, half * settings.root_radius,
+                             half * settings.tip_radius)
+        if settings.use_close_tip:
+            radii[:, -1] = 0.0
+        radii *= scale
+        material = exporter.material(exporter.slot_material(obj, settings.material - 1),
+                                     for_hair=True)
+        first = np.arange(curve_count + 1, dtype=np.uint32) * np.uint32(key_count)
+        data.curves.append(CurvesData(
+            name="%s/%s" % (obj.name, psys.name), source="PARTICLES", material=material,
+            first=first, positions=points.reshape(-1, 3).astype(np.float32),
+            radii=radii.reshape(-1).astype(np.float32)))
+
+
+def export_scene(depsgraph, camera=None):
+    """Exports the evaluated depsgraph to :class:`SceneData` (raises :class:`ExportError`).
+
+    ``camera`` overrides the scene camera (``RenderEngine.camera_override``).
+    """
+    return _Exporter(depsgraph, camera).run()
+
+
+def export_context(context=None):
+    """Exports the viewport depsgraph of ``context`` (default ``bpy.context``): for tests."""
+    context = context or bpy.context
+    return export_scene(context.evaluated_depsgraph_get())

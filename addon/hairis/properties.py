@@ -1,0 +1,109 @@
+"""Properties: ``scene.hairis`` (render settings) and ``material.hairis`` (sampling tables)."""
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import StringProperty
+
+STRATEGY_ITEMS = (
+    ("UNIFORM", "Uniform", "Sample hair scattering uniformly over the sphere", 0),
+    ("ANALYTIC", "Analytic",
+     "Chiang 2016 lobe sampling as Cycles and pbrt do (exact density)", 1),
+    ("GAUSSIAN", "Gaussian", "The seed's Gaussian densities per lobe", 2),
+    ("TABLE", "Table",
+     "Baked inverse-CDF tables of the fiber's scattering (needs baked tables)", 3),
+)
+"""Values and numbers match ``hairis_strategy``."""
+
+N_H_ITEMS = tuple(
+    (str(n), str(n), "Multiple-scattering distribution through %d strand%s"
+     % (n, "" if n == 1 else "s"), i)
+    for i, n in enumerate((1, 2, 4, 8, 16)))
+
+
+class HairisRenderSettings(bpy.types.PropertyGroup):
+    """Render settings of the Hairis engine (``scene.hairis``)."""
+
+    samples: IntProperty(
+        name="Samples", description="Samples per pixel",
+        default=64, min=1, max=1 << 24, soft_max=4096)
+    max_bounces: IntProperty(
+        name="Max Bounces", description="Total maximum number of bounces (as Cycles)",
+        default=12, min=0, max=1024)
+    strategy: EnumProperty(
+        name="Strategy", description="How hair scattering directions are sampled",
+        items=STRATEGY_ITEMS, default="TABLE")
+    multiple_weight: FloatProperty(
+        name="Multiple Weight",
+        description="One-sample mixture weight of the multiple-scattering distribution "
+                    "(Table and Gaussian strategies)",
+        default=0.25, min=0.0, max=1.0, subtype="FACTOR")
+    n_h: EnumProperty(
+        name="Strands (n_h)",
+        description="Number of strands light crosses in the multiple-scattering distribution",
+        items=N_H_ITEMS, default="2")
+    seed: IntProperty(
+        name="Seed", description="Random seed: same seed, same image, whatever the thread count",
+        default=0, min=0)
+    threads: IntProperty(
+        name="Threads", description="Render and bake threads (0: all cores)",
+        default=0, min=0, max=1024)
+    auto_bake: BoolProperty(
+        name="Auto Bake",
+        description="Bake missing or stale sampling tables when rendering (otherwise the Table "
+                    "strategy refuses materials without current tables)",
+        default=True)
+
+    @classmethod
+    def register(cls):
+        """Adds ``bpy.types.Scene.hairis``."""
+        bpy.types.Scene.hairis = PointerProperty(
+            name="Hairis Render Settings", description="Hairis render settings", type=cls)
+
+    @classmethod
+    def unregister(cls):
+        """Removes ``bpy.types.Scene.hairis``."""
+        del bpy.types.Scene.hairis
+
+    @property
+    def n_h_value(self):
+        """``n_h`` as an int."""
+        return int(self.n_h)
+
+
+class HairisMaterialSettings(bpy.types.PropertyGroup):
+    """The sampling tables of a hair material (``material.hairis``)."""
+
+    table_image: PointerProperty(
+        name="Sampling Tables", description="The baked sampling tables (float EXR, Non-Color)",
+        type=bpy.types.Image)
+    baked_parameters: StringProperty(
+        name="Baked Parameters",
+        description="The fiber parameters the tables were baked for (name=value;...)")
+    baked_model: StringProperty(
+        name="Baked Model", description="The fiber model the tables were baked for")
+
+    @classmethod
+    def register(cls):
+        """Adds ``bpy.types.Material.hairis``."""
+        bpy.types.Material.hairis = PointerProperty(
+            name="Hairis Material Settings", description="Hairis sampling tables", type=cls)
+
+    @classmethod
+    def unregister(cls):
+        """Removes ``bpy.types.Material.hairis``."""
+        del bpy.types.Material.hairis
+
+
+classes = (HairisRenderSettings, HairisMaterialSettings)
+
+
+def register():
+    """Registers the property groups."""
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    """Unregisters the property groups."""
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,216 @@
+"""Sampling tables of hair materials: where they live, whether they are current, baking.
+
+A hair material's tables are an EXR image datablock (``material.hairis.table_image``), saved
+next to the .blend as ``//hairis_<material>.exr`` or packed into it. They are *current* when
+the native library loads them and ``hairis_tables_match_fiber`` says they were baked for the
+fiber the material's Principled Hair BSDF describes now; otherwise they are missing, invalid
+or stale. Used by the bake operator (main thread) and the render engine (render thread, which
+never writes ``bpy.data``: it bakes into a per-session cache file instead).
+"""
+
+import hashlib
+import os
+import tempfile
+from dataclasses import dataclass
+
+import bpy
+
+from . import export, native
+
+N_H_CHOICES = (1, 2, 4, 8, 16)
+"""The strand counts the add-on offers (and bakes multiple-scattering tables for)."""
+
+
+class TableError(Exception):
+    """A material's tables cannot be used (missing file, no image, library-linked, ...)."""
+
+
+@dataclass
+class TableStatus:
+    """The state of a material's tables: 'OK', 'MISSING', 'INVALID' or 'STALE'."""
+
+    state: str
+    message: str
+    tables: object = None
+
+    @property
+    def ok(self):
+        """True when the tables are current."""
+        return self.state == "OK"
+
+
+def principled_struct(library, params):
+    """A ``native.PrincipledHair`` from :class:`export.HairParameters`."""
+    return library.principled_hair_defaults().update(params.as_dict())
+
+
+def material_parameters(material):
+    """The material's hair parameters, or raise TableError when it is not a usable hair one."""
+    node = export.hair_node(material)
+    if node is None:
+        raise TableError("material %r has no Principled Hair BSDF connected to its output"
+                         % material.name)
+    params, _warnings, error = export.read_hair_node(node, material.name)
+    if error is not None:
+        raise TableError(error)
+    return params
+
+
+def hair_materials(materials=None):
+    """Every material (default: all of ``bpy.data.materials`` with users) that is hair."""
+    if materials is None:
+        materials = [m for m in bpy.data.materials if m.users > 0]
+    return [m for m in materials if export.is_hair_material(m)]
+
+
+def bake_options(library, n_h=None, threads=0):
+    """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``."""
+    options = library.bake_options_defaults()
+    values = set(options.n_h_list()) | set(N_H_CHOICES)
+    if n_h is not None:
+        values.add(int(n_h))
+    values = sorted(v for v in values if v > 0)[:16]
+    options.set_n_h_list(values)
+    options.threads = int(threads)
+    return options
+
+
+def image_path(image):
+    """The absolute file path of an image datablock ('' for none)."""
+    path = image.filepath_raw or image.filepath
+    if not path:
+        return ""
+    return os.path.normpath(bpy.path.abspath(path, library=image.library))
+
+
+def image_tables(library, image):
+    """Loads the tables an image datablock holds: its packed bytes, else its file."""
+    if image is None:
+        raise TableError("no table image")
+    packed = image.packed_file
+    if packed is not None:
+        return library.load_tables_memory(packed.data)
+    path = image_path(image)
+    if not path:
+        raise TableError("image %r has no file path" % image.name)
+    if not os.path.isfile(path):
+        raise TableError("table file %s does not exist" % path)
+    return library.load_tables_file(path)
+
+
+def check_material(library, material, fiber):
+    """Full check (load, validate, match ``fiber``) of a material's tables: a TableStatus."""
+    image = material.hairis.table_image
+    if image is None:
+        return TableStatus("MISSING", "material %r has no sampling tables" % material.name)
+    try:
+        tables = image_tables(library, image)
+    except (TableError, native.HairisError) as error:
+        return TableStatus("INVALID", "material %r: its tables cannot be used: %s"
+                           % (material.name, error))
+    if not tables.matches(fiber):
+        tables.close()
+        return TableStatus("STALE", "material %r: its tables were baked for other hair "
+                           "parameters" % material.name)
+    return TableStatus("OK", "material %r: tables are current" % material.name, tables)
+
+
+def quick_state(library, material):
+    """A cheap check for the UI (no table load): 'OK', 'MISSING', 'STALE' or 'ERROR'."""
+    settings = material.hairis
+    image = settings.table_image
+    if image is None:
+        return "MISSING"
+    if image.packed_file is None and not os.path.isfile(image_path(image)):
+        return "MISSING"
+    try:
+        params = material_parameters(material)
+        with library.fiber_principled(principled_struct(library, params)) as fiber:
+            current = fiber.parameters
+    except (TableError, native.HairisError):
+        return "ERROR"
+    return "OK" if current == settings.baked_parameters else "STALE"
+
+
+def table_filename(material):
+    """``hairis_<material>.exr`` with the name made file-system safe."""
+    return "hairis_%s.exr" % bpy.path.clean_name(material.name)
+
+
+def output_path(material):
+    """Where to write a material's tables: (absolute path, path to store, blend_saved).
+
+    Next to the saved .blend as ``//hairis_<material>.exr``; for an unsaved .blend in a
+    temporary folder (the caller packs the image and warns).
+    """
+    filename = table_filename(material)
+    if bpy.data.filepath:
+        stored = "//" + filename
+        return os.path.normpath(bpy.path.abspath(stored)), stored, True
+    folder = os.path.join(tempfile.gettempdir(), "hairis_tables")
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, filename)
+    return path, path, False
+
+
+def store_image(material, path, stored_path, pack, parameters, model):
+    """Loads ``path`` as the material's table image (float, Non-Color) and records the bake.
+
+    Main thread only (writes ``bpy.data``). An image already pointing at ``path`` is
+    reloaded; otherwise a new datablock replaces the old one (removed if nothing else uses it).
+    """
+    settings = material.hairis
+    old = settings.table_image
+    image = None
+    if (old is not None and old.library is None and old.packed_file is None
+            and image_path(old) == os.path.normpath(path)):
+        image = old
+        image.reload()
+    else:
+        image = bpy.data.images.load(path, check_existing=False)
+    image.filepath = stored_path
+    image.name = "hairis_%s" % material.name
+    image.colorspace_settings.name = "Non-Color"
+    if hasattr(image, "use_half_precision"):
+        image.use_half_precision = False
+    image.alpha_mode = "CHANNEL_PACKED"  # data: R and G are densities, A is just 1
+    if pack:
+        image.pack()
+    settings.table_image = image
+    settings.baked_parameters = parameters
+    settings.baked_model = model
+    if old is not None and old != image and old.users == 0:
+        bpy.data.images.remove(old)
+    return image
+
+
+def cache_path(parameters):
+    """The per-session cache file for tables auto-baked during a render."""
+    folder = bpy.app.tempdir or tempfile.gettempdir()
+    digest = hashlib.sha1(parameters.encode("utf-8")).hexdigest()[:16]
+    return os.path.join(folder, "hairis_autobake_%s.exr" % digest)
+
+
+def cached_tables(library, fiber):
+    """Tables from the auto-bake cache when present and matching ``fiber``, else None."""
+    path = cache_path(fiber.parameters)
+    if not os.path.isfile(path):
+        return None
+    try:
+        tables = library.load_tables_file(path)
+    except native.HairisError:
+        return None
+    if tables.matches(fiber):
+        return tables
+    tables.close()
+    return None
+
+
+def write_cache(tables, fiber):
+    """Writes auto-baked tables to the cache; returns the path, or None if writing failed."""
+    path = cache_path(fiber.parameters)
+    try:
+        tables.write(path)
+    except native.HairisError:
+        return None
+    return path

@@ -1,0 +1,359 @@
+"""Panels: Hairis render settings, the material/world/light node panels, the table bake.
+
+Blender's generic property panels (output, camera, particles, ...) list the engines they show
+for in ``COMPAT_ENGINES``; like Cycles, Hairis adds itself to every panel that lists
+``BLENDER_RENDER`` except those it replaces. Cycles' own material/world/light panels cannot be
+shared the same way: their ``poll`` calls ``CyclesButtonsPanel.poll``, which reads the *base*
+class's ``COMPAT_ENGINES`` (adding Hairis there would show every Cycles panel, sampling and
+all). So Hairis draws the Cycles node trees itself, with ``template_node_view`` as Cycles does,
+and users keep editing Cycles' nodes.
+"""
+
+import bpy
+
+from . import export, native, tables
+
+ENGINE = "HAIRIS"
+
+# Generic panels that Hairis replaces or cannot use (as Cycles excludes them).
+EXCLUDED_PANELS = {
+    "DATA_PT_area",
+    "DATA_PT_camera_dof",
+    "DATA_PT_falloff_curve",
+    "DATA_PT_light",
+    "DATA_PT_preview",
+    "DATA_PT_spot",
+    "MATERIAL_PT_context_material",
+    "MATERIAL_PT_preview",
+    "NODE_DATA_PT_light",
+    "NODE_DATA_PT_spot",
+    "OBJECT_PT_visibility",
+    "VIEWLAYER_PT_filter",
+    "VIEWLAYER_PT_layer_passes",
+    "RENDER_PT_post_processing",
+    "RENDER_PT_simplify",
+}
+
+
+def compatible_panels():
+    """Blender's generic panels that Hairis shows (those that list BLENDER_RENDER)."""
+    panels = []
+    for panel in bpy.types.Panel.__subclasses__():
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        if isinstance(engines, set) and "BLENDER_RENDER" in engines \
+                and panel.__name__ not in EXCLUDED_PANELS:
+            panels.append(panel)
+    return panels
+
+
+def draw_node_input(layout, id_data, input_name):
+    """Draws the node tree feeding ``input_name`` of the active output (as Cycles)."""
+    if not id_data.use_nodes:
+        layout.prop(id_data, "use_nodes", icon="NODETREE")
+        return False
+    node_tree = id_data.node_tree
+    output = export.output_node(node_tree)
+    if output is None:
+        layout.label(text="No output node")
+        return True
+    socket = None
+    for candidate in output.inputs:
+        if candidate.name == input_name:
+            socket = candidate
+            break
+    if socket is None:
+        layout.label(text="Incompatible output node")
+    else:
+        layout.template_node_view(node_tree, output, socket)
+    return True
+
+
+def draw_library_status(layout, status=None):
+    """One line on the native library: its version, or why it is unavailable."""
+    status = status or native.library_status()
+    if status.ok:
+        layout.label(text=status.message, icon="CHECKMARK")
+    else:
+        column = layout.column(align=True)
+        column.alert = True
+        for number, line in enumerate(_wrap(status.message, 70)):
+            column.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
+    return status
+
+
+def _wrap(text, width):
+    """Splits ``text`` into lines of at most about ``width`` characters."""
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = (line + " " + word).strip()
+    if line:
+        lines.append(line)
+    return lines
+
+
+def engine_is_hairis(context):
+    """True when the scene renders with Hairis."""
+    return context.engine == ENGINE
+
+
+class HairisPanel:
+    """Base of the Hairis panels: shown when the render engine is Hairis."""
+
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        """Only with the Hairis engine."""
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
+    """Samples, seed and threads."""
+
+    bl_label = "Sampling"
+    bl_context = "render"
+
+    def draw(self, context):
+        """Draws the panel."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.hairis
+        column = layout.column()
+        column.prop(settings, "samples")
+        column.prop(settings, "seed")
+        column.prop(settings, "max_bounces")
+        column.prop(settings, "threads")
+
+
+class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
+    """The hair sampling strategy and its tables."""
+
+    bl_label = "Hair Sampling Strategy"
+    bl_context = "render"
+
+    def draw(self, context):
+        """Draws the panel."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.hairis
+        column = layout.column()
+        column.prop(settings, "strategy")
+        sub = column.column()
+        sub.active = settings.strategy in {"TABLE", "GAUSSIAN"}
+        sub.prop(settings, "multiple_weight")
+        sub.prop(settings, "n_h")
+        sub = column.column()
+        sub.active = settings.strategy == "TABLE"
+        sub.prop(settings, "auto_bake")
+        sub.operator("hairis.bake_tables", icon="RENDER_STILL")
+        layout.separator()
+        draw_library_status(layout)
+
+
+class HAIRIS_PT_context_material(HairisPanel, bpy.types.Panel):
+    """Material slots (as Cycles' context panel)."""
+
+    bl_label = ""
+    bl_context = "material"
+    bl_options = {"HIDE_HEADER"}
+
+    @classmethod
+    def poll(cls, context):
+        """Objects with materials, not grease pencil."""
+        if context.active_object and context.active_object.type == "GPENCIL":
+            return False
+        return (context.material or context.object) and engine_is_hairis(context)
+
+    def draw(self, context):
+        """Draws the slot list and the material selector."""
+        layout = self.layout
+        material = context.material
+        obj = context.object
+        slot = context.material_slot
+        space = context.space_data
+        if obj:
+            sortable = len(obj.material_slots) > 1
+            row = layout.row()
+            row.template_list("MATERIAL_UL_matslots", "", obj, "material_slots", obj,
+                              "active_material_index", rows=4 if sortable else 3)
+            column = row.column(align=True)
+            column.operator("object.material_slot_add", icon="ADD", text="")
+            column.operator("object.material_slot_remove", icon="REMOVE", text="")
+            column.separator()
+            column.menu("MATERIAL_MT_context_menu", icon="DOWNARROW_HLT", text="")
+            if sortable:
+                column.separator()
+                column.operator("object.material_slot_move", icon="TRIA_UP",
+                                text="").direction = "UP"
+                column.operator("object.material_slot_move", icon="TRIA_DOWN",
+                                text="").direction = "DOWN"
+            if obj.mode == "EDIT":
+                row = layout.row(align=True)
+                row.operator("object.material_slot_assign", text="Assign")
+                row.operator("object.material_slot_select", text="Select")
+                row.operator("object.material_slot_deselect", text="Deselect")
+        row = layout.row()
+        if obj:
+            row.template_ID(obj, "active_material", new="material.new")
+            if slot:
+                icon = "MESH_DATA" if slot.link == "DATA" else "OBJECT_DATA"
+                row.prop(slot, "link", text="", icon=icon, icon_only=True)
+        elif material:
+            layout.template_ID(space, "pin_id")
+
+
+class HAIRIS_MATERIAL_PT_surface(HairisPanel, bpy.types.Panel):
+    """The material's surface node tree (Cycles nodes)."""
+
+    bl_label = "Surface"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        """Materials that are not grease pencil."""
+        material = context.material
+        return material and not material.grease_pencil and engine_is_hairis(context)
+
+    def draw(self, context):
+        """Draws the node view."""
+        layout = self.layout
+        layout.use_property_split = True
+        material = context.material
+        if not draw_node_input(layout, material, "Surface"):
+            layout.prop(material, "diffuse_color")
+
+
+class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
+    """The sampling tables of a hair material and the bake button."""
+
+    bl_label = "Hairis Sampling Tables"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        """Hair materials (a Principled Hair BSDF at the output)."""
+        material = context.material
+        return (material is not None and engine_is_hairis(context)
+                and export.is_hair_material(material))
+
+    def draw(self, context):
+        """Draws the table state and the bake button."""
+        layout = self.layout
+        material = context.material
+        settings = material.hairis
+        status = native.library_status()
+        column = layout.column()
+        column.template_ID(settings, "table_image", open="image.open")
+        if status.ok:
+            library = native.load_library(status.path)
+            state = tables.quick_state(library, material)
+            text, icon = {
+                "OK": ("Tables are current", "CHECKMARK"),
+                "MISSING": ("No tables baked", "ERROR"),
+                "STALE": ("Tables are stale: the hair parameters changed", "ERROR"),
+                "ERROR": ("The hair node cannot be read", "ERROR"),
+            }[state]
+            column.label(text=text, icon=icon)
+        else:
+            draw_library_status(column, status)
+        row = column.row(align=True)
+        bake = row.operator("hairis.bake_tables", text="Bake Sampling Tables", icon="RENDER_STILL")
+        bake.material = material.name
+        bake.force = False
+        rebake = row.operator("hairis.bake_tables", text="", icon="FILE_REFRESH")
+        rebake.material = material.name
+        rebake.force = True
+
+
+class HAIRIS_WORLD_PT_surface(HairisPanel, bpy.types.Panel):
+    """The world's surface node tree (a Background node)."""
+
+    bl_label = "Surface"
+    bl_context = "world"
+
+    @classmethod
+    def poll(cls, context):
+        """Scenes with a world."""
+        return context.world and engine_is_hairis(context)
+
+    def draw(self, context):
+        """Draws the node view, or the world colour without nodes."""
+        layout = self.layout
+        layout.use_property_split = True
+        world = context.world
+        if not draw_node_input(layout, world, "Surface"):
+            layout.prop(world, "color")
+
+
+class HAIRIS_LIGHT_PT_light(HairisPanel, bpy.types.Panel):
+    """The light's type, colour, power and shape (what Hairis renders)."""
+
+    bl_label = "Light"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        """Light data."""
+        return context.light and engine_is_hairis(context)
+
+    def draw(self, context):
+        """Draws the light settings Hairis uses."""
+        layout = self.layout
+        light = context.light
+        layout.row().prop(light, "type", expand=True)
+        layout.use_property_split = True
+        column = layout.column()
+        column.prop(light, "color")
+        column.prop(light, "energy")
+        column.separator()
+        if light.type == "POINT":
+            column.prop(light, "shadow_soft_size", text="Radius")
+        elif light.type == "SUN":
+            column.prop(light, "angle")
+        elif light.type == "AREA":
+            column.prop(light, "shape", text="Shape")
+            sub = column.column(align=True)
+            if light.shape in {"SQUARE", "DISK"}:
+                sub.prop(light, "size")
+            else:
+                sub.prop(light, "size", text="Size X")
+                sub.prop(light, "size_y", text="Y")
+        elif light.type == "SPOT":
+            column.label(text="Spot lights are not supported by Hairis", icon="ERROR")
+
+
+classes = (
+    HAIRIS_RENDER_PT_sampling,
+    HAIRIS_RENDER_PT_strategy,
+    HAIRIS_PT_context_material,
+    HAIRIS_MATERIAL_PT_surface,
+    HAIRIS_MATERIAL_PT_tables,
+    HAIRIS_WORLD_PT_surface,
+    HAIRIS_LIGHT_PT_light,
+)
+
+
+def register():
+    """Registers the panels and adds Hairis to Blender's generic panels."""
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    for panel in compatible_panels():
+        panel.COMPAT_ENGINES.add(ENGINE)
+
+
+def unregister():
+    """Removes Hairis from the generic panels and unregisters the panels."""
+    for panel in bpy.types.Panel.__subclasses__():
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        if isinstance(engines, set) and panel not in classes:
+            engines.discard(ENGINE)
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,210 @@
+// Internals shared by the C API's translation units (lib/include/hairis/hairis.h): the
+// thread-local last error, the exception boundary every exported function runs inside, the
+// argument checks, and the definitions of the opaque handles.
+//
+// Error model: an implementation reports a refused input by throwing capi::Refusal (a code
+// and a message); the boundary (guard_status / guard_handle / guard_value / guard_void)
+// catches it and every other exception, stores the message as the calling thread's last
+// error and returns the failure value. On success the boundary clears the last error. No C++
+// exception ever crosses into C.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hairis/chiang.h"
+#include "hairis/expected.h"
+#include "hairis/fiber.h"
+#include "hairis/fiber_spec.h"
+#include "hairis/hairis.h"
+#include "hairis/strategies.h"
+#include "hairis/table_file.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace hairis::capi {
+
+// ---- The last error -------------------------------------------------------------------------
+
+/// Sets the calling thread's last error. Never throws: if the message cannot be stored (out
+/// of memory), a fixed message is reported instead.
+void set_error(const std::string &message) noexcept;
+void set_error(const char *message) noexcept;
+/// Clears the calling thread's last error ("" = the last call succeeded).
+void clear_error() noexcept;
+/// The calling thread's last error ("" after a successful call); never NULL.
+const char *last_error() noexcept;
+
+/// A refused call: thrown inside an implementation, turned into a status at the boundary.
+struct Refusal {
+    int code;
+    std::string message;
+};
+
+[[noreturn]] inline void refuse(int code, std::string message) {
+    throw Refusal{code, std::move(message)};
+}
+[[noreturn]] inline void invalid(std::string message) {
+    refuse(HAIRIS_ERROR_INVALID_ARGUMENT, std::move(message));
+}
+
+/// Records an exception that is not a Refusal as an internal error of `function`.
+int report_exception(const char *function, std::exception_ptr error) noexcept;
+
+/// Runs f() -> int (a status) at the boundary: clears the last error on HAIRIS_OK.
+template <typename F>
+int guard_status(const char *function, F &&f) noexcept {
+    try {
+        const int code = f();
+        if (code == HAIRIS_OK) clear_error();
+        return code;
+    } catch (const Refusal &r) {
+        set_error(r.message);
+        return r.code;
+    } catch (...) {
+        return report_exception(function, std::current_exception());
+    }
+}
+
+/// Runs f() -> T* (a new handle) at the boundary: NULL on failure.
+template <typename T, typename F>
+T *guard_handle(const char *function, F &&f) noexcept {
+    try {
+        T *handle = f();
+        clear_error();
+        return handle;
+    } catch (const Refusal &r) {
+        set_error(r.message);
+    } catch (...) {
+        report_exception(function, std::current_exception());
+    }
+    return nullptr;
+}
+
+/// Runs f() -> T at the boundary: `failure` when it throws.
+template <typename T, typename F>
+T guard_value(const char *function, T failure, F &&f) noexcept {
+    try {
+        T value = f();
+        clear_error();
+        return value;
+    } catch (const Refusal &r) {
+        set_error(r.message);
+    } catch (...) {
+        report_exception(function, std::current_exception());
+    }
+    return failure;
+}
+
+/// Runs f() -> void at the boundary.
+template <typename F>
+void guard_void(const char *function, F &&f) noexcept {
+    try {
+        f();
+        clear_error();
+    } catch (const Refusal &r) {
+        set_error(r.message);
+    } catch (...) {
+        report_exception(function, std::current_exception());
+    }
+}
+
+// ---- Argument checks (each throws a Refusal naming the argument) ----------------------------
+
+/// Refuses a NULL pointer: "<name> must not be NULL".
+inline void require(const void *pointer, const char *name) {
+    if (pointer == nullptr) invalid(std::string(name) + " must not be NULL");
+}
+/// Refuses a NULL array unless it holds no items: "<name> must not be NULL (n = 5)".
+inline void require_array(const void *pointer, size_t n, const char *name) {
+    if (pointer == nullptr && n > 0)
+        invalid(std::string(name) + " must not be NULL when n > 0 (n = " + std::to_string(n) + ")");
+}
+/// Refuses n whose arrays of `per_item` floats would not fit in memory.
+void require_batch_size(size_t n, size_t per_item, const char *name);
+/// Turns a failed core check into a Refusal (INVALID_ARGUMENT), with an optional prefix.
+inline void ok_or_invalid(const Status &status, const std::string &prefix = {}) {
+    if (status) invalid(prefix + status->message);
+}
+/// Prints a float for messages (9 significant digits; nan, inf).
+std::string describe(double value);
+/// "<name>[i]" for messages.
+std::string indexed(const char *name, size_t i);
+/// Refuses a non-finite float: "<name> must be finite (got nan)".
+void require_finite(float value, const std::string &name);
+/// Refuses a non-finite or negative float: "<name> must be finite and >= 0 (got -1)".
+void require_non_negative(float value, const std::string &name);
+/// Refuses a colour with a non-finite or negative component, naming it "<name>[k]".
+void require_colour(const float *rgb, const char *name);
+/// Refuses a direction that is not finite or not of unit length (within 1e-3).
+void require_unit_direction(const float *w, const char *name, size_t i);
+/// Reads an enum argument as the int the caller passed, without loading an out-of-range value
+/// through the enum type (undefined behaviour in C++ that UBSan would trap).
+/// Takes the argument by reference: copying it would be such a load.
+template <typename E>
+int enum_value(const E &value) {
+    static_assert(sizeof(E) == sizeof(int), "C enums are passed as int");
+    int v = 0;
+    std::memcpy(&v, &value, sizeof v);
+    return v;
+}
+
+/// Calls f(i) for every i < n: in order for small batches, in parallel (oneTBB) for large
+/// ones. Items must be independent. Exceptions propagate to the caller.
+template <typename F>
+void for_each_item(size_t n, const F &f) {
+    constexpr size_t kParallelFrom = 2048, kGrain = 512;
+    if (n < kParallelFrom) {
+        for (size_t i = 0; i < n; ++i) f(i);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain),
+                      [&](const tbb::blocked_range<size_t> &r) {
+                          for (size_t i = r.begin(); i != r.end(); ++i) f(i);
+                      });
+}
+
+// ---- Shared conversions ---------------------------------------------------------------------
+
+/// The C node as hairis' PrincipledHairNode; refuses a parametrization out of range and
+/// non-finite inputs (argument name `name`, e.g. "node").
+PrincipledHairNode to_node(const hairis_principled_hair &node, const char *name);
+/// The canonical "name=value;..." string of a fiber spec (what table metadata records).
+std::string spec_parameters(const FiberSpec &spec);
+
+}  // namespace hairis::capi
+
+// ---- The handles ----------------------------------------------------------------------------
+
+/// A fiber: its FiberSpec (the source of its model name and parameter string, as the table
+/// metadata records them) and the model built from it. Immutable after creation.
+struct hairis_fiber {
+    hairis::FiberSpec spec;
+    std::shared_ptr<const hairis::FiberModel> model;
+    std::shared_ptr<const hairis::ChiangFiber> chiang;  // the same object, for Chiang fibers
+    std::string model_name;
+    std::string parameters;  // canonical_parameters(spec.parameters())
+};
+
+/// Baked or loaded tables: the table set (for writing) and the samplers built from it. The
+/// samplers are shared: a hairis_sampler or a scene material copies the shared_ptrs and so
+/// stays valid after this handle is destroyed.
+struct hairis_tables {
+    hairis::TableSet set;
+    hairis::SamplingTables sampling;
+    std::string parameters;  // canonical_parameters(set.parameters)
+};
+
+/// A direction sampler (owns everything it samples from).
+struct hairis_sampler {
+    std::shared_ptr<const hairis::DirectionSampler> sampler;
+};

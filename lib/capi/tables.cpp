@@ -1,0 +1,174 @@
+// C API: sampling tables — bake, write, load (file or memory), metadata and fiber matching.
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "capi_internal.h"
+#include "hairis/bake.h"
+
+namespace hairis::capi {
+
+namespace {
+
+constexpr int kMaxNhValues = 16;  // hairis_bake_options::n_h_values
+
+hairis_tables *make_tables(TableSet set) {
+    Expected<SamplingTables> sampling = SamplingTables::from(set);
+    if (!sampling) refuse(HAIRIS_ERROR_INVALID_TABLE, "hairis table: " + sampling.error().message);
+    auto tables = std::make_unique<hairis_tables>();
+    tables->parameters = canonical_parameters(set.parameters);
+    tables->sampling = std::move(sampling).value();
+    tables->set = std::move(set);
+    return tables.release();
+}
+
+// Reads a whole file; the error names the file and the system's reason.
+std::vector<unsigned char> read_file(const std::string &path) {
+    std::FILE *file = std::fopen(path.c_str(), "rb");
+    if (!file)
+        refuse(HAIRIS_ERROR_IO, "cannot open \"" + path + "\" for reading: " + std::strerror(errno));
+    std::vector<unsigned char> bytes;
+    unsigned char chunk[1 << 16];
+    size_t got = 0;
+    try {
+        while ((got = std::fread(chunk, 1, sizeof chunk, file)) > 0)
+            bytes.insert(bytes.end(), chunk, chunk + got);
+    } catch (...) {
+        std::fclose(file);
+        throw;
+    }
+    const bool failed = std::ferror(file) != 0;
+    std::fclose(file);
+    if (failed) refuse(HAIRIS_ERROR_IO, "cannot read \"" + path + "\" (read error)");
+    return bytes;
+}
+
+}  // namespace
+
+}  // namespace hairis::capi
+
+using namespace hairis;
+using namespace hairis::capi;
+
+extern "C" {
+
+HAIRIS_API void hairis_bake_options_defaults(hairis_bake_options *options) {
+    guard_void("hairis_bake_options_defaults", [&] {
+        require(options, "options");
+        const BakeOptions d;
+        hairis_bake_options c{};
+        c.theta_r_count = d.theta_r_count;
+        c.theta_i_count = d.theta_i_count;
+        c.phi_count = d.phi_count;
+        c.n_h_count = int(std::min<size_t>(d.n_h_values.size(), kMaxNhValues));
+        for (int k = 0; k < c.n_h_count; ++k) c.n_h_values[k] = d.n_h_values[size_t(k)];
+        c.source = d.source == "gaussian" ? 1 : 0;
+        c.threads = d.threads;
+        *options = c;
+    });
+}
+
+HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber,
+                                             const hairis_bake_options *options,
+                                             hairis_progress_fn progress, void *user) {
+    return guard_handle<hairis_tables>("hairis_tables_bake", [&] {
+        require(fiber, "fiber");
+        require(options, "options");
+        const hairis_bake_options &c = *options;
+        if (c.n_h_count < 1 || c.n_h_count > kMaxNhValues)
+            invalid("options.n_h_count must be an integer in [1, 16] (got " +
+                    std::to_string(c.n_h_count) + ")");
+        if (c.source != 0 && c.source != 1)
+            invalid("options.source must be 0 (exact distributions) or 1 (the seed's Gaussian "
+                    "PDFs) (got " + std::to_string(c.source) + ")");
+        BakeOptions o;
+        o.theta_r_count = c.theta_r_count;
+        o.theta_i_count = c.theta_i_count;
+        o.phi_count = c.phi_count;
+        o.n_h_values.assign(c.n_h_values, c.n_h_values + c.n_h_count);
+        o.source = c.source == 1 ? "gaussian" : "exact";
+        o.threads = c.threads;
+        ok_or_invalid(o.validate(), "options: ");
+
+        Expected<std::vector<std::pair<std::string, double>>> parameters = fiber->spec.parameters();
+        if (!parameters) invalid("fiber: " + parameters.error().message);
+
+        bool cancelled = false;
+        ProgressFn report;
+        if (progress)
+            report = [&](float fraction) {
+                if (progress(user, fraction) != 0) cancelled = true;
+                return !cancelled;
+            };
+        Expected<TableSet> baked = bake_tables(*fiber->model, parameters.value(), o, report);
+        if (cancelled) refuse(HAIRIS_ERROR_CANCELLED, "cancelled");
+        if (!baked) refuse(HAIRIS_ERROR_INTERNAL, "bake failed: " + baked.error().message);
+        return make_tables(std::move(baked).value());
+    });
+}
+
+HAIRIS_API int hairis_tables_write(const hairis_tables *tables, const char *path) {
+    return guard_status("hairis_tables_write", [&] {
+        require(tables, "tables");
+        require(path, "path");
+        if (*path == '\0') invalid("path must not be empty");
+        if (Status s = write_table_file(tables->set, path)) refuse(HAIRIS_ERROR_IO, s->message);
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API hairis_tables *hairis_tables_load_file(const char *path) {
+    return guard_handle<hairis_tables>("hairis_tables_load_file", [&] {
+        require(path, "path");
+        if (*path == '\0') invalid("path must not be empty");
+        const std::vector<unsigned char> bytes = read_file(path);
+        Expected<TableSet> set = decode_table_exr(bytes.data(), bytes.size());
+        if (!set)
+            refuse(HAIRIS_ERROR_INVALID_TABLE,
+                   set.error().message + " (in \"" + std::string(path) + "\")");
+        return make_tables(std::move(set).value());
+    });
+}
+
+HAIRIS_API hairis_tables *hairis_tables_load_memory(const void *data, size_t size) {
+    return guard_handle<hairis_tables>("hairis_tables_load_memory", [&] {
+        require(data, "data");
+        if (size == 0) invalid("size must be > 0 (an empty buffer is not a table file)");
+        Expected<TableSet> set = decode_table_exr(data, size);
+        if (!set) refuse(HAIRIS_ERROR_INVALID_TABLE, set.error().message + " (in the buffer)");
+        return make_tables(std::move(set).value());
+    });
+}
+
+HAIRIS_API void hairis_tables_destroy(hairis_tables *tables) {
+    guard_void("hairis_tables_destroy", [&] { delete tables; });
+}
+
+HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables) {
+    return guard_value<const char *>("hairis_tables_model", "", [&] {
+        require(tables, "tables");
+        return tables->set.model.c_str();
+    });
+}
+
+HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables) {
+    return guard_value<const char *>("hairis_tables_parameters", "", [&] {
+        require(tables, "tables");
+        return tables->parameters.c_str();
+    });
+}
+
+HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hairis_fiber *fiber) {
+    return guard_value<int>("hairis_tables_match_fiber", 0, [&] {
+        require(tables, "tables");
+        require(fiber, "fiber");
+        return tables->set.model == fiber->model_name && tables->parameters == fiber->parameters
+                   ? 1
+                   : 0;
+    });
+}
+
+}  // extern "C"

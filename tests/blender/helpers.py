@@ -1,0 +1,320 @@
+"""Shared code of the headless Blender tests (runs inside Blender's Python).
+
+Each test script calls :func:`setup` (parse the arguments run_test.py passes after ``--``,
+install the add-on zip into the temporary user scripts folder and enable it), builds scenes
+with the ``make_*`` helpers and runs its test functions with :func:`run`.
+"""
+
+import argparse
+import math
+import os
+import sys
+import time
+import traceback
+import types
+
+import addon_utils
+import bpy
+import numpy as np
+from mathutils import Euler, Vector
+
+SKIP = 77
+MODULE = "hairis"
+
+
+def parse_args():
+    """The arguments after ``--``: zip, fake_library, workdir."""
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--zip", required=True)
+    parser.add_argument("--fake-library", default="")
+    parser.add_argument("--workdir", required=True)
+    return parser.parse_args(argv)
+
+
+def skip(message):
+    """Ends the test as skipped (exit code 77, CTest's SKIP_RETURN_CODE)."""
+    print("SKIP: " + message, flush=True)
+    sys.stdout.flush()
+    sys.exit(SKIP)
+
+
+def install_addon(zip_path):
+    """Installs the zip into BLENDER_USER_SCRIPTS and enables it; returns the package."""
+    user_scripts = os.environ.get("BLENDER_USER_SCRIPTS")
+    assert user_scripts, "BLENDER_USER_SCRIPTS must point to a temporary folder"
+    assert os.path.isfile(zip_path), "add-on zip %s does not exist" % zip_path
+    result = bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    assert result == {"FINISHED"}, result
+    result = bpy.ops.preferences.addon_enable(module=MODULE)
+    assert result == {"FINISHED"}, result
+    loaded, enabled = addon_utils.check(MODULE)
+    assert loaded and enabled, "the add-on did not enable"
+    package = sys.modules[MODULE]
+    installed = os.path.realpath(os.path.dirname(package.__file__))
+    expected = os.path.realpath(os.path.join(user_scripts, "addons", MODULE))
+    assert installed == expected, "add-on loaded from %s, not %s" % (installed, expected)
+    return package
+
+
+def setup():
+    """Parses arguments, installs and enables the add-on; returns (args, package)."""
+    args = parse_args()
+    package = install_addon(args.zip)
+    return args, package
+
+
+def bundled_library(package):
+    """The path of the library inside the installed add-on (may not exist)."""
+    return os.path.join(os.path.dirname(package.__file__), "lib", "libhairis.so")
+
+
+def use_library(path):
+    """Points the add-on at ``path`` through HAIRIS_LIBRARY ('' or None: the bundled one)."""
+    if path:
+        os.environ["HAIRIS_LIBRARY"] = path
+    else:
+        os.environ.pop("HAIRIS_LIBRARY", None)
+
+
+def run(tests):
+    """Runs test functions in order; prints PASS/FAIL and exits 1 if any failed."""
+    failed = []
+    for test in tests:
+        start = time.monotonic()
+        try:
+            test()
+        except Exception:  # noqa: BLE001 - report every failure
+            traceback.print_exc()
+            failed.append(test.__name__)
+            print("FAIL %s" % test.__name__, flush=True)
+        else:
+            print("PASS %s (%.2f s)" % (test.__name__, time.monotonic() - start), flush=True)
+    print("%d passed, %d failed" % (len(tests) - len(failed), len(failed)), flush=True)
+    # Exit explicitly: Blender exits 1 after any render that reported an error, even one a
+    # test provoked and caught.
+    sys.exit(1 if failed else 0)
+
+
+# ---- Scenes ----------------------------------------------------------------------------------
+
+def reset():
+    """An empty file (the add-on stays enabled)."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    return bpy.context.scene
+
+
+def make_hair_material(name, parametrization="MELANIN", **inputs):
+    """A material whose output is fed by a Principled Hair BSDF with the given inputs."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        if node.type != "OUTPUT_MATERIAL":
+            tree.nodes.remove(node)
+    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
+    hair = tree.nodes.new("ShaderNodeBsdfHairPrincipled")
+    hair.parametrization = parametrization
+    for key, value in inputs.items():
+        hair.inputs[key].default_value = value
+    tree.links.new(hair.outputs["BSDF"], output.inputs["Surface"])
+    return material
+
+
+def make_surface_material(name, color=(0.6, 0.4, 0.3, 1.0)):
+    """A Principled BSDF material with a base colour."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    node = material.node_tree.nodes["Principled BSDF"]
+    node.inputs["Base Color"].default_value = color
+    return material
+
+
+def make_camera(scene, location=(0.0, -6.0, 1.0), rotation=(math.radians(90), 0.0, 0.0),
+                resolution=(64, 48), percentage=50):
+    """A perspective camera looking along +Y; sets the output resolution."""
+    data = bpy.data.cameras.new("Camera")
+    data.lens = 50.0
+    camera = bpy.data.objects.new("Camera", data)
+    camera.location = location
+    camera.rotation_euler = Euler(rotation)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = percentage
+    return camera
+
+
+def make_world(scene, color=(0.05, 0.1, 0.2), strength=1.5):
+    """A world whose Background node has ``color``·``strength``."""
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = tuple(color) + (1.0,)
+    background.inputs["Strength"].default_value = strength
+    scene.world = world
+    return world
+
+
+def make_light(scene, kind, name, location=(0.0, 0.0, 5.0), rotation=(0.3, 0.2, 0.1), **props):
+    """A light object of ``kind`` with ``props`` set on its data."""
+    data = bpy.data.lights.new(name, kind)
+    for key, value in props.items():
+        setattr(data, key, value)
+    light = bpy.data.objects.new(name, data)
+    light.location = location
+    light.rotation_euler = Euler(rotation)
+    scene.collection.objects.link(light)
+    return light
+
+
+def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.1), scale=1.5,
+                       hair_material=None, skin_material=None):
+    """A UV sphere with a hair particle system (``children``: None or rendered count)."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=16,
+                                         ring_count=8)
+    sphere = bpy.context.view_layer.objects.active
+    sphere.name = "Head"
+    sphere.scale = (scale, scale, scale)
+    sphere.data.materials.append(skin_material)
+    sphere.data.materials.append(hair_material)
+    modifier = sphere.modifiers.new("Hair", "PARTICLE_SYSTEM")
+    settings = modifier.particle_system.settings
+    settings.type = "HAIR"
+    settings.count = count
+    settings.hair_length = 0.4
+    settings.render_step = 3
+    settings.display_step = 2
+    settings.root_radius = 1.0
+    settings.tip_radius = 0.2
+    settings.radius_scale = 0.02
+    settings.shape = 0.3
+    settings.use_close_tip = True
+    settings.material = 2
+    if children:
+        settings.child_type = "INTERPOLATED"
+        settings.child_nbr = 1
+        settings.rendered_child_count = children
+    else:
+        settings.child_type = "NONE"
+    return sphere
+
+
+def make_curves(scene, hair_material, location=(0.0, 0.0, 1.0), rotation=(0.0, 0.0, 1.2),
+                scale=2.0, radius=True):
+    """A Curves object with known positions and radii; returns (object, positions, radii)."""
+    bpy.ops.object.curves_random_add(location=(0.0, 0.0, 0.0))
+    obj = bpy.context.view_layer.objects.active
+    obj.name = "Curls"
+    curves = obj.data
+    n = len(curves.points)
+    rng = np.random.default_rng(7)
+    positions = rng.uniform(-0.5, 0.5, size=(n, 3)).astype(np.float32)
+    curves.position_data.foreach_set("vector", positions.reshape(-1))
+    radii = rng.uniform(0.001, 0.01, size=n).astype(np.float32)
+    attribute = curves.attributes.get("radius")
+    if radius:
+        if attribute is None:
+            attribute = curves.attributes.new("radius", "FLOAT", "POINT")
+        attribute.data.foreach_set("value", radii)
+    elif attribute is not None:
+        curves.attributes.remove(attribute)
+    obj.location = location
+    obj.rotation_euler = Euler(rotation)
+    obj.scale = (scale, scale, scale)
+    curves.materials.append(hair_material)
+    return obj, positions, radii
+
+
+def make_test_scene(children=None, with_curves=True):
+    """The standard test scene: particle hair, Curves, sun, point, area, spot, world, camera."""
+    scene = reset()
+    scene.render.engine = "HAIRIS"
+    make_camera(scene)
+    make_world(scene)
+    hair = make_hair_material("Hair", "MELANIN", **{
+        "Melanin": 0.35, "Melanin Redness": 0.6, "Tint": (0.9, 0.8, 0.7, 1.0),
+        "Roughness": 0.25, "Radial Roughness": 0.4, "Coat": 0.1, "IOR": 1.6,
+        "Offset": math.radians(3.0), "Random Color": 0.2, "Random Roughness": 0.1})
+    skin = make_surface_material("Skin")
+    curly = make_hair_material("Curly", "ABSORPTION", **{
+        "Absorption Coefficient": (0.3, 0.6, 1.2), "Roughness": 0.5, "IOR": 1.5})
+    make_particle_hair(scene, children=children, hair_material=hair, skin_material=skin)
+    if with_curves:
+        make_curves(scene, curly)
+    make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(5.0))
+    make_light(scene, "POINT", "Bulb", location=(1.0, -2.0, 3.0), energy=100.0,
+               shadow_soft_size=0.25)
+    make_light(scene, "AREA", "Panel", location=(-2.0, -1.0, 2.0), energy=50.0,
+               shape="RECTANGLE", size=0.5, size_y=0.25)
+    make_light(scene, "SPOT", "Spot", location=(0.0, -3.0, 3.0), energy=10.0)
+    bpy.context.view_layer.update()
+    return scene
+
+
+# ---- UI stubs --------------------------------------------------------------------------------
+
+class RecordingLayout:
+    """A stand-in for ``UILayout`` that records what a draw function puts in it."""
+
+    def __init__(self, log=None):
+        self.log = log if log is not None else []
+        self.use_property_split = False
+        self.use_property_decorate = True
+        self.active = True
+        self.alert = False
+        self.enabled = True
+
+    def _child(self, *args, **kwargs):
+        return RecordingLayout(self.log)
+
+    row = column = box = split = column_flow = grid_flow = _child
+
+    def label(self, text="", icon="NONE", **kwargs):
+        """Records a label."""
+        self.log.append(("label", text, icon))
+
+    def prop(self, data, prop, **kwargs):
+        """Records a property (checking it exists)."""
+        assert hasattr(data, prop) or prop in getattr(data, "bl_rna").properties, prop
+        self.log.append(("prop", prop))
+
+    def operator(self, idname, **kwargs):
+        """Records an operator button; returns a namespace to set properties on."""
+        self.log.append(("operator", idname))
+        return types.SimpleNamespace()
+
+    def separator(self, **kwargs):
+        """Ignored."""
+
+    def menu(self, *args, **kwargs):
+        """Records a menu."""
+        self.log.append(("menu", args[0] if args else ""))
+
+    def template_ID(self, *args, **kwargs):  # noqa: N802 - Blender's name
+        """Records an ID template."""
+        self.log.append(("template_ID", args[1] if len(args) > 1 else ""))
+
+    def template_list(self, *args, **kwargs):
+        """Records a list template."""
+        self.log.append(("template_list",))
+
+    def template_node_view(self, tree, node, socket):
+        """Records a node view."""
+        self.log.append(("template_node_view", node.name, socket.name))
+
+    def labels(self):
+        """The texts of all recorded labels."""
+        return [entry[1] for entry in self.log if entry[0] == "label"]
+
+
+def draw_panel(panel_class, context):
+    """Runs a panel's draw() on a RecordingLayout; returns the layout."""
+    layout = RecordingLayout()
+    panel_class.draw(types.SimpleNamespace(layout=layout), context)
+    return layout
+
+
+def vector(values):
+    """A mathutils Vector (helper for readability)."""
+    return Vector(values)

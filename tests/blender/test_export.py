@@ -1,0 +1,325 @@
+"""Scene export tests: no native library needed.
+
+Builds the hair test scene by script and checks the exported numpy arrays against values read
+through other Blender APIs (mathutils transforms, particle locations, node inputs, curve
+slices) and against Cycles' radius rules written out independently here.
+"""
+
+import math
+import os
+import sys
+import types
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import helpers  # noqa: E402
+
+ARGS, PACKAGE = helpers.setup()
+export = sys.modules["hairis.export"]
+
+# Node input name → hairis_principled_hair field, written out here on purpose (not imported).
+HAIR_FIELDS = {
+    "Color": "color", "Melanin": "melanin", "Melanin Redness": "melanin_redness",
+    "Tint": "tint", "Absorption Coefficient": "absorption_coefficient",
+    "Roughness": "roughness", "Radial Roughness": "radial_roughness", "Coat": "coat",
+    "IOR": "ior", "Offset": "offset", "Random Color": "random_color",
+    "Random Roughness": "random_roughness", "Random": "random",
+}
+PARAMETRIZATION = {"ABSORPTION": 0, "MELANIN": 1, "COLOR": 2}
+
+
+def particle_curves(data):
+    """The one CurvesData exported from particles."""
+    found = [c for c in data.curves if c.source == "PARTICLES"]
+    assert len(found) == 1, [c.name for c in data.curves]
+    return found[0]
+
+
+def check_hair_material(material_data, material):
+    """The exported parameters equal the node's inputs, field for field."""
+    node = material.node_tree.nodes["Principled Hair BSDF"]
+    assert material_data.kind == "HAIR", material_data.kind
+    params = material_data.hair
+    assert params.parametrization == PARAMETRIZATION[node.parametrization]
+    for name, field in HAIR_FIELDS.items():
+        expected = node.inputs[name].default_value
+        actual = getattr(params, field)
+        if isinstance(actual, tuple):
+            np.testing.assert_allclose(actual, tuple(expected)[:3], rtol=0, atol=1e-7,
+                                       err_msg=name)
+        else:
+            assert actual == float(expected), (name, actual, expected)
+
+
+def test_particle_hair_viewport():
+    """200 strands, 2**display_step + 1 keys, world positions, Cycles radii, material."""
+    scene = helpers.make_test_scene()
+    data = export.export_context()
+    curves = particle_curves(data)
+    settings = bpy.data.objects["Head"].particle_systems[0].settings
+    keys = 2 ** settings.display_step + 1
+    assert curves.curve_count == 200, curves.curve_count
+    np.testing.assert_array_equal(curves.first, np.arange(201) * keys)
+    assert curves.positions.dtype == np.float32 and curves.positions.shape == (200 * keys, 3)
+    points = curves.positions.reshape(200, keys, 3).astype(np.float64)
+
+    # Tips are the particles' locations (world space), read with another API.
+    evaluated = bpy.data.objects["Head"].evaluated_get(bpy.context.evaluated_depsgraph_get())
+    locations = np.empty(200 * 3, np.float32)
+    evaluated.particle_systems[0].particles.foreach_get("location", locations)
+    np.testing.assert_allclose(points[:, -1], locations.reshape(-1, 3), atol=1e-5)
+
+    # Roots lie on the scaled low-poly sphere (faces sit inside the unit sphere).
+    head = bpy.data.objects["Head"]
+    center = np.array(head.location)
+    scale = head.scale[0]
+    root_distance = np.linalg.norm(points[:, 0] - center, axis=1)
+    assert np.all(root_distance <= scale * 1.0 + 1e-4), root_distance.max()
+    assert np.all(root_distance >= scale * 0.85), root_distance.min()
+
+    # Straight hair: hair_length is a world-space length (Blender divides it by the object
+    # scale when it grows the hair). The path cache's keys are not evenly spaced.
+    segments = np.linalg.norm(np.diff(points, axis=1), axis=2)
+    np.testing.assert_allclose(segments.sum(axis=1), settings.hair_length, rtol=2e-3)
+
+    # Cycles' shaperadius, written out: t is the arc-length fraction (uniform scale, so world
+    # fractions equal object-space ones), root/tip = radius_scale·0.5·root/tip, times the
+    # object scale, 0 at the tip with close tip.
+    half = settings.radius_scale * 0.5
+    root, tip = half * settings.root_radius, half * settings.tip_radius
+    radii = curves.radii.reshape(200, keys)
+    for strand in (0, 1, 99, 199):
+        lengths = np.concatenate([[0.0], np.cumsum(segments[strand])])
+        for k in range(keys):
+            t = lengths[k] / lengths[-1]
+            r = ((1.0 - t) ** (1.0 / (1.0 - settings.shape)) * (root - tip) + tip) * scale
+            if settings.use_close_tip and k == keys - 1:
+                r = 0.0
+            assert math.isclose(radii[strand, k], r, rel_tol=1e-4, abs_tol=1e-8), \
+                (strand, k, radii[strand, k], r)
+    assert radii[0, 0] == np.float32(root * scale)
+    assert np.all(radii[:, -1] == 0.0)
+
+    material = data.materials[curves.material]
+    assert material.name == "Hair", material.name
+    check_hair_material(material, bpy.data.materials["Hair"])
+    assert scene.render.engine == "HAIRIS"
+    # Random Color/Roughness with Random unlinked: Cycles randomizes per strand, hairis not.
+    assert any("per strand" in w and "'Hair'" in w for w in data.warnings), data.warnings
+
+
+def test_curves_object():
+    """Curves: offsets, world positions (mathutils), radii × scale, material."""
+    helpers.make_test_scene()
+    data = export.export_context()
+    found = [c for c in data.curves if c.source == "CURVES"]
+    assert len(found) == 1, [c.name for c in data.curves]
+    curves = found[0]
+    obj = bpy.data.objects["Curls"]
+    source = obj.data
+    assert curves.curve_count == len(source.curves)
+    assert curves.point_count == len(source.points)
+    for index in (0, 1, len(source.curves) // 2, len(source.curves) - 1):
+        assert curves.first[index] == source.curves[index].first_point_index
+    assert curves.first[-1] == len(source.points)
+    matrix = obj.matrix_world
+    for index in (0, 7, 1234, len(source.points) - 1):
+        expected = matrix @ Vector(source.points[index].position)
+        np.testing.assert_allclose(curves.positions[index], tuple(expected), atol=1e-5)
+        assert math.isclose(curves.radii[index], source.points[index].radius * 2.0,
+                            rel_tol=1e-6)
+    material = data.materials[curves.material]
+    assert material.name == "Curly"
+    check_hair_material(material, bpy.data.materials["Curly"])
+    np.testing.assert_allclose(material.hair.absorption_coefficient, (0.3, 0.6, 1.2), atol=1e-7)
+
+
+def test_curves_without_radius():
+    """Without a radius attribute Cycles uses 0.005 (times the object scale)."""
+    scene = helpers.reset()
+    helpers.make_camera(scene)
+    helpers.make_curves(scene, helpers.make_hair_material("Plain", "COLOR"), radius=False)
+    data = export.export_context()
+    (curves,) = data.curves
+    np.testing.assert_allclose(curves.radii, 0.005 * 2.0, rtol=1e-6)
+    assert data.materials[curves.material].hair.parametrization == 2
+
+
+def test_lights_world_camera():
+    """Sun direction/strength/angle, point, area, spot warning, world, camera frame."""
+    scene = helpers.make_test_scene()
+    data = export.export_context()
+    kinds = sorted(light.kind for light in data.lights)
+    assert kinds == ["AREA", "POINT", "SUN"], kinds
+    assert any("spot" in w for w in data.warnings), data.warnings
+
+    sun = next(light for light in data.lights if light.kind == "SUN")
+    sun_object = bpy.data.objects["Sun"]
+    direction = (sun_object.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
+    np.testing.assert_allclose(sun.direction, tuple(direction), atol=1e-6)
+    assert math.isclose(sun.strength, 3.0)
+    assert math.isclose(sun.angle, math.radians(5.0), rel_tol=1e-6)
+
+    point = next(light for light in data.lights if light.kind == "POINT")
+    np.testing.assert_allclose(point.position, (1.0, -2.0, 3.0), atol=1e-6)
+    assert math.isclose(point.strength, 100.0) and math.isclose(point.radius, 0.25)
+
+    area = next(light for light in data.lights if light.kind == "AREA")
+    assert area.shape == "RECTANGLE" and math.isclose(area.size_x, 0.5)
+    assert math.isclose(area.size_y, 0.25) and math.isclose(area.strength, 50.0)
+    np.testing.assert_allclose(area.matrix, np.array(bpy.data.objects["Panel"].matrix_world),
+                               atol=1e-6)
+
+    np.testing.assert_allclose(data.world_color, (0.05, 0.1, 0.2), atol=1e-7)
+    assert math.isclose(data.world_strength, 1.5)
+
+    camera = data.camera
+    assert (camera.width, camera.height) == (32, 24), (camera.width, camera.height)
+    assert not camera.orthographic
+    frame = [tuple(v) for v in scene.camera.data.view_frame(scene=scene)]
+    np.testing.assert_allclose(camera.frame, frame, atol=1e-6)
+    np.testing.assert_allclose(camera.camera_to_world, np.array(scene.camera.matrix_world),
+                               atol=1e-6)
+
+
+def test_camera_orthographic_and_scale():
+    """Orthographic flag; a scaled camera's matrix is exported without scale."""
+    scene = helpers.make_test_scene(with_curves=False)
+    scene.camera.data.type = "ORTHO"
+    scene.camera.scale = (2.0, 2.0, 2.0)
+    bpy.context.view_layer.update()
+    camera = export.export_context().camera
+    assert camera.orthographic
+    np.testing.assert_allclose(np.linalg.norm(camera.camera_to_world[:3, :3], axis=0), 1.0,
+                               atol=1e-6)
+    scene.camera.data.type = "PANO"
+    try:
+        export.export_context()
+    except export.ExportError as error:
+        assert "panoramic" in str(error)
+    else:
+        raise AssertionError("a panoramic camera must be refused")
+
+
+def test_mesh():
+    """The emitter mesh: loop triangles, world positions, per-triangle material."""
+    helpers.make_test_scene(with_curves=False)
+    data = export.export_context()
+    meshes = [m for m in data.meshes if m.name == "Head"]
+    assert len(meshes) == 1
+    mesh = meshes[0]
+    head = bpy.data.objects["Head"]
+    evaluated = head.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    source = evaluated.to_mesh()
+    source.calc_loop_triangles()
+    assert mesh.indices.shape == (len(source.loop_triangles), 3)
+    assert mesh.positions.shape == (len(source.vertices), 3)
+    for index in (0, 5, len(source.vertices) - 1):
+        expected = head.matrix_world @ source.vertices[index].co
+        np.testing.assert_allclose(mesh.positions[index], tuple(expected), atol=1e-5)
+    triangle = source.loop_triangles[3]
+    assert tuple(mesh.indices[3]) == tuple(triangle.vertices)
+    evaluated.to_mesh_clear()
+    names = {data.materials[i].name for i in np.unique(mesh.materials)}
+    assert names == {"Skin"}, names
+    skin = data.materials[mesh.materials[0]]
+    assert skin.kind == "DIFFUSE"
+    np.testing.assert_allclose(skin.albedo, (0.6, 0.4, 0.3), atol=1e-7)
+
+
+def test_unsupported_things_warn():
+    """Linked hair inputs, environment textures, unknown shaders: warnings, no crash."""
+    scene = helpers.make_test_scene(with_curves=False)
+    hair = bpy.data.materials["Hair"]
+    tree = hair.node_tree
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    tree.links.new(info.outputs["Random"], tree.nodes["Principled Hair BSDF"].inputs["Random"])
+    world_tree = scene.world.node_tree
+    environment = world_tree.nodes.new("ShaderNodeTexEnvironment")
+    world_tree.links.new(environment.outputs["Color"],
+                         world_tree.nodes["Background"].inputs["Color"])
+    skin = bpy.data.materials["Skin"]
+    glass = skin.node_tree.nodes.new("ShaderNodeBsdfGlass")
+    output = skin.node_tree.nodes["Material Output"]
+    skin.node_tree.links.new(glass.outputs["BSDF"], output.inputs["Surface"])
+    data = export.export_context()
+    text = "\n".join(data.warnings)
+    assert "'Random'" in text and "linked" in text, text
+    assert "environment textures are not supported" in text, text
+    assert "Glass BSDF is not supported" in text, text
+    # Blender 4.x's Huang model: refused with a message naming it.
+    stub = types.SimpleNamespace(model="HUANG", parametrization="COLOR", inputs=[])
+    params, _warnings, error = export.read_hair_node(stub, "Future")
+    assert params is None and "HUANG" in error, error
+
+
+def test_disabled_modifier_and_strands():
+    """A particle modifier hidden in the viewport exports no strands."""
+    helpers.make_test_scene(with_curves=False)
+    head = bpy.data.objects["Head"]
+    head.modifiers["Hair"].show_viewport = False
+    bpy.context.view_layer.update()
+    data = export.export_context()
+    assert not [c for c in data.curves if c.source == "PARTICLES"]
+
+
+def test_no_camera():
+    """A scene without a camera is refused with ExportError."""
+    scene = helpers.make_test_scene(with_curves=False)
+    scene.camera = None
+    try:
+        export.export_context()
+    except export.ExportError as error:
+        assert "no camera" in str(error)
+    else:
+        raise AssertionError("export without a camera must fail")
+
+
+def test_render_mode_export_through_engine():
+    """F12 export: render_step keys, rendered_child_count children (dumped before the
+    library is needed; the missing library then fails the render cleanly)."""
+    helpers.make_test_scene(children=3, with_curves=False)
+    settings = bpy.data.objects["Head"].particle_systems[0].settings
+    settings.display_percentage = 50
+    bpy.context.view_layer.update()
+    viewport = particle_curves(export.export_context())  # child_nbr 1, half displayed
+    assert viewport.curve_count == 100, viewport.curve_count
+    np.testing.assert_array_equal(np.diff(viewport.first), 2 ** settings.display_step + 1)
+    dump = os.path.join(ARGS.workdir, "render_export.npz")
+    os.environ["HAIRIS_EXPORT_DUMP"] = dump
+    helpers.use_library(os.path.join(ARGS.workdir, "missing", "libhairis.so"))
+    try:
+        bpy.ops.render.render()
+    except RuntimeError as error:
+        assert "hairis native library not found at" in str(error), error
+    else:
+        raise AssertionError("rendering without the library must report an error")
+    finally:
+        del os.environ["HAIRIS_EXPORT_DUMP"]
+        helpers.use_library(None)
+    arrays = np.load(dump)
+    index = [i for i in range(int(arrays["counts"][0]))
+             if str(arrays["curves%d_source" % i]) == "PARTICLES"]
+    assert len(index) == 1
+    first = arrays["curves%d_first" % index[0]]
+    keys = 2 ** 3 + 1  # render_step = 3
+    assert first.size - 1 == 200 * 3, first.size - 1  # children only: 200 parents × 3
+    np.testing.assert_array_equal(np.diff(first), keys)
+    assert tuple(arrays["camera_size"]) == (32, 24)
+
+
+helpers.run([
+    test_particle_hair_viewport,
+    test_curves_object,
+    test_curves_without_radius,
+    test_lights_world_camera,
+    test_camera_orthographic_and_scale,
+    test_mesh,
+    test_unsupported_things_warn,
+    test_disabled_modifier_and_strands,
+    test_no_camera,
+    test_render_mode_export_through_engine,
+])
