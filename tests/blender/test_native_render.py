@@ -30,7 +30,7 @@ STATUS = native.library_status()
 assert STATUS.ok, "the library exists but does not load: " + STATUS.message
 FAKE = STATUS.version.endswith("-fake")
 STRATEGIES = ("UNIFORM", "ANALYTIC", "GAUSSIAN", "TABLE")
-SEEDS = 16  # enough seeds that a tile's sample variance is itself reliable (heavy tails under UNIFORM)
+SEEDS = 16  # enough seeds that a tile's sample variance is itself reliable
 SAMPLES = 16
 TILE = 8
 
