@@ -11,14 +11,8 @@
 
 #include "hairis/frame.h"
 
-#if __has_include("hairis/chiang.h") && !defined(HAIRIS_TEST_WITHOUT_CHIANG)
 #include "hairis/chiang.h"
-#define HAIRIS_HAVE_CHIANG 1
-#endif
-#if __has_include("hairis/marschner.h") && !defined(HAIRIS_TEST_WITHOUT_MARSCHNER)
 #include "hairis/marschner.h"
-#define HAIRIS_HAVE_MARSCHNER 1
-#endif
 
 namespace hairis {
 namespace {
@@ -394,7 +388,6 @@ DualScattering time_default_grids(const FiberModel &model, const char *label, co
     return ds;
 }
 
-#ifdef HAIRIS_HAVE_CHIANG
 ChiangFiber cycles_default_chiang() {
     ChiangParams params;
     params.sigma_a = Rgb(0.245531f, 0.52f, 1.365f);
@@ -417,9 +410,7 @@ TEST(DistributionsRealModels, ChiangMultiple) {
     const DualScattering ds = time_default_grids(fiber, "chiang", {});
     check_multiple_table(multiple_table(ds, "chiang (Cycles defaults)"), PeakRules{}, "chiang");
 }
-#endif
 
-#ifdef HAIRIS_HAVE_MARSCHNER
 TEST(DistributionsRealModels, MarschnerDirect) {
     const MarschnerFiber fiber = value_of(MarschnerFiber::create(MarschnerParams::blonde()));
     check_direct_real(fiber, "marschner", 2 * fiber.params().alpha_r);
@@ -440,7 +431,6 @@ TEST(DistributionsRealModels, MarschnerMultiple) {
     rules.towards_normal = false;
     check_multiple_table(multiple_table(ds, "marschner (blonde, energy_scale 0.5)"), rules, "marschner");
 }
-#endif
 
 }  // namespace
 }  // namespace hairis

@@ -11,14 +11,8 @@
 
 #include "hairis/frame.h"
 
-#if __has_include("hairis/chiang.h") && !defined(HAIRIS_TEST_WITHOUT_CHIANG)
 #include "hairis/chiang.h"
-#define HAIRIS_HAVE_CHIANG 1
-#endif
-#if __has_include("hairis/marschner.h") && !defined(HAIRIS_TEST_WITHOUT_MARSCHNER)
 #include "hairis/marschner.h"
-#define HAIRIS_HAVE_MARSCHNER 1
-#endif
 
 namespace hairis {
 namespace {
@@ -438,7 +432,6 @@ void check_real_model(const FiberModel &model, const char *label, const DualScat
     }
 }
 
-#ifdef HAIRIS_HAVE_CHIANG
 TEST(DualScatteringRealModels, Chiang) {
     ChiangParams params;
     params.sigma_a = Rgb(0.245531f, 0.52f, 1.365f);
@@ -450,9 +443,7 @@ TEST(DualScatteringRealModels, Chiang) {
     ASSERT_TRUE(fiber.ok()) << fiber.error().message;
     check_real_model(fiber.value(), "chiang");
 }
-#endif
 
-#ifdef HAIRIS_HAVE_MARSCHNER
 TEST(DualScatteringRealModels, MarschnerBlonde) {
     Expected<MarschnerFiber> fiber = MarschnerFiber::create(MarschnerParams::blonde());
     ASSERT_TRUE(fiber.ok()) << fiber.error().message;
@@ -469,7 +460,6 @@ TEST(DualScatteringRealModels, MarschnerBlonde) {
     params.energy_scale = 0.5f;
     check_real_model(fiber.value(), "marschner-blonde", params);
 }
-#endif
 
 }  // namespace
 }  // namespace hairis
