@@ -87,7 +87,8 @@ def main():
                 " (azimuthally uniform)", os.path.join(d, "figure2.png"), positive_norm(fig2))
 
     fig3 = np.load(os.path.join(d, "figure3.npy"))
-    fig, axes = plt.subplots(2, 5, figsize=(12, 5.5), sharex=True, sharey=True)
+    fig, axes = plt.subplots(2, 5, figsize=(15, 6), sharex=True, sharey=True,
+                             constrained_layout=True)
     for k, n_h in enumerate(STRANDS):
         image = band(fig3[k])
         top = axes[0][k].imshow(image.T, origin="lower", extent=EXTENT, aspect="auto", cmap="gray",
@@ -96,7 +97,8 @@ def main():
                                    cmap="gray")
         axes[0][k].set_title(f"n_h = {n_h}", fontsize=9)
         axes[1][k].set_xlabel("θ_i (°)", fontsize=8)
-        fig.colorbar(bottom, ax=axes[1][k], fraction=0.05)
+        bar = fig.colorbar(bottom, ax=axes[1][k], fraction=0.08, format="%.0e")
+        bar.ax.tick_params(labelsize=7)
     axes[0][0].set_ylabel("fixed scale [0, 0.2]\nφ_i (°)", fontsize=8)
     axes[1][0].set_ylabel("automatic scale\nφ_i (°)", fontsize=8)
     fig.colorbar(top, ax=axes[0].tolist(), fraction=0.02)
