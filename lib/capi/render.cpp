@@ -7,6 +7,7 @@
 
 #include "capi_scene.h"
 #include "hairis/render.h"
+#include "hairis/strategies.h"
 
 namespace hairis::capi {
 
@@ -46,7 +47,7 @@ std::shared_ptr<const DirectionSampler> hair_sampler(const SceneHairMaterial &ha
         case HAIRIS_STRATEGY_UNIFORM: break;
         case HAIRIS_STRATEGY_ANALYTIC:
             // The renderer recognises this sampler and takes f·cos from the fiber's own sample.
-            return builtin_samplers::chiang_analytic(hair.fiber);
+            return std::make_shared<const AnalyticSampler>(hair.fiber);
         case HAIRIS_STRATEGY_GAUSSIAN: {
             const std::vector<int> &allowed = inputs.seed.n_h_values;
             if (std::find(allowed.begin(), allowed.end(), s.n_h) == allowed.end())

@@ -524,6 +524,21 @@ const ChiangFiber::FarSlice &ChiangFiber::far_slice(const Outgoing &o) const {
     return slice;
 }
 
+// The edges of the pieces of [−π/2, π/2] on which the deflection Φ(p, γ) is monotone: one
+// piece, or three for TRT when the caustic exists (k > 1/2). Returns the number of edges.
+static int monotone_pieces(int p, double k, double cuts[4]) {
+    cuts[0] = -kHalfPi;
+    if (p == 2 && k > 0.5) {
+        const double caustic = caustic_gamma(k);
+        cuts[1] = -caustic;
+        cuts[2] = caustic;
+        cuts[3] = kHalfPi;
+        return 4;
+    }
+    cuts[1] = kHalfPi;
+    return 2;
+}
+
 std::array<double, 3> ChiangFiber::far_azimuthal(int p, const Outgoing &o, double phi) const {
     const FarSlice &slice = far_slice(o);
     if (slice.node_count == 0) return far_azimuthal_graded(p, o, phi);
@@ -561,15 +576,8 @@ std::array<double, 3> ChiangFiber::far_azimuthal(int p, const Outgoing &o, doubl
     if (negligible) return result;
 
     const Deflection deflection{p, o.k};
-    double cuts[4] = {-kHalfPi, kHalfPi, 0, 0};
-    int cut_count = 2;
-    if (p == 2 && o.k > 0.5) {
-        const double caustic = caustic_gamma(o.k);
-        cuts[1] = -caustic;
-        cuts[2] = caustic;
-        cuts[3] = kHalfPi;
-        cut_count = 4;
-    }
+    double cuts[4];
+    const int cut_count = monotone_pieces(p, o.k, cuts);
     int refined[3] = {-1, -1, -1};
     for (int piece = 0; piece + 1 < cut_count; ++piece) {
         const double a = cuts[piece], b = cuts[piece + 1];
@@ -651,15 +659,8 @@ std::array<double, 3> ChiangFiber::far_azimuthal_graded(int p, const Outgoing &o
     };
 
     // Monotone pieces of Φ.
-    double cuts[4] = {-kHalfPi, kHalfPi, 0, 0};
-    int cut_count = 2;
-    if (p == 2 && o.k > 0.5) {
-        const double caustic = caustic_gamma(o.k);
-        cuts[1] = -caustic;
-        cuts[2] = caustic;
-        cuts[3] = kHalfPi;
-        cut_count = 4;
-    }
+    double cuts[4];
+    const int cut_count = monotone_pieces(p, o.k, cuts);
 
     Channels total{};
     for (int piece = 0; piece + 1 < cut_count; ++piece) {

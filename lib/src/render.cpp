@@ -1,5 +1,7 @@
 #include "hairis/render.h"
 
+#include "hairis/strategies.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
@@ -56,8 +58,8 @@ class Bsdf {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             hair_ = hair;
             // Chiang's own sampler returns f·cos with the sample: no second evaluation.
-            if (builtin_samplers::chiang_analytic_fiber(*hair->sampler) == hair->fiber.get())
-                analytic_ = hair->fiber.get();
+            const auto *analytic = dynamic_cast<const AnalyticSampler *>(hair->sampler.get());
+            if (analytic && &analytic->fiber() == hair->fiber.get()) analytic_ = hair->fiber.get();
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
             h_ = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
             wo_local_ = frame_.to_local(wo);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "hairis/strategies.h"
+
 #include <cstdio>
 
 #include <chrono>
@@ -322,7 +324,7 @@ TEST(Render, HairInAWhiteWorldStaysAtMostOne) {
     // σ_a = 0: the fiber absorbs nothing, so in a white furnace no pixel can exceed the world.
     const auto clear = fiber_with(Rgb(0.0f));
     SceneDesc d;
-    d.materials = {HairMaterial{clear, builtin_samplers::chiang_analytic(clear)}};
+    d.materials = {HairMaterial{clear, std::make_shared<const AnalyticSampler>(clear)}};
     d.curves = {parallel_hairs(5, 0.15f, 0.06f)};
     d.world = {Rgb(1.0f), 1.0f};
     d.camera = ortho_down(0.5f, 0.5f, 10, 10);
@@ -381,8 +383,8 @@ TEST(Render, HairStrategiesAgree) {
         d.camera = ortho_down(0.05f, 0.25f, 1, 5);
         return build(std::move(d));
     };
-    const Scene analytic = make(builtin_samplers::chiang_analytic(fiber));
-    const Scene uniform = make(builtin_samplers::uniform_sphere());
+    const Scene analytic = make(std::make_shared<const AnalyticSampler>(fiber));
+    const Scene uniform = make(std::make_shared<const UniformSampler>());
     RenderSettings s;
     s.max_bounces = 4;
     for (int y = 0; y < 5; ++y) {
@@ -417,7 +419,7 @@ TEST(Render, HairStrategiesAgreeOnDeepPaths) {
         d.camera = ortho_down(0.05f, 0.05f, 1, 1);
         return build(std::move(d));
     };
-    const Scene analytic = make(builtin_samplers::chiang_analytic(fiber));
+    const Scene analytic = make(std::make_shared<const AnalyticSampler>(fiber));
     const Scene gauss =
         make(std::make_shared<GaussianSampler>(GaussianSampler::create(SeedPdfParams{}, 0.3, 2).value()));
     RenderSettings s;
@@ -431,7 +433,7 @@ TEST(Render, HairStrategiesAgreeOnDeepPaths) {
 
 TEST(Render, HairOffsetIsCyclesH) {
     SceneDesc d;
-    d.materials = {HairMaterial{fiber_with(Rgb(0.5f)), builtin_samplers::uniform_sphere()}};
+    d.materials = {HairMaterial{fiber_with(Rgb(0.5f)), std::make_shared<const UniformSampler>()}};
     d.curves = {parallel_hairs(1, 0.1f, 0.1f)};
     d.camera = ortho_down(1, 1, 2, 2);
     const Scene scene = build(std::move(d));
@@ -512,7 +514,7 @@ TEST(Render, ImageIsWrittenBottomRowFirst) {
 Scene hair_tuft_scene(int width, int height, int curves = 64) {
     const auto fiber = fiber_with(Rgb(0.3f, 0.6f, 1.2f));
     SceneDesc d;
-    d.materials = {HairMaterial{fiber, builtin_samplers::chiang_analytic(fiber)},
+    d.materials = {HairMaterial{fiber, std::make_shared<const AnalyticSampler>(fiber)},
                    DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}};
     d.curves = {tuft(curves, 8, 0.01f)};
     d.meshes = {quad(3.0f, 0.0f, 1)};

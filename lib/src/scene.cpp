@@ -105,55 +105,7 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
                   d0 * p0.w + d1 * p1.w + d2 * p2.w + d3 * p3.w};
 }
 
-class UniformSphereSampler final : public DirectionSampler {
-  public:
-    StrategyKind kind() const override { return StrategyKind::Uniform; }
-    std::optional<DirectionSample> sample(Vec3, float, float u0, float u1, float) const override {
-        const float z = 1.0f - 2.0f * u0;
-        const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const float phi = float(kTwoPi) * u1;
-        return DirectionSample{{z, r * std::cos(phi), r * std::sin(phi)}, float(kInvFourPi)};
-    }
-    float pdf(Vec3, Vec3, float) const override { return float(kInvFourPi); }
-};
-
-class ChiangAnalyticSampler final : public DirectionSampler {
-  public:
-    explicit ChiangAnalyticSampler(std::shared_ptr<const ChiangFiber> fiber)
-        : fiber_(std::move(fiber)) {}
-    StrategyKind kind() const override { return StrategyKind::Analytic; }
-    std::optional<DirectionSample> sample(Vec3 wo, float h, float u0, float u1,
-                                          float u2) const override {
-        const auto s = fiber_->sample(wo, h, u0, u1, u2);
-        if (!s || !(s->pdf > 0.0f)) return std::nullopt;
-        return DirectionSample{s->wi, s->pdf};
-    }
-    float pdf(Vec3 wi, Vec3 wo, float h) const override { return fiber_->pdf(wi, wo, h); }
-    const ChiangFiber *fiber() const { return fiber_.get(); }
-
-  private:
-    std::shared_ptr<const ChiangFiber> fiber_;
-};
-
 }  // namespace
-
-namespace builtin_samplers {
-
-std::shared_ptr<const DirectionSampler> uniform_sphere() {
-    return std::make_shared<UniformSphereSampler>();
-}
-
-std::shared_ptr<const DirectionSampler> chiang_analytic(std::shared_ptr<const ChiangFiber> fiber) {
-    if (!fiber) return nullptr;
-    return std::make_shared<ChiangAnalyticSampler>(std::move(fiber));
-}
-
-const ChiangFiber *chiang_analytic_fiber(const DirectionSampler &sampler) {
-    const auto *analytic = dynamic_cast<const ChiangAnalyticSampler *>(&sampler);
-    return analytic ? analytic->fiber() : nullptr;
-}
-
-}  // namespace builtin_samplers
 
 struct Scene::Impl {
     RTCDevice device = nullptr;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "hairis/strategies.h"
+
 #include <cmath>
 #include <string>
 
@@ -25,7 +27,7 @@ std::shared_ptr<const ChiangFiber> default_fiber() {
 }
 
 HairMaterial hair_material() {
-    return HairMaterial{default_fiber(), builtin_samplers::uniform_sphere()};
+    return HairMaterial{default_fiber(), std::make_shared<const UniformSampler>()};
 }
 
 // One straight hair along X at y = z = 0, radius 0.1, through 4 points.
@@ -269,8 +271,8 @@ TEST(Scene, InvalidScenesGiveClearErrors) {
     EXPECT_NE(e.find("camera: width"), std::string::npos) << e;
 }
 
-TEST(BuiltinSamplers, UniformSphereMatchesItsPdf) {
-    const auto sampler = builtin_samplers::uniform_sphere();
+TEST(HairSamplers, UniformSphereMatchesItsPdf) {
+    const auto sampler = std::make_shared<const UniformSampler>();
     EXPECT_EQ(sampler->kind(), StrategyKind::Uniform);
     const Vec3 wo = safe_normalize({0.3f, -0.9f, 0.1f});
     testing::Chi2Options options;
@@ -286,11 +288,11 @@ TEST(BuiltinSamplers, UniformSphereMatchesItsPdf) {
     EXPECT_TRUE(r.passed) << r.message;
 }
 
-TEST(BuiltinSamplers, ChiangAnalyticIsTheFibersOwnSampler) {
+TEST(HairSamplers, ChiangAnalyticIsTheFibersOwnSampler) {
     const auto fiber = default_fiber();
-    const auto sampler = builtin_samplers::chiang_analytic(fiber);
+    const auto sampler = std::make_shared<const AnalyticSampler>(fiber);
     EXPECT_EQ(sampler->kind(), StrategyKind::Analytic);
-    EXPECT_EQ(builtin_samplers::chiang_analytic(nullptr), nullptr);
+    EXPECT_EQ(&sampler->fiber(), fiber.get());  // what the renderer checks to reuse f·cos
     const Vec3 wo = safe_normalize({0.3f, -0.9f, 0.1f});
     for (int i = 0; i < 50; ++i) {
         const float u0 = (i + 0.5f) / 50.0f, u1 = std::fmod(u0 * 7.3f, 1.0f),

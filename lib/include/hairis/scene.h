@@ -194,17 +194,4 @@ class Scene {
     std::unique_ptr<Impl> impl_;
 };
 
-/// Built-in direction samplers for hair materials (the real strategies live elsewhere).
-namespace builtin_samplers {
-
-/// Uniform over the sphere: pdf 1/(4π). Kind Uniform.
-std::shared_ptr<const DirectionSampler> uniform_sphere();
-/// ChiangFiber's own analytic sample()/pdf() as a DirectionSampler. Kind Analytic.
-std::shared_ptr<const DirectionSampler> chiang_analytic(std::shared_ptr<const ChiangFiber> fiber);
-/// The fiber behind a sampler made by chiang_analytic(), or null for any other sampler (the
-/// renderer then takes f·cos from ChiangFiber::sample instead of evaluating it again).
-const ChiangFiber *chiang_analytic_fiber(const DirectionSampler &sampler);
-
-}  // namespace builtin_samplers
-
 }  // namespace hairis

@@ -28,6 +28,9 @@ class AnalyticSampler final : public DirectionSampler {
     StrategyKind kind() const override { return StrategyKind::Analytic; }
     std::optional<DirectionSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const override;
     float pdf(Vec3 wi, Vec3 wo, float h) const override;
+    /// The fiber sampled: a renderer can take f·cos from ChiangFiber::sample instead of
+    /// evaluating it again.
+    const ChiangFiber &fiber() const { return *fiber_; }
 
   private:
     std::shared_ptr<const ChiangFiber> fiber_;
