@@ -73,6 +73,7 @@ std::shared_ptr<const DirectionSampler> hair_sampler(const SceneHairMaterial &ha
                        name + " (hair): its tables hold n_h " + join(hair.tables_n_h) +
                            ", not settings.n_h = " + std::to_string(s.n_h));
             inputs.tables = &hair.tables;
+            inputs.chiang = hair.fiber;  // the near field gets its own table (near_field_table.h)
             break;
         default: break;  // refused by check_settings
     }

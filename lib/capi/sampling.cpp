@@ -60,6 +60,9 @@ HAIRIS_API hairis_sampler *hairis_sampler_create(hairis_strategy strategy,
         if (kind == HAIRIS_STRATEGY_TABLE) {
             if (!tables) invalid("tables must not be NULL for HAIRIS_STRATEGY_TABLE");
             inputs.tables = &tables->sampling;  // make_sampler copies the shared_ptrs
+            // With a Chiang fiber the sampler follows the near field at h (near_field_table.h);
+            // without one it samples the h-averaged direct table.
+            if (fiber && fiber->chiang) inputs.chiang = fiber->chiang;
         }
         if (kind == HAIRIS_STRATEGY_GAUSSIAN || kind == HAIRIS_STRATEGY_TABLE) {
             const std::vector<int> &allowed = kind == HAIRIS_STRATEGY_TABLE

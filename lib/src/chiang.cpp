@@ -318,6 +318,23 @@ Rgb ChiangFiber::attenuation(int p, Vec3 wo, float h) const {
     return to_rgb(attenuation_at(outgoing(wo), h).a[p]);
 }
 
+ChiangFiber::LobeGeometry ChiangFiber::lobe_geometry(Vec3 wo, float h) const {
+    const Attenuation at = attenuation_at(outgoing(wo), h);
+    LobeGeometry g;
+    for (int p = 0; p < 4; ++p) g.attenuation[size_t(p)] = to_rgb(at.a[size_t(p)]);
+    for (int p = 0; p < 3; ++p) g.shift[size_t(p)] = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t);
+    return g;
+}
+
+double ChiangFiber::longitudinal(int p, double sin_theta_i, double sin_theta_o) const {
+    if (p < 0 || p > 3) return 0.0;
+    Outgoing o;
+    o.sin_theta = std::clamp(sin_theta_o, -1.0, 1.0);
+    o.cos_theta = cos_from_sin(o.sin_theta);
+    sin_theta_i = std::clamp(sin_theta_i, -1.0, 1.0);
+    return tilted_longitudinal(p, sin_theta_i, cos_from_sin(sin_theta_i), o);
+}
+
 namespace {
 
 std::array<double, 4> selection_weights(const std::array<Channels, 4> &a) {

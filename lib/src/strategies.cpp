@@ -1,5 +1,7 @@
 #include "hairis/strategies.h"
 
+#include <algorithm>
+
 #include "hairis/frame.h"
 
 namespace hairis {
@@ -41,23 +43,50 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
                           std::make_shared<const MultipleTable>(std::move(multiple).value())};
 }
 
-Expected<TableSampler> TableSampler::create(const SamplingTables &tables, float multiple_weight, int n_h) {
+Expected<TableSampler> TableSampler::create(const SamplingTables &tables, float multiple_weight, int n_h,
+                                            std::shared_ptr<const NearFieldTable> near_field) {
     Expected<MixtureSampler> m = MixtureSampler::create(tables.direct, tables.multiple, n_h, multiple_weight);
     if (!m) return m.error();
-    return TableSampler(std::move(m).value());
+    TableSampler sampler(std::move(m).value(), std::move(near_field));
+    sampler.strand_ = tables.multiple->strand_index(n_h);
+    return sampler;
 }
 
-std::optional<DirectionSample> TableSampler::sample(Vec3 wo, float, float u0, float u1, float u2) const {
+std::optional<DirectionSample> TableSampler::sample(Vec3 wo, float h, float u0, float u1, float u2) const {
     const FiberAngles o = angles_of(wo);
-    const TableSample s = mixture_.sample(o.theta, u0, u1, u2);
-    if (!(s.pdf > 0.0f)) return std::nullopt;
-    return DirectionSample{s.local_direction(o.phi), s.pdf};
+    if (!near_) {
+        const TableSample s = mixture_.sample(o.theta, u0, u1, u2);
+        if (!(s.pdf > 0.0f)) return std::nullopt;
+        return DirectionSample{s.local_direction(o.phi), s.pdf};
+    }
+    // u2 first chooses the part, then is reused inside it.
+    const float w = mixture_.multiple_weight();
+    Vec3 wi;
+    if (u2 < w) {
+        const TableSample s = mixture_.multiple().sample(strand_, o.theta, u0, u1, u2 / w);
+        if (!(s.pdf > 0.0f)) return std::nullopt;
+        wi = s.local_direction(o.phi);
+    } else {
+        const float rest = std::min((u2 - w) / (1.0f - w), kOneMinusEpsilon);
+        const std::optional<NearFieldSample> s = near_->sample(wo, h, u0, u1, rest);
+        if (!s) return std::nullopt;
+        wi = s->wi;
+    }
+    const float density = pdf(wi, wo, h);
+    if (!(density > 0.0f) || !std::isfinite(density)) return std::nullopt;
+    return DirectionSample{wi, density};
 }
 
-float TableSampler::pdf(Vec3 wi, Vec3 wo, float) const {
+float TableSampler::pdf(Vec3 wi, Vec3 wo, float h) const {
     const FiberAngles o = angles_of(wo);
-    const float phi_i = std::atan2(wi.z, wi.y);
-    return mixture_.pdf_sin(o.theta, wi.x, relative_azimuth(phi_i, o.phi));
+    if (!near_) {
+        const float phi_i = std::atan2(wi.z, wi.y);
+        return mixture_.pdf_sin(o.theta, wi.x, relative_azimuth(phi_i, o.phi));
+    }
+    const float w = mixture_.multiple_weight();
+    const float single = w < 1.0f ? near_->pdf(wi, wo, h) : 0.0f;
+    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, o.theta, wi.x) : 0.0f;
+    return (1.0f - w) * single + w * multiple;
 }
 
 Expected<std::shared_ptr<const DirectionSampler>> make_sampler(StrategyKind kind, const StrategyInputs &in) {
@@ -75,7 +104,13 @@ Expected<std::shared_ptr<const DirectionSampler>> make_sampler(StrategyKind kind
         case StrategyKind::Table: {
             if (!in.tables || !in.tables->direct || !in.tables->multiple)
                 return Error{"the table strategy needs baked tables (none were given)"};
-            Expected<TableSampler> t = TableSampler::create(*in.tables, in.multiple_weight, in.n_h);
+            std::shared_ptr<const NearFieldTable> near_field = in.near_field;
+            if (!near_field && in.chiang) {
+                Expected<NearFieldTable> made = NearFieldTable::create(in.chiang);
+                if (!made) return Error{"near-field table: " + made.error().message};
+                near_field = std::make_shared<const NearFieldTable>(std::move(made).value());
+            }
+            Expected<TableSampler> t = TableSampler::create(*in.tables, in.multiple_weight, in.n_h, near_field);
             if (!t) return t.error();
             return std::shared_ptr<const DirectionSampler>(std::make_shared<TableSampler>(std::move(t).value()));
         }

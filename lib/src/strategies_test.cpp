@@ -21,7 +21,8 @@ constexpr int kNodes = 15;  // nodes every 12° at ±6°, ±18°, ..., ±84°
 // θ_r (degrees): on a node, between nodes, and near grazing (on the last node, between the
 // last two, and past the last node where the outer slice is used).
 const double kThetaR[] = {-36.0, 0.0, 30.0, 84.0, -81.0, 87.5};
-constexpr int kFamily = 6 * (1 + 5 + 1) + 6 + 6;  // table (direct, 5 n_h, mixture), analytic, uniform
+// table (direct, 5 n_h, mixture, near-field mixture), analytic, uniform
+constexpr int kFamily = 6 * (1 + 5 + 1 + 1) + 6 + 6;
 
 struct Fixture {
     std::shared_ptr<const ChiangFiber> fiber;
@@ -53,6 +54,9 @@ void expect_exact(const DirectionSampler &sampler, double theta_r_deg, float h, 
         options.theta_breaks.push_back(-kHalfPi + kPi * k / 32);
         options.phi_breaks.push_back(-kPi + kTwoPi * k / 32);
     }
+    // ... and at the near-field table's (linear inside each cell).
+    for (int k = 0; k <= NearFieldTableOptions{}.theta_i_cells; ++k)
+        options.theta_breaks.push_back(-kHalfPi + kPi * k / NearFieldTableOptions{}.theta_i_cells);
     const auto r = testing::chi2_direction_test(
         [&](Sample3 u) -> std::optional<Vec3> {
             auto s = sampler.sample(wo, h, u.u0, u.u1, u.u2);
@@ -75,27 +79,37 @@ void expect_exact(const DirectionSampler &sampler, double theta_r_deg, float h, 
 class TableStrategy : public ::testing::TestWithParam<double> {};
 
 TEST_P(TableStrategy, DirectTableIsExact) {
-    auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.0f, 2});
+    auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.0f, 2, nullptr});
     ASSERT_TRUE(s.ok()) << s.error().message;
     expect_exact(*s.value(), GetParam(), 0.0f, "direct table");
 }
 
 TEST_P(TableStrategy, EachMultipleTableIsExact) {
     for (int n_h : {1, 2, 4, 8, 16}) {
-        auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 1.0f, n_h});
+        auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 1.0f, n_h, nullptr});
         ASSERT_TRUE(s.ok()) << s.error().message;
         expect_exact(*s.value(), GetParam(), 0.0f, "multiple table n_h " + std::to_string(n_h));
     }
 }
 
 TEST_P(TableStrategy, MixtureIsExact) {
-    auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.3f, 4});
+    auto s = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.3f, 4, nullptr});
     ASSERT_TRUE(s.ok()) << s.error().message;
     expect_exact(*s.value(), GetParam(), 0.0f, "mixture");
 }
 
+TEST_P(TableStrategy, NearFieldMixtureIsExact) {
+    // With a Chiang fiber the table strategy follows the near field at h.
+    auto s = make_sampler(StrategyKind::Table, {fixture().fiber, &fixture().tables, {}, 0.3f, 4, nullptr});
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    const auto *table = dynamic_cast<const TableSampler *>(s.value().get());
+    ASSERT_NE(table, nullptr);
+    ASSERT_NE(table->near_field(), nullptr);
+    expect_exact(*s.value(), GetParam(), -0.45f, "near-field mixture");
+}
+
 TEST_P(TableStrategy, AnalyticIsExact) {
-    auto s = make_sampler(StrategyKind::Analytic, {fixture().fiber, nullptr, {}, 0.0f, 2});
+    auto s = make_sampler(StrategyKind::Analytic, {fixture().fiber, nullptr, {}, 0.0f, 2, nullptr});
     ASSERT_TRUE(s.ok()) << s.error().message;
     expect_exact(*s.value(), GetParam(), 0.35f, "analytic");
 }
@@ -115,9 +129,9 @@ TEST(Strategies, MissingInputsAreReported) {
     auto t = make_sampler(StrategyKind::Table, {});
     ASSERT_FALSE(t.ok());
     EXPECT_NE(t.error().message.find("baked tables"), std::string::npos);
-    auto n = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.5f, 3});
+    auto n = make_sampler(StrategyKind::Table, {nullptr, &fixture().tables, {}, 0.5f, 3, nullptr});
     EXPECT_FALSE(n.ok());
-    auto w = make_sampler(StrategyKind::Gaussian, {nullptr, nullptr, {}, 2.0f, 2});
+    auto w = make_sampler(StrategyKind::Gaussian, {nullptr, nullptr, {}, 2.0f, 2, nullptr});
     EXPECT_FALSE(w.ok());
     EXPECT_STREQ(strategy_name(StrategyKind::Table), "table");
 }

@@ -113,6 +113,17 @@ class ChiangFiber final : public FiberModel {
     /// Attenuation A_p at (ω_o, h) for p in [0, 3] (zero otherwise).
     Rgb attenuation(int p, Vec3 wo, float h) const;
 
+    /// What the near field at (ω_o, h) needs besides M_p, computed once: every lobe's
+    /// attenuation and the azimuthal centres Φ(p, h) of R, TT and TRT.
+    struct LobeGeometry {
+        std::array<Rgb, 4> attenuation;
+        std::array<double, 3> shift{};
+    };
+    LobeGeometry lobe_geometry(Vec3 wo, float h) const;
+    /// Cycles' tilted longitudinal function M_p(θ_i + δ_p, θ_o) of lobe p ∈ [0, 3] (density
+    /// per cos θ_i dθ_i before the tilt), the factor of f_cos_near that does not depend on h.
+    double longitudinal(int p, double sin_theta_i, double sin_theta_o) const;
+
     /// The validated parameters as given.
     const ChiangParams &params() const { return params_; }
     /// The mapped longitudinal variance of lobe p (R: coat-reduced v_m0, TT: v/4, TRT and

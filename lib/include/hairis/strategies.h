@@ -6,6 +6,7 @@
 
 #include "hairis/chiang.h"
 #include "hairis/expected.h"
+#include "hairis/near_field_table.h"
 #include "hairis/sampling_table.h"
 #include "hairis/seed_pdfs.h"
 #include "hairis/strategy.h"
@@ -45,28 +46,40 @@ struct SamplingTables {
     static Expected<SamplingTables> from(const TableSet &tables);
 };
 
-/// The table strategy: a one-sample mixture of the direct table and the multiple table for
-/// one n_h, (1 − w)·pdf_direct + w·pdf_multiple. Ignores h (the tables are far field).
+/// The table strategy: a one-sample mixture (1 − w)·pdf_single + w·pdf_multiple of a
+/// single-scattering part and the multiple table for one n_h. The single-scattering part is
+/// the near-field table (near_field_table.h) when one is given — what a renderer shading
+/// Chiang's near field wants — and otherwise the far-field direct table, which ignores h.
 class TableSampler final : public DirectionSampler {
   public:
-    static Expected<TableSampler> create(const SamplingTables &tables, float multiple_weight, int n_h);
+    static Expected<TableSampler> create(const SamplingTables &tables, float multiple_weight, int n_h,
+                                         std::shared_ptr<const NearFieldTable> near_field = nullptr);
     StrategyKind kind() const override { return StrategyKind::Table; }
     std::optional<DirectionSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const override;
     float pdf(Vec3 wi, Vec3 wo, float h) const override;
+    /// The near-field table, or null when the far-field direct table is used.
+    const NearFieldTable *near_field() const { return near_.get(); }
 
   private:
-    explicit TableSampler(MixtureSampler mixture) : mixture_(std::move(mixture)) {}
+    TableSampler(MixtureSampler mixture, std::shared_ptr<const NearFieldTable> near_field)
+        : mixture_(std::move(mixture)), near_(std::move(near_field)) {}
     MixtureSampler mixture_;
+    std::shared_ptr<const NearFieldTable> near_;
+    int strand_ = 0;
 };
 
 /// What a strategy needs: the fiber for ANALYTIC (Chiang only), tables for TABLE, the seed's
 /// parameters for GAUSSIAN, and the mixture weight and n_h for TABLE and GAUSSIAN.
 struct StrategyInputs {
+    /// For ANALYTIC; with TABLE, a Chiang fiber also gets the near-field table (built from
+    /// it unless near_field is given).
     std::shared_ptr<const ChiangFiber> chiang;
     const SamplingTables *tables = nullptr;
     SeedPdfParams seed;
     float multiple_weight = 0.25f;
     int n_h = 2;
+    /// A near-field table to share between samplers (TABLE with a Chiang fiber).
+    std::shared_ptr<const NearFieldTable> near_field;
 };
 
 /// Builds a strategy; the error names what is missing or out of range.

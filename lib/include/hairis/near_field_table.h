@@ -1,0 +1,103 @@
+// Tables for the near field of a Chiang fiber: the part of f that the 2D far-field tables
+// cannot follow.
+//
+// A renderer (like Cycles) shades the near field f(ω_i, ω_o, h), whose azimuthal lobes move
+// with the offset h: R sits at Φ = −2γ_o, and over h ∈ [−1, 1] it sweeps all of [−π, π].
+// Tables averaged over h spread every lobe over that whole sweep, and sample a fixed h about
+// 80× worse than Chiang's own analytic sampler (docs/performance.md). A 4D table over
+// (θ_o, h, θ_i, φ) would be large. It is not needed, because the model factors per lobe:
+//
+//   f_p·|cos θ_i| = A_p(θ_o, h) · M_p(θ_i | θ_o) · N_p(φ − Φ_p(h)).
+//
+// Only M_p depends on θ_i, and it does not depend on h. So this table holds, per θ_o node and
+// lobe, M_p(θ_i | θ_o)·cos θ_i exactly as Cycles evaluates it (with the cuticle tilt on θ_i,
+// which the analytic sampler can only approximate) as a 1D inverse-CDF over θ_i cells, plus
+// each lobe's integral I_p(θ_o). Inside a cell the density is linear in sin θ_i between M_p's
+// values at the cell's edges (a piecewise-constant cell would cost ~10⁻³ relative variance
+// at 1° cells; linear, ~10⁻⁶), with the cell's mass from the exact integral. At a shading point the sampler picks the lobe with
+// probability ∝ luminance(A_p)·I_p, θ_i from the lobe's table and φ from the trimmed logistic
+// around Φ_p(h) (N_p is sampled exactly, in closed form). θ_o between nodes picks the lower
+// or upper node stochastically, so the density is the exact blend of the two nodes'.
+//
+// The density is then proportional to luminance(f·cos) up to the θ_i cells' resolution and
+// the blend between nodes: far closer than the analytic sampler's, whose M_p is tilted on
+// θ_o instead of θ_i.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "hairis/chiang.h"
+#include "hairis/expected.h"
+#include "hairis/piecewise.h"
+#include "hairis/sampling_table.h"
+#include "hairis/strategy.h"
+
+namespace hairis {
+
+/// Resolution of a NearFieldTable (chosen in docs/performance.md's resolution sweep).
+struct NearFieldTableOptions {
+    int theta_o_nodes = 61;   ///< nodes over [−π/2, π/2], ends included (3° apart)
+    int theta_i_cells = 180;  ///< equal θ_i cells over [−π/2, π/2] (1° wide)
+};
+
+/// A sampled direction of the near-field table, with the lobe it came from.
+struct NearFieldSample {
+    Vec3 wi;
+    float pdf = 0;
+    int lobe = 0;
+};
+
+/// Per-θ_o, per-lobe inverse CDFs of Cycles' M_p·cos θ_i, and the near-field sampler on them.
+class NearFieldTable {
+  public:
+    /// Tabulates the fiber's M_p; refuses node counts outside [2, kMaxThetaRNodes] and cell
+    /// counts outside [4, kMaxTableAxisCells].
+    static Expected<NearFieldTable> create(std::shared_ptr<const ChiangFiber> fiber,
+                                           const NearFieldTableOptions &options = {});
+
+    /// Draws ω_i at (ω_o, h): u2 picks the θ_o node and the lobe, u1 θ_i, u0 φ.
+    /// nullopt when the density there is not positive (never for a valid fiber).
+    std::optional<NearFieldSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const;
+    /// The density of sample() per steradian of ω_i.
+    float pdf(Vec3 wi, Vec3 wo, float h) const;
+
+    const ChiangFiber &fiber() const { return *fiber_; }
+    int theta_o_nodes() const { return nodes_.count(); }
+    int theta_i_cells() const { return cells_.count(); }
+    /// ∫ M_p(θ_i | θ_o node r)·cos θ_i dθ_i: 1 without a tilt, not exactly 1 with one.
+    double lobe_integral(int r, int p) const { return integral_[size_t(r) * 4 + size_t(p)]; }
+    /// Bytes the tables hold (CDFs, guides, integrals).
+    size_t memory_bytes() const;
+
+  private:
+    NearFieldTable() = default;
+    float density(Vec3 wi, Vec3 wo, const ChiangFiber::LobeGeometry &g) const;
+
+    std::shared_ptr<const ChiangFiber> fiber_;
+    ThetaRNodes nodes_;
+    LongitudinalCells cells_;
+    const float *edge(int row) const { return edge_.data() + size_t(row) * size_t(cells_.count() + 1); }
+
+    DiscreteCdfs cdfs_;              // row r·4 + p: the cells' masses
+    std::vector<float> edge_;        // row r·4 + p: M_p at the cells' edges
+    std::vector<double> integral_;  // r·4 + p
+    double s_ = 1;                  // the fiber's logistic scale
+};
+
+/// The near-field table as a strategy (no multiple-scattering part).
+class NearFieldTableSampler final : public DirectionSampler {
+  public:
+    explicit NearFieldTableSampler(std::shared_ptr<const NearFieldTable> table)
+        : table_(std::move(table)) {}
+    StrategyKind kind() const override { return StrategyKind::Table; }
+    std::optional<DirectionSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const override;
+    float pdf(Vec3 wi, Vec3 wo, float h) const override { return table_->pdf(wi, wo, h); }
+    const NearFieldTable &table() const { return *table_; }
+
+  private:
+    std::shared_ptr<const NearFieldTable> table_;
+};
+
+}  // namespace hairis

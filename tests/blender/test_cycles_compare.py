@@ -1,0 +1,223 @@
+"""Hairis against Cycles: the same scene, rendered by both, must agree within the noise.
+
+The scene has particle hair on a diffuse sphere, a Curves object, a sun, a point light with a
+radius, an area light and a world colour. Cycles is set up as the README's "Comparing with
+Cycles" section says (3D Curves, a 1-pixel box filter, the same bounce limit for every kind of
+bounce, no clamping, no glossy filter, no denoising, no adaptive sampling, no light threshold).
+
+Both engines render SEEDS independent images of SAMPLES samples. Per 4×4 block and channel,
+d = mean_hairis − mean_cycles and its variance s² = (var_h + var_c)/SEEDS come from the seeds,
+so t = d/s follows Student's t with about 2(SEEDS−1) degrees of freedom when both engines
+converge to the same image. The test asserts
+  * each channel's image mean agrees within 2%,
+  * the mean of t² over the blocks is within its expectation ν/(ν−2) plus five standard errors
+    (a bound derived from the measured noise, not a tolerance picked by hand),
+  * no block is beyond the t quantile at α = 0.01 with a Šidák correction over the blocks.
+"""
+
+import math
+import os
+import sys
+import time
+
+import bpy
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import helpers  # noqa: E402
+
+ARGS, PACKAGE = helpers.setup()
+if not os.path.isfile(helpers.bundled_library(PACKAGE)):
+    helpers.skip("libhairis.so is not built yet (looked for %s)"
+                 % helpers.bundled_library(PACKAGE))
+SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
+SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+BOUNCES = 4
+BLOCK = 4
+STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
+
+
+def make_diffuse_material(name, color):
+    """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        if node.type != "OUTPUT_MATERIAL":
+            tree.nodes.remove(node)
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = color
+    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
+    tree.links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
+    return material
+
+
+def match_cycles(scene, samples, bounces):
+    """Cycles settings under which its image is comparable with Hairis' (see the README)."""
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = samples
+    cycles.use_adaptive_sampling = False
+    cycles.use_denoising = False
+    for name in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                 "transparent_max_bounces"):
+        setattr(cycles, name, bounces)
+    cycles.volume_bounces = 0
+    cycles.blur_glossy = 0.0
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.light_sampling_threshold = 0.0
+    cycles.pixel_filter_type = "BOX"
+    cycles.filter_width = 1.0
+    scene.cycles_curves.shape = "THICK"
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+
+
+def make_scene():
+    """Particle hair, Curves, a diffuse sphere, three kinds of light and a world colour."""
+    scene = helpers.reset()
+    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(64, 48), percentage=100)
+    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+    hair = helpers.make_hair_material("Hair", "MELANIN", **{
+        "Melanin": 0.3, "Melanin Redness": 0.7, "Roughness": 0.3, "Radial Roughness": 0.4,
+        "Coat": 0.1, "IOR": 1.55})
+    dyed = helpers.make_hair_material("Dyed", "COLOR", **{
+        "Color": (0.2, 0.5, 0.8, 1.0), "Roughness": 0.45})
+    skin = make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    helpers.make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0),
+                        scale=1.4)
+    helpers.make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
+                               hair_material=hair, skin_material=skin)
+    helpers.make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
+                       rotation=(0.6, 0.3, 0.0))
+    helpers.make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
+                       shadow_soft_size=0.2)
+    helpers.make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
+                       shape="RECTANGLE", size=0.6, size_y=0.3,
+                       rotation=(math.radians(60), 0.0, math.radians(-40)))
+    match_cycles(scene, SAMPLES, BOUNCES)
+    settings = scene.hairis
+    settings.samples = SAMPLES
+    settings.max_bounces = BOUNCES
+    settings.strategy = STRATEGY
+    settings.auto_bake = True
+    settings.threads = 0
+    bpy.context.view_layer.update()
+    return scene
+
+
+def render(scene, engine, seed):
+    """Renders with ``engine`` and returns (linear RGB array, seconds) read back from EXR."""
+    scene.render.engine = engine
+    scene.cycles.seed = seed
+    scene.hairis.seed = seed
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    path = os.path.join(ARGS.workdir, "%s_%d.exr" % (engine.lower(), seed))
+    start = time.monotonic()
+    bpy.ops.render.render()
+    seconds = time.monotonic() - start
+    bpy.data.images["Render Result"].save_render(path, scene=scene)
+    image = bpy.data.images.load(path)
+    width, height = image.size
+    pixels = np.empty(width * height * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)[..., :3].astype(np.float64), seconds
+
+
+def downsample(images, factor):
+    """Means over factor×factor blocks of a (seeds, height, width, 3) stack."""
+    s, h, w, c = images.shape
+    return images.reshape(s, h // factor, factor, w // factor, factor, c).mean(axis=(2, 4))
+
+
+
+
+def student_t_sf(t, dof):
+    """P(T > t) for Student's t with ``dof`` degrees of freedom (numerical integration)."""
+    x = np.linspace(0.0, t, 20001)
+    log_c = (math.lgamma((dof + 1) / 2) - math.lgamma(dof / 2)
+             - 0.5 * math.log(dof * math.pi))
+    density = np.exp(log_c - (dof + 1) / 2 * np.log1p(x * x / dof))
+    return 0.5 - np.trapz(density, x)
+
+
+def t_critical(alpha_two_sided, dof):
+    """t with P(|T| > t) = alpha for Student's t (bisection)."""
+    lo, hi = 0.0, 1000.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if 2.0 * student_t_sf(mid, dof) > alpha_two_sided:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+def compare(cycles, hairis):
+    """The three assertions of the module docstring; returns the figures for the log."""
+    seeds = cycles.shape[0]
+    cycles_mean = cycles.reshape(seeds, -1, 3).mean(axis=(0, 1))
+    hairis_mean = hairis.reshape(seeds, -1, 3).mean(axis=(0, 1))
+    ratio = hairis_mean / cycles_mean
+    print("channel means: cycles %s hairis %s ratio %s" % (cycles_mean, hairis_mean, ratio))
+    assert np.all(np.abs(ratio - 1.0) <= 0.02), "channel means differ by more than 2%%: %s" % ratio
+
+    c, h = downsample(cycles, BLOCK), downsample(hairis, BLOCK)
+    difference = h.mean(axis=0) - c.mean(axis=0)
+    variance = (h.var(axis=0, ddof=1) + c.var(axis=0, ddof=1)) / seeds
+    # Blocks of pure background are constant in both engines: no noise to compare with, so
+    # they must agree to float precision instead.
+    flat = variance <= 1e-12
+    assert np.all(np.abs(difference[flat]) <= 1e-5 * np.maximum(1.0, np.abs(c.mean(0)[flat]))), \
+        "noise-free blocks differ: %s" % np.abs(difference[flat]).max()
+    t = difference[~flat] / np.sqrt(variance[~flat])
+    dof = 2 * (seeds - 1)
+    # t² ~ F(1, ν): mean ν/(ν−2), variance 2ν²(ν−1)/((ν−2)²(ν−4)). Channels of a block are
+    # correlated, so the standard error counts blocks, not block-channels.
+    mean_t2 = dof / (dof - 2.0)
+    var_t2 = 2.0 * dof ** 2 * (dof - 1) / ((dof - 2.0) ** 2 * (dof - 4.0))
+    blocks = t.size / 3.0
+    bound = mean_t2 + 5.0 * math.sqrt(var_t2 / blocks)
+    observed = float(np.mean(t * t))
+    relative_rms = math.sqrt(float(np.mean(difference ** 2))) / float(c.mean())
+    noise_rms = math.sqrt(float(np.mean(variance))) / float(c.mean())
+    print("4x4 blocks: %d noisy, mean t^2 %.3f (expected %.3f, bound %.3f), max |t| %.2f; "
+          "relative RMS difference %.4f against noise %.4f"
+          % (t.size, observed, mean_t2, bound, float(np.abs(t).max()), relative_rms, noise_rms))
+    assert observed <= bound, "the difference image is beyond the noise: mean t^2 %.3f > %.3f" \
+        % (observed, bound)
+    alpha = 1.0 - (1.0 - 0.01) ** (1.0 / t.size)
+    critical = t_critical(alpha, dof)
+    worst = float(np.abs(t).max())
+    print("Sidak: per-block alpha %.2e, |t| bound %.2f" % (alpha, critical))
+    assert worst <= critical, "a block differs beyond the noise: |t| = %.2f > %.2f" \
+        % (worst, critical)
+
+
+def test_hairis_matches_cycles():
+    """Cycles and Hairis render the same scene to the same image within the noise."""
+    scene = make_scene()
+    blend = os.path.join(ARGS.workdir, "compare.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    stacks, times = {}, {}
+    for engine in ("CYCLES", "HAIRIS"):
+        images = []
+        times[engine] = 0.0
+        for seed in range(1, SEEDS + 1):
+            image, seconds = render(scene, engine, seed)
+            assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % engine
+            images.append(image)
+            times[engine] += seconds
+        stacks[engine] = np.stack(images)
+    print("render time for %d x %d samples: cycles %.1f s, hairis %.1f s (%s)"
+          % (SEEDS, SAMPLES, times["CYCLES"], times["HAIRIS"], STRATEGY))
+    dump = os.environ.get("HAIRIS_COMPARE_DUMP")
+    if dump:
+        np.savez(dump, cycles=stacks["CYCLES"], hairis=stacks["HAIRIS"])
+    compare(stacks["CYCLES"], stacks["HAIRIS"])
+
+
+helpers.run([test_hairis_matches_cycles])
