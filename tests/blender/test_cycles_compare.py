@@ -133,8 +133,6 @@ def downsample(images, factor):
     return images.reshape(s, h // factor, factor, w // factor, factor, c).mean(axis=(2, 4))
 
 
-
-
 def student_t_sf(t, dof):
     """P(T > t) for Student's t with ``dof`` degrees of freedom (numerical integration)."""
     x = np.linspace(0.0, t, 20001)
