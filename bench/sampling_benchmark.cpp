@@ -46,8 +46,10 @@ void sample_and_pdf(benchmark::State &state, int which) {
 BENCHMARK_CAPTURE(sample_and_pdf, uniform, 0);
 BENCHMARK_CAPTURE(sample_and_pdf, analytic, 1);
 BENCHMARK_CAPTURE(sample_and_pdf, gaussian, 3);
-BENCHMARK_CAPTURE(sample_and_pdf, table_direct, 4);
-BENCHMARK_CAPTURE(sample_and_pdf, table_mixture, 5);
+BENCHMARK_CAPTURE(sample_and_pdf, table_far_direct, 4);
+BENCHMARK_CAPTURE(sample_and_pdf, table_far_mixture, 5);
+BENCHMARK_CAPTURE(sample_and_pdf, table_near_direct, 6);
+BENCHMARK_CAPTURE(sample_and_pdf, table_near_mixture, 7);
 
 void chiang_near_field(benchmark::State &state) {
     const Queries q(4096);

@@ -37,20 +37,26 @@ struct NamedSampler {
 };
 
 inline std::vector<NamedSampler> all_samplers(const StudySetup &s, float mixture_weight = 0.25f, int n_h = 2) {
-    auto make = [&](StrategyKind kind, float w) {
+    // The near-field table is built once and shared by both table variants that use it.
+    const auto near_field = std::make_shared<const NearFieldTable>(NearFieldTable::create(s.fiber).value());
+    auto make = [&](StrategyKind kind, float w, bool near) {
         StrategyInputs in;
-        in.chiang = s.fiber;
+        in.chiang = kind == StrategyKind::Table && !near ? nullptr : s.fiber;
         in.tables = &s.sampling;
         in.multiple_weight = w;
         in.n_h = n_h;
+        if (near) in.near_field = near_field;
         return make_sampler(kind, in).value();
     };
-    return {{"uniform", make(StrategyKind::Uniform, 0.0f)},
-            {"analytic", make(StrategyKind::Analytic, 0.0f)},
-            {"gaussian (w=0)", make(StrategyKind::Gaussian, 0.0f)},
-            {"gaussian (w=" + std::to_string(mixture_weight).substr(0, 4) + ")", make(StrategyKind::Gaussian, mixture_weight)},
-            {"table (w=0)", make(StrategyKind::Table, 0.0f)},
-            {"table (w=" + std::to_string(mixture_weight).substr(0, 4) + ")", make(StrategyKind::Table, mixture_weight)}};
+    const std::string w = "w=" + std::to_string(mixture_weight).substr(0, 4);
+    return {{"uniform", make(StrategyKind::Uniform, 0.0f, false)},
+            {"analytic", make(StrategyKind::Analytic, 0.0f, false)},
+            {"gaussian (w=0)", make(StrategyKind::Gaussian, 0.0f, false)},
+            {"gaussian (" + w + ")", make(StrategyKind::Gaussian, mixture_weight, false)},
+            {"table, far-field 2D (w=0)", make(StrategyKind::Table, 0.0f, false)},
+            {"table, far-field 2D (" + w + ")", make(StrategyKind::Table, mixture_weight, false)},
+            {"table, near-field (w=0)", make(StrategyKind::Table, 0.0f, true)},
+            {"table, near-field (" + w + ")", make(StrategyKind::Table, mixture_weight, true)}};
 }
 
 }  // namespace hairis::bench
