@@ -48,7 +48,7 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
         return *s;
     NearFieldTable table;
     table.fiber_ = std::move(fiber);
-    table.s_ = table.fiber_->logistic_scale();
+    table.logistic_ = TrimmedLogistic(table.fiber_->logistic_scale());
 
     const int nodes = options.theta_o_nodes, cells = options.theta_i_cells;
     std::vector<float> theta_o(static_cast<size_t>(nodes));
@@ -111,19 +111,6 @@ size_t NearFieldTable::memory_bytes() const {
 
 namespace {
 
-// Lobe-selection weights at one node: luminance(A_p)·I_p, normalized.
-struct NodeWeights {
-    float w[4];
-};
-
-NodeWeights node_weights(const ChiangFiber::LobeGeometry &g, const double *integral) {
-    NodeWeights n{};
-    double a[4], total = 0;
-    for (int p = 0; p < 4; ++p) total += (a[p] = double(luminance(g.attenuation[size_t(p)])) * integral[p]);
-    for (int p = 0; p < 4; ++p) n.w[p] = float(total > 0 ? a[p] / total : (p == 0 ? 1.0 : 0.0));
-    return n;
-}
-
 float clamp_unit(float u) { return u > 0.0f ? (u < kOneMinusEpsilon ? u : kOneMinusEpsilon) : 0.0f; }
 
 // Inside a cell the density is linear in t ∈ [0, 1] between the edge values a and b:
@@ -146,82 +133,103 @@ float sample_cell_shape(float a, float b, float u) {
 
 }  // namespace
 
-float NearFieldTable::density(Vec3 wi, Vec3 wo, const ChiangFiber::LobeGeometry &g) const {
+NearFieldTable::Prepared NearFieldTable::prepare(Vec3 wo, float h) const {
+    Prepared q;
+    const ChiangFiber::LobeGeometry g = fiber_->lobe_geometry(wo, h);
+    for (int p = 0; p < 3; ++p) q.shift[p] = g.shift[size_t(p)];
+    q.blend = nodes_.locate(safe_asin(wo.x));
+    // Lobe weights luminance(A_p)·I_p at both nodes, normalized per node.
+    for (int side = 0; side < 2; ++side) {
+        const int r = std::min(q.blend.lower + side, nodes_.count() - 1);
+        const double *integral = &integral_[size_t(r) * 4];
+        double a[4], total = 0;
+        for (int p = 0; p < 4; ++p)
+            total += (a[p] = double(luminance(g.attenuation[size_t(p)])) * integral[p]);
+        for (int p = 0; p < 4; ++p)
+            q.weight[side][p] = float(total > 0 ? a[p] / total : (p == 0 ? 1.0 : 0.0));
+    }
+    // The view's azimuth as a rotation, so that φ = φ_i − φ_o needs one atan2.
+    const double r = std::sqrt(double(wo.y) * wo.y + double(wo.z) * wo.z);
+    q.cos_phi_o = r > 0 ? wo.y / r : 0.0;
+    q.sin_phi_o = r > 0 ? wo.z / r : -1.0;
+    return q;
+}
+
+float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
     if (!LongitudinalCells::contains_sin(wi.x)) return 0.0f;
-    const float theta_o = safe_asin(wo.x);
-    const NodeBlend b = nodes_.locate(theta_o);
     const int k = cells_.cell_of_sin(wi.x);
-    const double phi = wrap_angle(std::atan2(double(wi.z), double(wi.y)) -
-                                  std::atan2(double(wo.z), double(wo.y)));
+    const double phi = std::atan2(wi.z * q.cos_phi_o - wi.y * q.sin_phi_o,
+                                  wi.y * q.cos_phi_o + wi.z * q.sin_phi_o);
     double azimuthal[4];
-    for (int p = 0; p < 3; ++p)
-        azimuthal[p] = chiang::trimmed_logistic(wrap_angle(phi - g.shift[size_t(p)]), s_);
+    for (int p = 0; p < 3; ++p) azimuthal[p] = logistic_.density(wrap_angle(phi - q.shift[p]));
     azimuthal[3] = kInvTwoPi;
-    const double per_sin = 1.0 / double(cells_.sin_width(k));
     const float t_in_cell = std::clamp((wi.x - cells_.sin_edge(k)) / cells_.sin_width(k), 0.0f, 1.0f);
 
     double pdf = 0;
-    const float node_weight[2] = {1.0f - b.t, b.t};
+    const float node_weight[2] = {1.0f - q.blend.t, q.blend.t};
     for (int side = 0; side < 2; ++side) {
         if (!(node_weight[side] > 0.0f)) continue;
-        const int r = b.lower + side;
-        const NodeWeights w = node_weights(g, &integral_[size_t(r) * 4]);
+        const int r = q.blend.lower + side;
         double d = 0;
-        for (int p = 0; p < 4; ++p)
-            if (w.w[p] > 0.0f) {
-                const float *e = edge(r * 4 + p) + k;
-                d += double(w.w[p]) * double(cdfs_.pmf(r * 4 + p, k)) *
-                     double(cell_shape(e[0], e[1], t_in_cell)) * azimuthal[p];
-            }
-        pdf += double(node_weight[side]) * d * per_sin;
+        for (int p = 0; p < 4; ++p) {
+            if (!(q.weight[side][p] > 0.0f)) continue;
+            const float *e = edge(r * 4 + p) + k;
+            d += double(q.weight[side][p]) * double(cdfs_.pmf(r * 4 + p, k)) *
+                 double(cell_shape(e[0], e[1], t_in_cell)) * azimuthal[p];
+        }
+        pdf += double(node_weight[side]) * d;
     }
-    return float(pdf);
+    return float(pdf / double(cells_.sin_width(k)));
 }
 
-float NearFieldTable::pdf(Vec3 wi, Vec3 wo, float h) const {
-    return density(wi, wo, fiber_->lobe_geometry(wo, h));
+float NearFieldTable::pdf(Vec3 wi, Vec3 wo, float h) const { return density(prepare(wo, h), wi); }
+
+std::optional<NearFieldSample> NearFieldTable::sample(const Prepared &q, float u0, float u1,
+                                                      float u2) const {
+    // u2 chooses the node (lower with probability 1 − t), then the lobe.
+    float u = clamp_unit(u2);
+    int side = 0;
+    if (q.blend.t > 0.0f) {
+        const float lower = 1.0f - q.blend.t;
+        if (u < lower) {
+            u = u / lower;
+        } else {
+            u = (u - lower) / q.blend.t;
+            side = 1;
+        }
+        u = clamp_unit(u);
+    }
+    const int r = q.blend.lower + side;
+    const float *w = q.weight[side];
+    int p = 0;
+    while (p < 3 && (u >= w[p] || !(w[p] > 0.0f))) {
+        u -= w[p];
+        ++p;
+    }
+    while (p > 0 && !(w[p] > 0.0f)) --p;  // rounding left u past the last positive lobe
+
+    const CellChoice c = cdfs_.sample(r * 4 + p, u1);
+    const float *e = edge(r * 4 + p) + c.index;
+    const LongitudinalCells::Point point = cells_.point_in_cell(
+        c.index, std::min(sample_cell_shape(e[0], e[1], c.fraction), kOneMinusEpsilon));
+    double phi = -kPi + kTwoPi * double(clamp_unit(u0));  // residual: uniform
+    if (p < 3) phi = q.shift[p] + logistic_.sample(clamp_unit(u0));
+    // φ_i = φ_o + φ, by rotation.
+    const double c_phi = std::cos(phi), s_phi = std::sin(phi);
+    const double cos_phi_i = q.cos_phi_o * c_phi - q.sin_phi_o * s_phi;
+    const double sin_phi_i = q.sin_phi_o * c_phi + q.cos_phi_o * s_phi;
+
+    NearFieldSample s;
+    s.wi = Vec3{point.sin_theta, float(point.cos_theta * cos_phi_i), float(point.cos_theta * sin_phi_i)};
+    s.lobe = p;
+    s.pdf = density(q, s.wi);
+    if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return std::nullopt;
+    return s;
 }
 
 std::optional<NearFieldSample> NearFieldTable::sample(Vec3 wo, float h, float u0, float u1,
                                                       float u2) const {
-    const ChiangFiber::LobeGeometry g = fiber_->lobe_geometry(wo, h);
-    const NodeBlend b = nodes_.locate(safe_asin(wo.x));
-    // u2 chooses the node (lower with probability 1 − t), then the lobe.
-    float u = clamp_unit(u2);
-    int r = b.lower;
-    if (b.t > 0.0f) {
-        const float lower = 1.0f - b.t;
-        if (u < lower) {
-            u = u / lower;
-        } else {
-            u = (u - lower) / b.t;
-            ++r;
-        }
-        u = clamp_unit(u);
-    }
-    const NodeWeights w = node_weights(g, &integral_[size_t(r) * 4]);
-    int p = 0;
-    while (p < 3 && (u >= w.w[p] || !(w.w[p] > 0.0f))) {
-        u -= w.w[p];
-        ++p;
-    }
-    while (p > 0 && !(w.w[p] > 0.0f)) --p;  // rounding left u past the last positive lobe
-
-    const CellChoice c = cdfs_.sample(r * 4 + p, u1);
-    const float *e = edge(r * 4 + p) + c.index;
-    const LongitudinalCells::Point point =
-        cells_.point_in_cell(c.index, std::min(sample_cell_shape(e[0], e[1], c.fraction), kOneMinusEpsilon));
-    double phi = -kPi + kTwoPi * double(clamp_unit(u0));  // residual: uniform
-    if (p < 3) phi = g.shift[size_t(p)] + chiang::sample_trimmed_logistic(clamp_unit(u0), s_);
-    const double phi_i = std::atan2(double(wo.z), double(wo.y)) + phi;
-
-    NearFieldSample s;
-    s.wi = Vec3{point.sin_theta, float(point.cos_theta * std::cos(phi_i)),
-                float(point.cos_theta * std::sin(phi_i))};
-    s.lobe = p;
-    s.pdf = density(s.wi, wo, g);
-    if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return std::nullopt;
-    return s;
+    return sample(prepare(wo, h), u0, u1, u2);
 }
 
 std::optional<DirectionSample> NearFieldTableSampler::sample(Vec3 wo, float h, float u0, float u1,

@@ -53,39 +53,43 @@ Expected<TableSampler> TableSampler::create(const SamplingTables &tables, float 
 }
 
 std::optional<DirectionSample> TableSampler::sample(Vec3 wo, float h, float u0, float u1, float u2) const {
-    const FiberAngles o = angles_of(wo);
     if (!near_) {
+        const FiberAngles o = angles_of(wo);
         const TableSample s = mixture_.sample(o.theta, u0, u1, u2);
         if (!(s.pdf > 0.0f)) return std::nullopt;
         return DirectionSample{s.local_direction(o.phi), s.pdf};
     }
-    // u2 first chooses the part, then is reused inside it.
+    // u2 first chooses the part, then is reused inside it. The near field's per-point work
+    // is shared between its sample and its density.
     const float w = mixture_.multiple_weight();
-    Vec3 wi;
+    const NearFieldTable::Prepared q = near_->prepare(wo, h);
+    const float theta_o = safe_asin(wo.x);
     if (u2 < w) {
-        const TableSample s = mixture_.multiple().sample(strand_, o.theta, u0, u1, u2 / w);
+        const TableSample s = mixture_.multiple().sample(strand_, theta_o, u0, u1, u2 / w);
         if (!(s.pdf > 0.0f)) return std::nullopt;
-        wi = s.local_direction(o.phi);
-    } else {
-        const float rest = std::min((u2 - w) / (1.0f - w), kOneMinusEpsilon);
-        const std::optional<NearFieldSample> s = near_->sample(wo, h, u0, u1, rest);
-        if (!s) return std::nullopt;
-        wi = s->wi;
+        const Vec3 wi = s.local_direction(std::atan2(wo.z, wo.y));
+        const float density = (1.0f - w) * near_->density(q, wi) + w * s.pdf;
+        if (!(density > 0.0f) || !std::isfinite(density)) return std::nullopt;
+        return DirectionSample{wi, density};
     }
-    const float density = pdf(wi, wo, h);
+    const float rest = std::min((u2 - w) / (1.0f - w), kOneMinusEpsilon);
+    const std::optional<NearFieldSample> s = near_->sample(q, u0, u1, rest);
+    if (!s) return std::nullopt;
+    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, theta_o, s->wi.x) : 0.0f;
+    const float density = (1.0f - w) * s->pdf + w * multiple;
     if (!(density > 0.0f) || !std::isfinite(density)) return std::nullopt;
-    return DirectionSample{wi, density};
+    return DirectionSample{s->wi, density};
 }
 
 float TableSampler::pdf(Vec3 wi, Vec3 wo, float h) const {
-    const FiberAngles o = angles_of(wo);
     if (!near_) {
+        const FiberAngles o = angles_of(wo);
         const float phi_i = std::atan2(wi.z, wi.y);
         return mixture_.pdf_sin(o.theta, wi.x, relative_azimuth(phi_i, o.phi));
     }
     const float w = mixture_.multiple_weight();
     const float single = w < 1.0f ? near_->pdf(wi, wo, h) : 0.0f;
-    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, o.theta, wi.x) : 0.0f;
+    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, safe_asin(wo.x), wi.x) : 0.0f;
     return (1.0f - w) * single + w * multiple;
 }
 
