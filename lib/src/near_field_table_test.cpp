@@ -28,8 +28,8 @@ std::shared_ptr<const ChiangFiber> fiber(float roughness = 0.3f, float offset_de
 
 Vec3 view_at(double theta_o_deg) { return direction_of(float(radians(theta_o_deg)), -float(kHalfPi)); }
 
-// θ_o (degrees) on a node (nodes every 3°), between nodes, and near grazing.
-const double kThetaO[] = {-36.0, 1.5, 40.0, 87.5, -88.9};
+// θ_o (degrees) on a node (nodes every 1.5°), between nodes, and near grazing.
+const double kThetaO[] = {-36.0, 0.7, 40.2, 87.5, -89.9};
 const float kH[] = {0.35f, -0.9f};
 constexpr int kFamily = 5 * 2 + 2;
 
@@ -100,7 +100,7 @@ TEST(NearFieldTable, LobeIntegralsAreOneWithoutTiltAndTrackTheTiltWithIt) {
     // With Cycles' tilt on θ_i the integral is ≈ cos δ − sin δ tan θ_o (chiang.h), e.g. R
     // (δ = 2α) at θ_o = 60°.
     const NearFieldTable tilted = NearFieldTable::create(fiber(0.3f, 5.0f)).value();
-    const int r60 = 50;  // −90° + 50·3° = 60°
+    const int r60 = 100;  // −90° + 100·1.5° = 60°
     const double delta = radians(10.0);
     EXPECT_NEAR(tilted.lobe_integral(r60, 0), std::cos(delta) - std::sin(delta) * std::tan(radians(60.0)), 0.02);
     EXPECT_NEAR(tilted.lobe_integral(r60, 3), 1.0, 1e-6);  // the residual is not tilted

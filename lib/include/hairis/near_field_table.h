@@ -4,7 +4,7 @@
 // A renderer (like Cycles) shades the near field f(ω_i, ω_o, h), whose azimuthal lobes move
 // with the offset h: R sits at Φ = −2γ_o, and over h ∈ [−1, 1] it sweeps all of [−π, π].
 // Tables averaged over h spread every lobe over that whole sweep, and sample a fixed h about
-// 80× worse than Chiang's own analytic sampler (docs/performance.md). A 4D table over
+// 80× worse than Chiang's own analytic sampler (bench/results/strategy_study.md). A 4D table over
 // (θ_o, h, θ_i, φ) would be large. It is not needed, because the model factors per lobe:
 //
 //   f_p·|cos θ_i| = A_p(θ_o, h) · M_p(θ_i | θ_o) · N_p(φ − Φ_p(h)).
@@ -13,15 +13,16 @@
 // lobe, M_p(θ_i | θ_o)·cos θ_i exactly as Cycles evaluates it (with the cuticle tilt on θ_i,
 // which the analytic sampler can only approximate) as a 1D inverse-CDF over θ_i cells, plus
 // each lobe's integral I_p(θ_o). Inside a cell the density is linear in sin θ_i between M_p's
-// values at the cell's edges (a piecewise-constant cell would cost ~10⁻³ relative variance
-// at 1° cells; linear, ~10⁻⁶), with the cell's mass from the exact integral. At a shading point the sampler picks the lobe with
-// probability ∝ luminance(A_p)·I_p, θ_i from the lobe's table and φ from the trimmed logistic
-// around Φ_p(h) (N_p is sampled exactly, in closed form). θ_o between nodes picks the lower
-// or upper node stochastically, so the density is the exact blend of the two nodes'.
+// values at the cell's edges, with the cell's mass from the exact integral (piecewise-constant
+// cells would cost ~10⁻³ relative variance at 1°). At a shading point the sampler picks the
+// lobe with probability ∝ luminance(A_p)·I_p, θ_i from the lobe's table and φ from the trimmed
+// logistic around Φ_p(h) (N_p is sampled exactly, in closed form). θ_o between nodes picks the
+// lower or upper node stochastically, so the density is the exact blend of the two nodes'.
 //
-// The density is then proportional to luminance(f·cos) up to the θ_i cells' resolution and
-// the blend between nodes: far closer than the analytic sampler's, whose M_p is tilted on
-// θ_o instead of θ_i.
+// The density is then proportional to luminance(f·cos) up to the cells' resolution and the
+// blend between nodes: relative variance ~10⁻⁵ against the analytic sampler's ~10⁻² (whose
+// M_p is tilted on θ_o instead of θ_i). The blend dominates, so the defaults spend memory on
+// nodes rather than cells (bench/results/strategy_study.md, section 4a).
 #pragma once
 
 #include <cmath>
@@ -39,8 +40,8 @@ namespace hairis {
 
 /// Resolution of a NearFieldTable (chosen in docs/performance.md's resolution sweep).
 struct NearFieldTableOptions {
-    int theta_o_nodes = 61;   ///< nodes over [−π/2, π/2], ends included (3° apart)
-    int theta_i_cells = 180;  ///< equal θ_i cells over [−π/2, π/2] (1° wide)
+    int theta_o_nodes = 121;  ///< nodes over [−π/2, π/2], ends included (1.5° apart)
+    int theta_i_cells = 90;   ///< equal θ_i cells over [−π/2, π/2] (2° wide)
 };
 
 /// A sampled direction of the near-field table, with the lobe it came from.
