@@ -42,12 +42,12 @@ struct Fiber {
 };
 
 const Fiber kFibers[] = {
-    {"blonde, roughness 0.2", "melanin = 0.15\nmelanin_redness = 0.6\nroughness = 0.2\n"},
-    {"blonde, roughness 0.5", "melanin = 0.15\nmelanin_redness = 0.6\nroughness = 0.5\n"},
-    {"brunette, roughness 0.2", "melanin = 0.55\nmelanin_redness = 0.7\nroughness = 0.2\n"},
-    {"brunette, roughness 0.5", "melanin = 0.55\nmelanin_redness = 0.7\nroughness = 0.5\n"},
-    {"black, roughness 0.2", "melanin = 0.95\nmelanin_redness = 0.3\nroughness = 0.2\n"},
-    {"black, roughness 0.5", "melanin = 0.95\nmelanin_redness = 0.3\nroughness = 0.5\n"},
+    {"blonde, roughness 0.2", "parametrization = melanin\nmelanin = 0.15\nmelanin_redness = 0.6\nroughness = 0.2\n"},
+    {"blonde, roughness 0.5", "parametrization = melanin\nmelanin = 0.15\nmelanin_redness = 0.6\nroughness = 0.5\n"},
+    {"brunette, roughness 0.2", "parametrization = melanin\nmelanin = 0.55\nmelanin_redness = 0.7\nroughness = 0.2\n"},
+    {"brunette, roughness 0.5", "parametrization = melanin\nmelanin = 0.55\nmelanin_redness = 0.7\nroughness = 0.5\n"},
+    {"black, roughness 0.2", "parametrization = melanin\nmelanin = 0.95\nmelanin_redness = 0.3\nroughness = 0.2\n"},
+    {"black, roughness 0.5", "parametrization = melanin\nmelanin = 0.95\nmelanin_redness = 0.3\nroughness = 0.5\n"},
 };
 
 std::string json_list(const std::vector<double> &v) {
