@@ -1,7 +1,7 @@
 #include "hairis/bake.h"
 
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <memory>
@@ -66,11 +66,11 @@ std::vector<float> theta_r_nodes(int count) {
     return nodes;
 }
 
-Expected<TableSet> bake_tables(const FiberModel &model,
-                               const std::vector<std::pair<std::string, double>> &parameters,
-                               const BakeOptions &options, const ProgressFn &progress) {
-    if (Status s = options.validate()) return *s;
+namespace {
 
+Expected<TableSet> bake_in_arena(const FiberModel &model,
+                                 const std::vector<std::pair<std::string, double>> &parameters,
+                                 const BakeOptions &options, const ProgressFn &progress) {
     TableSet t;
     t.model = model.name();
     t.source = options.source;
@@ -90,11 +90,6 @@ Expected<TableSet> bake_tables(const FiberModel &model,
         if (!ds) return Error{"dual scattering: " + ds.error().message};
         dual = std::make_unique<DualScattering>(std::move(ds).value());
     }
-
-    std::unique_ptr<tbb::global_control> limit;
-    if (options.threads > 0)
-        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      size_t(options.threads));
 
     // One θ_r slice at a time keeps progress and cancel responsive; the work inside a slice
     // is parallel and each cell is computed alone, so the result is thread-count independent.
@@ -141,6 +136,21 @@ Expected<TableSet> bake_tables(const FiberModel &model,
     if (progress && !progress(1.0f)) return Error{"cancelled"};
     if (Status s = t.validate()) return Error{"baked tables are invalid (a bug): " + s->message};
     return t;
+}
+
+}  // namespace
+
+Expected<TableSet> bake_tables(const FiberModel &model,
+                               const std::vector<std::pair<std::string, double>> &parameters,
+                               const BakeOptions &options, const ProgressFn &progress) {
+    if (Status s = options.validate()) return *s;
+    // All the parallel work, the dual-scattering precomputation included, runs in an arena of
+    // options.threads slots (a local limit: a process-wide tbb::global_control would also
+    // throttle, or be overridden by, whatever else the host runs at the same time).
+    tbb::task_arena arena(options.threads > 0 ? options.threads : int(tbb::task_arena::automatic));
+    Expected<TableSet> result = Error{"not run"};
+    arena.execute([&] { result = bake_in_arena(model, parameters, options, progress); });
+    return result;
 }
 
 }  // namespace hairis

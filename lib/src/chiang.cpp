@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "hairis/frame.h"
@@ -106,11 +107,22 @@ double log_bessel_i0(double x) {
 
 double longitudinal_scattering(double sin_theta_i, double cos_theta_i, double sin_theta_o,
                                double cos_theta_o, double v) {
-    const double kappa = 1.0 / v;
+    return longitudinal_scattering(sin_theta_i, cos_theta_i, sin_theta_o, cos_theta_o,
+                                   longitudinal_constants(v));
+}
+
+LongitudinalConstants longitudinal_constants(double v) {
+    LongitudinalConstants c;
+    c.kappa = 1.0 / v;
     // log(csch(κ)/(2v)) = log κ − κ − log(1 − e^{−2κ}), finite for every κ > 0.
-    const double log_normalization = std::log(kappa) - kappa - std::log(-std::expm1(-2.0 * kappa));
-    const double log_value = log_normalization - kappa * sin_theta_i * sin_theta_o +
-                             log_bessel_i0(kappa * cos_theta_i * cos_theta_o);
+    c.log_normalization = std::log(c.kappa) - c.kappa - std::log(-std::expm1(-2.0 * c.kappa));
+    return c;
+}
+
+double longitudinal_scattering(double sin_theta_i, double cos_theta_i, double sin_theta_o,
+                               double cos_theta_o, const LongitudinalConstants &c) {
+    const double log_value = c.log_normalization - c.kappa * sin_theta_i * sin_theta_o +
+                             log_bessel_i0(c.kappa * cos_theta_i * cos_theta_o);
     return std::exp(log_value);
 }
 
@@ -190,6 +202,8 @@ Expected<ChiangFiber> ChiangFiber::create(const ChiangParams &p) {
     }
     fiber.sigma_ = {p.sigma_a.r, p.sigma_a.g, p.sigma_a.b};
     fiber.logistic_norm_ = 1.0 / logistic_mass(fiber.s_);
+    for (int lobe = 0; lobe < 4; ++lobe)
+        fiber.longitudinal_[std::size_t(lobe)] = chiang::longitudinal_constants(fiber.lobe_variance(lobe));
     const double panel = std::min(kFixedPanelPerScale * fiber.s_, kFixedMaxPanel);
     const int panels = int(std::ceil(kPi / panel));
     fiber.fixed_panels_ = 8 * panels <= kMaxFixedNodes ? panels : 0;
@@ -257,12 +271,12 @@ double ChiangFiber::tilted_longitudinal(int p, double sin_theta_i, double cos_th
                                         const Outgoing &o) const {
     if (p == kLobeResidual) {
         return chiang::longitudinal_scattering(sin_theta_i, cos_theta_i, o.sin_theta,
-                                               o.cos_theta, lobe_variance(p));
+                                               o.cos_theta, longitudinal_[std::size_t(p)]);
     }
     // Cycles rotates θ_i by δ_p.
     const SinCos tilted = rotate(sin_theta_i, cos_theta_i, {tilt_sin_[p], tilt_cos_[p]});
     return chiang::longitudinal_scattering(tilted.sin, tilted.cos, o.sin_theta, o.cos_theta,
-                                           lobe_variance(p));
+                                           longitudinal_[std::size_t(p)]);
 }
 
 double ChiangFiber::sampling_longitudinal(int p, double sin_theta_i, double cos_theta_i,
@@ -271,7 +285,7 @@ double ChiangFiber::sampling_longitudinal(int p, double sin_theta_i, double cos_
     // M_p the exact marginal density of the sampled sin θ_i.
     const SinCos cone = p < 3 ? o.cone[p] : SinCos{o.sin_theta, o.cos_theta};
     return chiang::longitudinal_scattering(sin_theta_i, cos_theta_i, cone.sin, cone.cos,
-                                           lobe_variance(p));
+                                           longitudinal_[std::size_t(p)]);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -497,12 +511,37 @@ struct ChiangFiber::FarSlice {
     std::vector<double> shift;   // [p·n + j]: Φ(p, γ_j) wrapped to [−π, π]
     std::vector<double> weight;  // [(p·n + j)·3 + c]: ½ w_j cos γ_j A_p(γ_j)_c
     std::array<Channels, 3> total_weight{};  // Σ_j weight, per lobe: ½∫ A_p cos γ dγ
+
+    // Memo of far_azimuthal for this slice: an open-addressing table keyed on the exact bits
+    // of (p, φ); entries of older slices are told apart by their generation.
+    struct MemoEntry {
+        std::uint64_t phi_bits = 0;
+        std::uint32_t generation = 0;  // 0: never used
+        int p = 0;
+        Channels value{};
+    };
+    // Slots in use: the first memo_slots (a power of two) of memo; the rest is storage kept
+    // from earlier slices, whose entries are all of older generations.
+    std::vector<MemoEntry> memo;
+    std::size_t memo_slots = 0;
+    std::uint32_t generation = 0;
+    std::size_t memo_count = 0;
+
+    void clear_memo() {
+        memo_count = 0;
+        memo_slots = 0;  // start small again: a small table stays in cache
+        if (++generation == 0) {  // wrapped: forget every entry for real
+            for (MemoEntry &e : memo) e.generation = 0;
+            generation = 1;
+        }
+    }
 };
 
-const ChiangFiber::FarSlice &ChiangFiber::far_slice(const Outgoing &o) const {
+ChiangFiber::FarSlice &ChiangFiber::far_slice(const Outgoing &o) const {
     thread_local FarSlice slice;
     if (slice.id == id_ && slice.sin_theta == o.sin_theta) return slice;
 
+    slice.clear_memo();
     slice.id = id_;
     slice.sin_theta = o.sin_theta;
     const int panels = fixed_panels_ > 0 ? fixed_panels_ : 6;  // the residual is smooth
@@ -556,8 +595,70 @@ static int monotone_pieces(int p, double k, double cuts[4]) {
     return 2;
 }
 
+namespace {
+
+// Memo slots: a power of two, from kMinMemoSlots for each new slice, doubled to stay at most
+// half full, up to kMaxMemoSlots (2.6 MB per thread); a full memo stops remembering (the
+// values are then computed as without it).
+constexpr std::size_t kMinMemoSlots = 512;
+constexpr std::size_t kMaxMemoSlots = std::size_t(1) << 16;
+
+std::size_t memo_hash(std::uint64_t phi_bits, int p) {
+    std::uint64_t h = (phi_bits + std::uint64_t(p + 1) * 0x9E3779B97F4A7C15ull) * 0xFF51AFD7ED558CCDull;
+    return std::size_t(h ^ (h >> 29));
+}
+
+}  // namespace
+
 std::array<double, 3> ChiangFiber::far_azimuthal(int p, const Outgoing &o, double phi) const {
-    const FarSlice &slice = far_slice(o);
+    // The far field N_p is a pure function of (fiber, θ_o, p, φ), and table sweeps ask for the
+    // same φ many times per θ_o (every θ_i and −θ_i give bit-identical φ), so the values are
+    // remembered per slice. A remembered value is exactly the value the computation returns,
+    // so results do not depend on the order of calls or on which thread makes them.
+    FarSlice &slice = far_slice(o);
+    std::uint64_t bits;
+    std::memcpy(&bits, &phi, sizeof bits);
+    using Entry = FarSlice::MemoEntry;
+    if (slice.memo_slots == 0) {
+        slice.memo_slots = kMinMemoSlots;
+        if (slice.memo.size() < kMinMemoSlots) slice.memo.resize(kMinMemoSlots);
+    }
+    std::size_t mask = slice.memo_slots - 1;
+    std::size_t index = memo_hash(bits, p) & mask;
+    while (slice.memo[index].generation == slice.generation) {
+        const Entry &e = slice.memo[index];
+        if (e.phi_bits == bits && e.p == p) return e.value;
+        index = (index + 1) & mask;
+    }
+    const Channels value = far_azimuthal_uncached(p, o, phi, slice);
+    if (2 * (slice.memo_count + 1) > slice.memo_slots) {
+        if (slice.memo_slots >= kMaxMemoSlots) return value;
+        // Grow: take this slice's entries out, double the slots in use, put them back.
+        thread_local std::vector<Entry> live;
+        live.clear();
+        for (std::size_t i = 0; i < slice.memo_slots; ++i) {
+            Entry &e = slice.memo[i];
+            if (e.generation == slice.generation) live.push_back(e);
+            e.generation = 0;
+        }
+        slice.memo_slots *= 2;
+        if (slice.memo.size() < slice.memo_slots) slice.memo.resize(slice.memo_slots);
+        mask = slice.memo_slots - 1;
+        for (const Entry &e : live) {
+            std::size_t i = memo_hash(e.phi_bits, e.p) & mask;
+            while (slice.memo[i].generation == slice.generation) i = (i + 1) & mask;
+            slice.memo[i] = e;
+        }
+        index = memo_hash(bits, p) & mask;
+        while (slice.memo[index].generation == slice.generation) index = (index + 1) & mask;
+    }
+    slice.memo[index] = Entry{bits, slice.generation, p, value};
+    ++slice.memo_count;
+    return value;
+}
+
+std::array<double, 3> ChiangFiber::far_azimuthal_uncached(int p, const Outgoing &o, double phi,
+                                                          const FarSlice &slice) const {
     if (slice.node_count == 0) return far_azimuthal_graded(p, o, phi);
     const int n = slice.node_count;
     const double *shift = slice.shift.data() + std::size_t(p * n);

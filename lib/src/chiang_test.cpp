@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <thread>
+#include <cstring>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -574,6 +577,43 @@ TEST(ChiangFarField, EqualsTheNearFieldAveragedOverH) {
                 for (int c = 0; c < 3; ++c) EXPECT_NEAR(total_far[c], total_brute[c], 1e-3 * total_brute[c]);
             }
         }
+    }
+}
+
+// The far field remembers azimuthal integrals per thread and θ_o: a remembered value must be
+// the computed one to the bit, whatever was evaluated before on the thread.
+TEST(ChiangFarField, RememberedValuesEqualFreshOnes) {
+    for (float radial : {0.3f, 0.02f}) {  // the fixed and the graded rule
+        ChiangParams p;
+        p.radial_roughness = radial;
+        const ChiangFiber fiber = make_fiber(p);
+        const Vec3 wo = direction(0.4, kCyclesPhiO), other_wo = direction(-0.7, kCyclesPhiO);
+        std::vector<Vec3> wis;
+        for (int i = 0; i < 9; ++i)
+            for (int j = 0; j < 11; ++j) {
+                const double theta = -1.4 + 2.8 * i / 8, phi = kCyclesPhiO - kPi + kTwoPi * (j + 0.3) / 11;
+                wis.push_back(direction_of(float(theta), float(phi)));
+                wis.push_back(direction_of(float(-theta), float(phi)));  // the same azimuth to the bit
+            }
+        auto same = [](Rgb a, Rgb b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+        // Each value once in a fresh thread (nothing remembered), lobe by lobe and summed.
+        std::vector<std::array<Rgb, 5>> fresh(wis.size());
+        for (std::size_t n = 0; n < wis.size(); ++n) {
+            std::thread([&] {
+                for (int q = 0; q < 4; ++q) fresh[n][std::size_t(q)] = fiber.lobe_f_cos(q, wis[n], wo);
+            }).join();
+            std::thread([&] { fresh[n][4] = fiber.f_cos(wis[n], wo); }).join();
+        }
+        // Then all of them on one thread, twice, backwards, with another θ_o in between.
+        std::thread([&] {
+            for (int pass = 0; pass < 2; ++pass) {
+                for (std::size_t m = wis.size(); m-- > 0;) {
+                    for (int q = 0; q < 4; ++q) EXPECT_TRUE(same(fresh[m][std::size_t(q)], fiber.lobe_f_cos(q, wis[m], wo)));
+                    EXPECT_TRUE(same(fresh[m][4], fiber.f_cos(wis[m], wo)));
+                    if (m % 17 == 0) (void)fiber.f_cos(wis[m], other_wo);
+                }
+            }
+        }).join();
     }
 }
 

@@ -50,9 +50,16 @@ Grid2D make_grid(const DirectGridSpec &spec, const Eval &eval) {
     const GaussLegendre gl = GaussLegendre::rule(spec.quadrature_points);
     const double dth = kPi / spec.theta_count, dph = kTwoPi / spec.phi_count;
     const std::size_t q = gl.nodes.size();
-    tbb::parallel_for(tbb::blocked_range<int>(0, spec.theta_count), [&](const tbb::blocked_range<int> &rows) {
+    // Rows i and n − 1 − i (θ_i and −θ_i, whose ω_i have the same azimuth to the bit) are
+    // computed by the same task, one after the other, so that a model remembering values per
+    // θ_o (ChiangFiber) finds the second row's azimuthal factors. Each cell is still computed
+    // alone by the same expression: the numbers do not depend on the pairing or the threads.
+    const int n = spec.theta_count;
+    tbb::parallel_for(tbb::blocked_range<int>(0, (n + 1) / 2), [&](const tbb::blocked_range<int> &pairs) {
         std::vector<double> th(q), wth(q);
-        for (int i = rows.begin(); i != rows.end(); ++i) {
+        for (int r = pairs.begin(); r != pairs.end(); ++r)
+        for (int side = 0; side < (2 * r + 1 == n ? 1 : 2); ++side) {  // the middle row once
+            const int i = side == 0 ? r : n - 1 - r;
             const double lo = g.theta_lo(i);
             for (std::size_t a = 0; a < q; ++a) {
                 th[a] = lo + 0.5 * dth * (1.0 + gl.nodes[a]);

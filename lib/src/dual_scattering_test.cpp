@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include <tbb/task_arena.h>
@@ -388,6 +389,43 @@ TEST(DualScattering, TablesAreIdenticalForOneAndTwoThreads) {
             EXPECT_EQ(one.forward_attenuation(t)[ch], two.forward_attenuation(t)[ch]);
             EXPECT_EQ(one.backscatter_width(t)[ch], two.backscatter_width(t)[ch]);
             for (int p = 0; p < 3; ++p) EXPECT_EQ(one.lobe_forward_azimuthal(p, t)[ch], two.lobe_forward_azimuthal(p, t)[ch]);
+        }
+    }
+}
+
+// The same with a real model, whose far field remembers values per thread (ChiangFiber):
+// every table entry, compared bit for bit, at table nodes and between them.
+TEST(DualScattering, ChiangTablesAreIdenticalForOneAndTwoThreads) {
+    const ChiangFiber fiber = ChiangFiber::create(ChiangParams{}).value();
+    DualScatteringParams params;  // coarse, to stay quick
+    params.theta_count = 12;
+    params.theta_panels = 8;
+    params.phi_panels = 3;
+    auto build = [&](int threads) {
+        tbb::task_arena arena(threads);
+        Expected<DualScattering> out = Error{""};
+        arena.execute([&] { out = DualScattering::create(fiber, params); });
+        return std::move(out).value();
+    };
+    const DualScattering one = build(1), two = build(2), again = build(2);
+    auto same = [](Rgb a, Rgb b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    for (int k = 0; 2 * k + 1 < 2 * one.theta_count(); ++k) {
+        const double t = -kHalfPi + (k + 0.5) * kPi / (2 * one.theta_count());  // nodes and midpoints
+        for (const DualScattering *other : {&two, &again}) {
+            EXPECT_TRUE(same(one.forward_attenuation(t), other->forward_attenuation(t))) << k;
+            EXPECT_TRUE(same(one.backward_attenuation(t), other->backward_attenuation(t))) << k;
+            EXPECT_TRUE(same(one.forward_shift(t), other->forward_shift(t))) << k;
+            EXPECT_TRUE(same(one.forward_width(t), other->forward_width(t))) << k;
+            EXPECT_TRUE(same(one.backscatter_attenuation(t), other->backscatter_attenuation(t))) << k;
+            EXPECT_TRUE(same(one.backscatter_shift(t), other->backscatter_shift(t))) << k;
+            EXPECT_TRUE(same(one.backscatter_width(t), other->backscatter_width(t))) << k;
+            for (int p = 0; p < one.lobe_count(); ++p) {
+                EXPECT_TRUE(same(one.lobe_forward_attenuation(p, t), other->lobe_forward_attenuation(p, t)));
+                EXPECT_TRUE(same(one.lobe_backward_attenuation(p, t), other->lobe_backward_attenuation(p, t)));
+                EXPECT_TRUE(same(one.lobe_forward_azimuthal(p, t), other->lobe_forward_azimuthal(p, t)));
+            }
+            for (int n_h : {0, 1, 4})
+                EXPECT_TRUE(same(one.multiple_f_cos(float(t), 0.3f, n_h), other->multiple_f_cos(float(t), 0.3f, n_h)));
         }
     }
 }

@@ -38,6 +38,15 @@
 
 namespace hairis {
 
+namespace chiang {
+/// The parts of d'Eon's longitudinal function that depend on the variance v only: κ = 1/v and
+/// log(csch(κ)/(2v)) (see chiang::longitudinal_scattering).
+struct LongitudinalConstants {
+    double kappa = 1;
+    double log_normalization = 0;
+};
+}  // namespace chiang
+
 /// Parameters in Cycles' internal form (the PrincipledHairBSDF closure before its setup).
 struct ChiangParams {
     /// Absorption coefficient per unit fiber radius (Cycles' bsdf->sigma), each channel >= 0.
@@ -77,8 +86,10 @@ class ChiangFiber final : public FiberModel {
     /// Far field: (1/2)∫_{−1}^{1} lobe_f_cos_near(p, wi, wo, h) dh, by deterministic
     /// quadrature over γ_o with h = sin γ_o (relative accuracy ~1e-5). Zero for p outside
     /// [0, 3]. The part that depends on ω_o only is remembered per thread for the last θ_o,
-    /// so sweeping many ω_i for one ω_o is fast (about 5 µs per f_cos at the defaults).
-    /// Thread-safe.
+    /// so sweeping many ω_i for one ω_o is fast (about 5 µs per f_cos at the defaults), and
+    /// so are the azimuthal integrals already computed for that θ_o (keyed on the exact bits
+    /// of φ; a table sweep meets each φ at least twice, at θ_i and −θ_i). Remembered values
+    /// are bit-identical to recomputed ones. Thread-safe.
     Rgb lobe_f_cos(int p, Vec3 wi, Vec3 wo) const override;
     /// Far field summed over the four lobes (shares the per-ω_o work between lobes).
     Rgb f_cos(Vec3 wi, Vec3 wo) const override;
@@ -145,8 +156,10 @@ class ChiangFiber final : public FiberModel {
                                const Outgoing &o) const;
     double sampling_longitudinal(int p, double sin_theta_i, double cos_theta_i,
                                  const Outgoing &o) const;
-    const FarSlice &far_slice(const Outgoing &o) const;
+    FarSlice &far_slice(const Outgoing &o) const;
     std::array<double, 3> far_azimuthal(int p, const Outgoing &o, double phi) const;
+    std::array<double, 3> far_azimuthal_uncached(int p, const Outgoing &o, double phi,
+                                                 const FarSlice &slice) const;
     std::array<double, 3> far_azimuthal_graded(int p, const Outgoing &o, double phi) const;
     std::array<double, 3> fixed_panel(int p, const FarSlice &slice, double phi, int panel) const;
     std::array<double, 3> exact_panel(int p, const Outgoing &o, double phi, double a,
@@ -161,6 +174,7 @@ class ChiangFiber final : public FiberModel {
     std::array<double, 3> tilt_sin_{}, tilt_cos_{1, 1, 1};  // of δ_p = (2α, −α, −4α)
     std::array<double, 3> sigma_{};
     double logistic_norm_ = 1;  // 1 / ∫_{−π}^{π} logistic
+    std::array<chiang::LongitudinalConstants, 4> longitudinal_{};  // of lobe_variance(p)
     int fixed_panels_ = 0;      // far field: γ panels of the fixed rule, 0 = graded rule
     std::uint64_t id_ = 0;      // identifies these parameters in per-thread caches
 };
@@ -184,6 +198,12 @@ double log_bessel_i0(double x);
 /// that tiny v neither overflows nor produces NaN. Cosines must be >= 0.
 double longitudinal_scattering(double sin_theta_i, double cos_theta_i, double sin_theta_o,
                                double cos_theta_o, double v);
+/// The parts of longitudinal_scattering that depend on v only (see LongitudinalConstants).
+LongitudinalConstants longitudinal_constants(double v);
+/// longitudinal_scattering with longitudinal_constants(v) computed beforehand (the same
+/// numbers, bit for bit).
+double longitudinal_scattering(double sin_theta_i, double cos_theta_i, double sin_theta_o,
+                               double cos_theta_o, const LongitudinalConstants &constants);
 
 /// Inverts the CDF of the cosine t of the angle to the cone axis, p(t) ∝ exp(t/v) on
 /// [−1, 1] (d'Eon's sampling): t = 1 + v·log(u + (1 − u)·exp(−2/v)).
