@@ -530,7 +530,7 @@ class Library:
         pointer = self.raw.hairis_tables_load_memory(buffer, len(data))
         return Tables(self, self._handle("hairis_tables_load_memory", pointer))
 
-    def sampler(self, strategy, fiber=None, tables=None, multiple_weight=0.25, n_h=2):
+    def sampler(self, strategy, fiber=None, tables=None, multiple_weight=0.0, n_h=2):
         """A direction sampler; ``strategy`` is a name ('TABLE', ...) or a hairis_strategy."""
         if isinstance(strategy, str):
             strategy = STRATEGIES[strategy]

@@ -35,8 +35,9 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     multiple_weight: FloatProperty(
         name="Multiple Weight",
         description="One-sample mixture weight of the multiple-scattering distribution "
-                    "(Table and Gaussian strategies)",
-        default=0.25, min=0.0, max=1.0, subtype="FACTOR")
+                    "(Table and Gaussian strategies). 0 is best for Table in a path tracer "
+                    "(bench/results/mixture_weight.md); Gaussian needs about 0.25",
+        default=0.0, min=0.0, max=1.0, subtype="FACTOR")
     n_h: EnumProperty(
         name="Strands (n_h)",
         description="Number of strands light crosses in the multiple-scattering distribution",

@@ -42,7 +42,7 @@ def test_engine_and_properties_registered():
     scene.render.engine = "HAIRIS"
     settings = scene.hairis
     assert settings.samples == 64 and settings.max_bounces == 12
-    assert settings.strategy == "TABLE" and abs(settings.multiple_weight - 0.25) < 1e-7
+    assert settings.strategy == "TABLE" and settings.multiple_weight == 0.0
     assert settings.n_h == "2" and settings.n_h_value == 2
     assert settings.seed == 0 and settings.threads == 0 and settings.auto_bake is True
     assert [item.identifier for item in

@@ -256,7 +256,7 @@ static void test_defaults(void)
     CHECK_NO_ERROR();
     CHECK(r.samples == 64 && r.max_bounces == 12 && r.strategy == HAIRIS_STRATEGY_TABLE,
           "samples %d bounces %d strategy %d", r.samples, r.max_bounces, r.strategy);
-    CHECK(fabsf(r.multiple_weight - 0.25f) < 1e-6f && r.n_h == 2 && r.seed == 0 &&
+    CHECK(r.multiple_weight == 0.0f && r.n_h == 2 && r.seed == 0 &&
               r.threads == 0,
           "weight %g n_h %d", r.multiple_weight, r.n_h);
 

@@ -285,7 +285,7 @@ HAIRIS_API int hairis_scene_add_area_light(hairis_scene *scene, const float ligh
 HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const float color[3], float strength);
 /** The camera. */
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const hairis_camera *camera);
-/** Fills `settings` with defaults: the add-on's (64 samples, 12 bounces, TABLE, weight 0.25,
+/** Fills `settings` with defaults: the add-on's (64 samples, 12 bounces, TABLE, weight 0,
  * n_h 2, seed 0, all threads). */
 HAIRIS_API void hairis_render_settings_defaults(hairis_render_settings *settings);
 /**

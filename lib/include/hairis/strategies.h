@@ -76,7 +76,9 @@ struct StrategyInputs {
     std::shared_ptr<const ChiangFiber> chiang;
     const SamplingTables *tables = nullptr;
     SeedPdfParams seed;
-    float multiple_weight = 0.25f;
+    /// 0: in a path tracer the multiple-scattering part only adds variance
+    /// (bench/results/mixture_weight.md).
+    float multiple_weight = 0.0f;
     int n_h = 2;
     /// A near-field table to share between samplers (TABLE with a Chiang fiber).
     std::shared_ptr<const NearFieldTable> near_field;
