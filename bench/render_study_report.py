@@ -218,9 +218,19 @@ def markdown(results):
         "scatter; for an estimator with rare, very large samples (UNIFORM: uniform "
         "directions that happen to land in a sharply peaked lobe) the few renders miss most "
         "of them, so both the mean and the SE come out low: a heavy-tailed estimator shows a "
-        "negative \"bias\" whose size shrinks as the sample count grows (a real bias would "
-        "stay the same fraction while its z grows), and an RMSE that does not fall as "
-        "1/sqrt(spp) yet.", ""]
+        "negative \"bias\" whose size shrinks as the sample count grows, and an RMSE that "
+        "does not fall as 1/sqrt(spp) yet; a real bias would stay the same fraction while "
+        "its z grows. UNIFORM's deficit shrinks from 4 to 256 spp, but the follow-up below "
+        "(when present) says whether it levels off: if UNIFORM still falls short at many "
+        "more samples with 4 bounces while it agrees with ANALYTIC at 1 bounce, either the "
+        "tail of products of uniform weights over several hair bounces is heavier still, or "
+        "multi-bounce paths are biased under UNIFORM; neither is settled here.", ""]
+    for check in results.get("extra_checks", []):
+        lines.append("- Follow-up (bench/render_study_uniform_check.py): %s: %s (%s s)." % (
+            check["what"], fmt_percent(check["relative_difference"]),
+            ", ".join("%.0f" % v for v in np.atleast_1d(check["seconds"]))))
+    if results.get("extra_checks"):
+        lines.append("")
     return "\n".join(lines)
 
 
