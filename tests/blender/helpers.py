@@ -252,6 +252,109 @@ def make_test_scene(children=None, with_curves=True):
     return scene
 
 
+# ---- Hairis against Cycles -------------------------------------------------------------------
+
+def make_diffuse_material(name, color):
+    """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    for node in list(tree.nodes):
+        if node.type != "OUTPUT_MATERIAL":
+            tree.nodes.remove(node)
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = color
+    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
+    tree.links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
+    return material
+
+
+def match_cycles(scene, samples, bounces):
+    """Cycles settings under which its image is comparable with Hairis' (see the README)."""
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = samples
+    cycles.use_adaptive_sampling = False
+    cycles.use_denoising = False
+    for name in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                 "transparent_max_bounces"):
+        setattr(cycles, name, bounces)
+    cycles.volume_bounces = 0
+    cycles.blur_glossy = 0.0
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.light_sampling_threshold = 0.0
+    cycles.pixel_filter_type = "BOX"
+    cycles.filter_width = 1.0
+    scene.cycles_curves.shape = "THICK"
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+
+
+def set_samples(scene, samples):
+    """The same sample count for Cycles and Hairis."""
+    scene.cycles.samples = samples
+    scene.hairis.samples = samples
+
+
+def make_compare_scene(samples, bounces, strategy, resolution=(64, 48)):
+    """The Hairis-against-Cycles scene: particle hair, Curves, a diffuse sphere, three kinds
+    of light and a world colour, with both engines set up alike (``match_cycles``)."""
+    scene = reset()
+    make_camera(scene, location=(0.0, -3.2, 0.0), resolution=resolution, percentage=100)
+    make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+    hair = make_hair_material("Hair", "MELANIN", **{
+        "Melanin": 0.3, "Melanin Redness": 0.7, "Roughness": 0.3, "Radial Roughness": 0.4,
+        "Coat": 0.1, "IOR": 1.55})
+    dyed = make_hair_material("Dyed", "COLOR", **{
+        "Color": (0.2, 0.5, 0.8, 1.0), "Roughness": 0.45})
+    skin = make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0), scale=1.4)
+    make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
+                       hair_material=hair, skin_material=skin)
+    make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
+               rotation=(0.6, 0.3, 0.0))
+    make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
+               shadow_soft_size=0.2)
+    make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
+               shape="RECTANGLE", size=0.6, size_y=0.3,
+               rotation=(math.radians(60), 0.0, math.radians(-40)))
+    match_cycles(scene, samples, bounces)
+    settings = scene.hairis
+    settings.samples = samples
+    settings.max_bounces = bounces
+    settings.strategy = strategy
+    settings.auto_bake = True
+    settings.threads = 0
+    bpy.context.view_layer.update()
+    return scene
+
+
+def render_pixels(scene, engine, seed, workdir, name=None):
+    """Renders with ``engine``; returns (linear RGB float64 array (height, width, 3), seconds).
+
+    The seconds are the wall time of ``bpy.ops.render.render()`` alone; the image is read
+    back from a 32-bit EXR written to ``workdir``.
+    """
+    scene.render.engine = engine
+    scene.cycles.seed = seed
+    scene.hairis.seed = seed
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    path = os.path.join(workdir, (name or "%s_%d" % (engine.lower(), seed)) + ".exr")
+    start = time.monotonic()
+    bpy.ops.render.render()
+    seconds = time.monotonic() - start
+    bpy.data.images["Render Result"].save_render(path, scene=scene)
+    image = bpy.data.images.load(path)
+    width, height = image.size
+    pixels = np.empty(width * height * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    os.remove(path)
+    return pixels.reshape(height, width, 4)[..., :3].astype(np.float64), seconds
+
+
 # ---- UI stubs --------------------------------------------------------------------------------
 
 class RecordingLayout:

@@ -18,7 +18,6 @@ converge to the same image. The test asserts
 import math
 import os
 import sys
-import time
 
 import bpy
 import numpy as np
@@ -37,94 +36,14 @@ BLOCK = 4
 STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
 
 
-def make_diffuse_material(name, color):
-    """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
-    material = bpy.data.materials.new(name)
-    material.use_nodes = True
-    tree = material.node_tree
-    for node in list(tree.nodes):
-        if node.type != "OUTPUT_MATERIAL":
-            tree.nodes.remove(node)
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = color
-    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
-    tree.links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
-    return material
-
-
-def match_cycles(scene, samples, bounces):
-    """Cycles settings under which its image is comparable with Hairis' (see the README)."""
-    cycles = scene.cycles
-    cycles.device = "CPU"
-    cycles.samples = samples
-    cycles.use_adaptive_sampling = False
-    cycles.use_denoising = False
-    for name in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
-                 "transparent_max_bounces"):
-        setattr(cycles, name, bounces)
-    cycles.volume_bounces = 0
-    cycles.blur_glossy = 0.0
-    cycles.sample_clamp_direct = 0.0
-    cycles.sample_clamp_indirect = 0.0
-    cycles.light_sampling_threshold = 0.0
-    cycles.pixel_filter_type = "BOX"
-    cycles.filter_width = 1.0
-    scene.cycles_curves.shape = "THICK"
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-
-
 def make_scene():
-    """Particle hair, Curves, a diffuse sphere, three kinds of light and a world colour."""
-    scene = helpers.reset()
-    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(64, 48), percentage=100)
-    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
-    hair = helpers.make_hair_material("Hair", "MELANIN", **{
-        "Melanin": 0.3, "Melanin Redness": 0.7, "Roughness": 0.3, "Radial Roughness": 0.4,
-        "Coat": 0.1, "IOR": 1.55})
-    dyed = helpers.make_hair_material("Dyed", "COLOR", **{
-        "Color": (0.2, 0.5, 0.8, 1.0), "Roughness": 0.45})
-    skin = make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    helpers.make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0),
-                        scale=1.4)
-    helpers.make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
-                               hair_material=hair, skin_material=skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
-                       rotation=(0.6, 0.3, 0.0))
-    helpers.make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
-                       shadow_soft_size=0.2)
-    helpers.make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
-                       shape="RECTANGLE", size=0.6, size_y=0.3,
-                       rotation=(math.radians(60), 0.0, math.radians(-40)))
-    match_cycles(scene, SAMPLES, BOUNCES)
-    settings = scene.hairis
-    settings.samples = SAMPLES
-    settings.max_bounces = BOUNCES
-    settings.strategy = STRATEGY
-    settings.auto_bake = True
-    settings.threads = 0
-    bpy.context.view_layer.update()
-    return scene
+    """The comparison scene of helpers.make_compare_scene at SAMPLES samples."""
+    return helpers.make_compare_scene(SAMPLES, BOUNCES, STRATEGY)
 
 
 def render(scene, engine, seed):
-    """Renders with ``engine`` and returns (linear RGB array, seconds) read back from EXR."""
-    scene.render.engine = engine
-    scene.cycles.seed = seed
-    scene.hairis.seed = seed
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    path = os.path.join(ARGS.workdir, "%s_%d.exr" % (engine.lower(), seed))
-    start = time.monotonic()
-    bpy.ops.render.render()
-    seconds = time.monotonic() - start
-    bpy.data.images["Render Result"].save_render(path, scene=scene)
-    image = bpy.data.images.load(path)
-    width, height = image.size
-    pixels = np.empty(width * height * 4, np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)[..., :3].astype(np.float64), seconds
+    """Renders with ``engine``; returns (linear RGB array, seconds)."""
+    return helpers.render_pixels(scene, engine, seed, ARGS.workdir)
 
 
 def downsample(images, factor):
