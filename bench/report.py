@@ -158,11 +158,16 @@ def write_summary(folder, rows, study, export, render):
         bake = find(rows, "bake_default_tables/2")
         if bake:
             add("default bake ≤ 2 s on 2 cores", "%.2f s" % (bake[2] / 1e9), bake[2] / 1e9 <= 2.0)
-    if render and "equal_time" in render:
-        for entry in render["equal_time"]:
-            if entry.get("best"):
-                add("equal time: Hairis' best strategy RMSE ≤ Cycles' (%s)" % entry.get("label", ""),
-                    "%.3f×" % entry["ratio"], entry["ratio"] <= 1.0)
+    equal = (render or {}).get("summary", {}).get("equal_time")
+    if equal:
+        # Hairis' best strategy at each of Cycles' render times.
+        for k, cycles in enumerate(next(iter(equal.values()))):
+            best = min(((name, rows[k]) for name, rows in equal.items()), key=lambda e: e[1]["ratio"])
+            add("equal time (%.1f s, Cycles at %d spp): Hairis' best RMSE ≤ Cycles'"
+                % (cycles["seconds"], cycles["cycles_spp"]),
+                "%s: %.2f× Cycles' RMSE%s" % (best[0], best[1]["ratio"],
+                                              " (extrapolated)" if best[1]["extrapolated"] else ""),
+                best[1]["ratio"] <= 1.0)
     if export:
         big = [r for r in export.get("runs", []) if r.get("strands", 0) >= 1000000]
         if big:

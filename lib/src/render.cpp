@@ -29,6 +29,8 @@ namespace {
 // Random-number dimensions: 2 for the pixel jitter, then a fixed block per path vertex.
 constexpr std::uint32_t kDimJitterU = 0, kDimJitterV = 1;
 constexpr std::uint32_t kDimFirstVertex = 2;
+// SobolSampleRng stratifies dimensions 2k and 2k + 1 together, so the layout keeps the pairs
+// that belong together: jitter (0, 1), light position (4, 5), BSDF φ and θ (6, 7) per vertex.
 constexpr std::uint32_t kDimsPerVertex = 8;
 enum VertexDim : std::uint32_t {
     kDimRoulette = 0,
@@ -136,7 +138,9 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     const Camera &camera = scene.camera();
     const LightSet &lights = scene.lights();
     const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x);
-    const SampleRng rng(settings.seed, pixel, sample);
+    // Stratified per pixel (jitter, light and BSDF pairs): hair is thinner than a pixel, and
+    // stratifying where a sample lands in the pixel is what Cycles' Sobol patterns buy it.
+    const SobolSampleRng rng(settings.seed, pixel, sample);
 
     const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
     Vec3 origin = cr.origin, dir = cr.direction;
