@@ -209,7 +209,7 @@ TEST(LightSet, HitsAgreeWithSamples) {
     ellipse.light_to_world = Mat4::translation({-1, 0.5f, 3});
     const std::vector<LightSet> sets = {
         build({sun}, {}, {}), build({}, {{Vec3{1, 1, 2}, Rgb(1.0f), 30.0f, 0.3f}}, {}),
-        build({}, {}, {rect}), build({}, {}, {ellipse}), build({}, {}, {}, {Rgb(0.2f), 1.0f})};
+        build({}, {}, {rect}), build({}, {}, {ellipse})};
     for (std::size_t k = 0; k < sets.size(); ++k) {
         const LightSet &set = sets[k];
         int checked = 0;
@@ -236,17 +236,19 @@ TEST(LightSet, HitsAgreeWithSamples) {
     }
 }
 
-TEST(LightSet, WorldIsSampledUniformly) {
+TEST(LightSet, ConstantWorldIsFoundByBsdfSamplingOnly) {
+    // As in Cycles 3.4: a constant world is not a light to sample, and escaping rays get its
+    // radiance at full weight, with or without MIS.
     const LightSet set = build({}, {}, {}, {Rgb(0.5f), 2.0f});
-    EXPECT_EQ(set.lamp_count(), 1);
-    const auto s = set.sample({0, 0, 0}, 0.3f, 0.7f, 0.1f);
-    ASSERT_TRUE(s.has_value());
-    EXPECT_FLOAT_EQ(s->pdf, float(kInvFourPi));
-    EXPECT_FLOAT_EQ(s->value.g, 1.0f);
-    // Irradiance of a uniform sky on a plane: π L.
-    const auto [e, se] = irradiance(set, {0, 0, 0}, {0, 0, 1}, 40000);
-    EXPECT_NEAR(e, kPi * 1.0, 4.0 * se);
+    EXPECT_EQ(set.lamp_count(), 0);
+    EXPECT_TRUE(set.empty());
+    EXPECT_FALSE(set.sample({0, 0, 0}, 0.3f, 0.7f, 0.1f).has_value());
     EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.0f, false).b, 1.0f);
+    EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.3f, true).g, 1.0f);
+    EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.3f, true, false).g, 0.0f);
+    // With a sun, the world does not dilute the sun's selection probability.
+    const LightSet with_sun = build({SunLight{}}, {}, {}, {Rgb(0.5f), 2.0f});
+    EXPECT_FLOAT_EQ(with_sun.lamp_selection_probability(), 1.0f);
 }
 
 TEST(LightSet, SelectionFollowsCycles) {

@@ -38,9 +38,9 @@
 // device_update_distribution): emissive triangles as a group get probability 1/2 when there
 // are also lamps (sun, point, area, and here the world), otherwise all of it; a triangle
 // within the group is chosen in proportion to its area; lamps share the rest uniformly (not by
-// power). Cycles 3.4 does not sample a constant world as a light at all (it disables the
-// background light when the world shader is not spatially varying); hairis samples it
-// uniformly over the sphere so that it gets MIS too. Both give the same expected image.
+// power). Like Cycles 3.4, which disables the background light when the world shader is not
+// spatially varying, hairis does not sample a constant world as a light: paths find it by BSDF
+// sampling alone, at full weight.
 #pragma once
 
 #include <cstdint>
@@ -199,7 +199,7 @@ class LightSet {
     std::size_t memory_bytes() const;
 
   private:
-    enum class LampType : std::uint8_t { Point, Area, Sun, World };
+    enum class LampType : std::uint8_t { Point, Area, Sun };
     struct Lamp {
         LampType type = LampType::Point;
         Rgb value;          // point: radiance (r > 0) or intensity (r = 0); area: radiance;
