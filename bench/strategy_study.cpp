@@ -155,7 +155,7 @@ int main(int argc, char **argv) {
     out.json << "{\n";
     print(out, "# Strategy study\n\n%lld samples per θ_r; relative variance per sample of the luminance estimate of ∫ f cos dω_i "
                "(lower is better), conditional on the offset h and averaged over h ∈ {±0.95, ±0.6, ±0.2}; θ_r ∈ {−80, −60, −30, 0, 30, 60, 80}°. Default tables (31×64×64, "
-               "n_h 1..16), near-field table 61 θ_o nodes × 180 θ_i cells, mixture weight w = 0.25 at n_h = 2.\n\n", n);
+               "n_h 1..16), near-field table 121 θ_o nodes × 90 θ_i cells; the mixture variants use w = 0.25 at n_h = 2.\n\n", n);
 
     // ---- 1. Near field, six fibers --------------------------------------------------------
     const bench::StudySetup cycles_default = bench::make_setup();
