@@ -4,6 +4,7 @@
 #include <OpenImageIO/hash.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -182,6 +183,11 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
                                check::count_in_range("theta_i_count", t.theta_i_count, 2, kMaxGridAxis),
                                check::count_in_range("phi_count", t.phi_count, 1, kMaxGridAxis)))
         return file_error(s->message);
+    // Checked before anything is allocated: the header alone can claim any size.
+    const long long cells = (long long)theta_r_count * t.theta_i_count * t.phi_count;
+    if (cells > kMaxTableCells)
+        return file_error("table has " + std::to_string(cells) + " cells; at most " +
+                          std::to_string(kMaxTableCells) + " are allowed");
     if (spec.width != t.phi_count || spec.height != theta_r_count * t.theta_i_count || spec.depth != 1 ||
         spec.x != 0 || spec.y != 0)
         return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
@@ -219,14 +225,25 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
         t.parameters.emplace_back(item.substr(0, eq), v);
     }
 
+    // Read in bands of rows, so memory grows with the data the file really holds: a small file
+    // whose header claims a large table fails at its first missing scanline instead of after
+    // allocating the whole table.
     const size_t width = size_t(spec.width), height = size_t(spec.height);
-    std::vector<float> px(width * height * kChannels);
-    if (!in->read_image(0, 0, 0, kChannels, TypeDesc::FLOAT, px.data()))
-        return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+    constexpr size_t kBandRows = 64;
+    std::vector<float> px, band;
+    OIIO::SHA1 hash;
+    for (size_t y = 0; y < height; y += kBandRows) {
+        const size_t rows = std::min(kBandRows, height - y);
+        band.resize(rows * width * kChannels);
+        if (!in->read_scanlines(0, 0, int(y), int(y + rows), 0, 0, kChannels, TypeDesc::FLOAT, band.data()))
+            return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+        hash.append(band.data(), band.size() * sizeof(float));
+        px.insert(px.end(), band.begin(), band.end());
+    }
     in->close();
 
     const std::string sha = spec.get_string_attribute("hairis:pixel_sha1");
-    if (sha != sha1_of(px))
+    if (sha != hash.digest())
         return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
 
     const int bands = int(t.n_h_values.size());
