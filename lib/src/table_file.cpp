@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -55,6 +57,60 @@ std::vector<float> pixels_of(const TableSet &t) {
 }
 
 Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+
+// A first look at the EXR header, before OpenEXR reads it: OpenEXR allocates what an
+// attribute's size field or the data window claims (a string attribute of 1.7 GB in a 2 KB
+// buffer, a window of 2^31 rows whose offset table it allocates) before finding the data
+// missing. Table files are single-part scanline images whose attributes lie inside the
+// buffer and whose window fits the table limits; anything else is refused here.
+Status check_exr_header(const unsigned char *data, size_t size) {
+    auto read_int = [&](size_t at) {
+        int32_t v = 0;
+        for (int b = 3; b >= 0; --b) v = int32_t(uint32_t(v) << 8 | data[at + size_t(b)]);
+        return v;
+    };
+    if (size < 8 || data[0] != 0x76 || data[1] != 0x2f || data[2] != 0x31 || data[3] != 0x01)
+        return file_error("not a readable OpenEXR file (no OpenEXR magic number)");
+    const uint32_t flags = uint32_t(read_int(4)) & ~0xffu;
+    constexpr uint32_t kLongNames = 0x400, kNonImage = 0x800, kMultiPart = 0x1000;
+    if (flags & (kNonImage | kMultiPart))
+        return file_error("a multi-part or deep OpenEXR file is not a table file");
+    const size_t max_name = flags & kLongNames ? 255 : 31;
+    size_t at = 8;
+    auto read_name = [&](std::string &name) -> Status {
+        const void *end = std::memchr(data + at, 0, std::min(size - at, max_name + 1));
+        if (!end) return file_error("the OpenEXR header is truncated or corrupt (attribute name)");
+        name.assign(reinterpret_cast<const char *>(data + at), size_t(static_cast<const unsigned char *>(end) - (data + at)));
+        at += name.size() + 1;
+        return std::nullopt;
+    };
+    std::string name, type;
+    while (true) {
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(name)) return s;
+        if (name.empty()) break;  // the end of the header
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(type)) return s;
+        if (size - at < 4) return file_error("the OpenEXR header is truncated");
+        const int32_t length = read_int(at);
+        at += 4;
+        if (length < 0 || size_t(length) > size - at)
+            return file_error("OpenEXR attribute \"" + name + "\" claims " + std::to_string(length) +
+                              " bytes; the data holds " + std::to_string(size - at));
+        if (name == "dataWindow") {
+            if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
+            const long long width = (long long)read_int(at + 8) - read_int(at) + 1;
+            const long long height = (long long)read_int(at + 12) - read_int(at + 4) + 1;
+            if (width < 1 || height < 1 || width > kMaxGridAxis ||
+                height > (long long)kMaxThetaRCount * kMaxGridAxis || width * height > kMaxTableCells)
+                return file_error("the image is " + std::to_string(width) + "x" + std::to_string(height) +
+                                  " pixels; a table has at most " + std::to_string(kMaxGridAxis) +
+                                  " columns and " + std::to_string(kMaxTableCells) + " pixels");
+        }
+        at += size_t(length);
+    }
+    return std::nullopt;
+}
 
 }  // namespace
 
@@ -150,6 +206,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
 
 Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
+    if (Status s = check_exr_header(static_cast<const unsigned char *>(data), size)) return *s;
     OIIO::Filesystem::IOMemReader proxy(data, size);
     auto in = OIIO::ImageInput::create("openexr");
     if (!in) return file_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
