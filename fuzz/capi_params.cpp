@@ -17,6 +17,12 @@
 #include "fuzz_input.h"
 #include "hairis/hairis.h"
 
+// c_calls.c: hairis_sampler_create with any int as its strategy, as a C caller may pass
+// (in C++ an int outside the enum's range cannot be converted to the enum type).
+extern "C" hairis_sampler *hairis_fuzz_sampler_create(int strategy, const hairis_fiber *fiber,
+                                                      const hairis_tables *tables,
+                                                      float multiple_weight, int n_h);
+
 namespace {
 
 using hairis::fuzz::check_last_error;
@@ -95,14 +101,12 @@ void bake(State &st, FuzzInput &in) {
 }
 
 void sample(State &st, FuzzInput &in) {
-    // Any int, as a C caller may pass: copied in, since converting an int outside the enum's
-    // range to the enum type is undefined in C++.
-    const hairis_strategy strategy = in.take<hairis_strategy>();
+    const int strategy = in.take<int>();
     hairis_fiber *fiber = State::pick(st.fibers, in.take<uint8_t>());
     hairis_tables *tables = State::pick(st.tables, in.take<uint8_t>());
     const float weight = in.take<float>();
     const int n_h = in.take<int>();
-    keep(st.samplers, hairis_sampler_create(strategy, fiber, tables, weight, n_h),
+    keep(st.samplers, hairis_fuzz_sampler_create(strategy, fiber, tables, weight, n_h),
          "hairis_sampler_create");
     hairis_sampler *sampler = State::pick(st.samplers, in.take<uint8_t>());
     const size_t n = in.count(4);

@@ -58,13 +58,17 @@ inline void check_not_internal(int status, const char *call) {
     }
 }
 
-/// The same for calls that return NULL or -1 on failure: an internal error is a finding.
+/// The same for calls that return NULL or -1 on failure. The C API's boundary words those
+/// failures "<function>: internal error (please report): ..." and "<function>: out of
+/// memory"; the prefix is matched, since refusals may quote the input, which can hold
+/// any text. "out of memory" counts too: sizes an input claims must be refused before
+/// allocating.
 inline void check_last_error(const char *call) {
     trace(call, false);
     const char *e = hairis_last_error();
-    // "out of memory" too: sizes claimed by the input must be refused before allocating.
-    if (std::strstr(e, "internal error") != nullptr || std::strstr(e, "please report") != nullptr ||
-        std::strstr(e, "out of memory") != nullptr) {
+    const size_t n = std::strlen(call);
+    if (std::strncmp(e, call, n) == 0 &&
+        (std::strncmp(e + n, ": internal error", 16) == 0 || std::strncmp(e + n, ": out of memory", 15) == 0)) {
         std::fprintf(stderr, "%s failed with an internal error: %s\n", call, e);
         std::abort();
     }

@@ -58,11 +58,28 @@ std::vector<float> pixels_of(const TableSet &t) {
 
 Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
 
+// The size OpenEXR reads for an attribute of a fixed-size type whatever its size field says
+// (0: a variable-size or unknown type, read as `size` bytes).
+int fixed_attribute_size(const std::string &type) {
+    static const std::pair<const char *, int> sizes[] = {
+        {"int", 4},    {"float", 4},     {"double", 8},     {"v2i", 8},        {"v2f", 8},
+        {"v2d", 16},   {"v3i", 12},      {"v3f", 12},       {"v3d", 24},       {"box2i", 16},
+        {"box2f", 16}, {"m33f", 36},     {"m33d", 72},      {"m44f", 64},      {"m44d", 128},
+        {"rational", 8}, {"timecode", 8}, {"keycode", 28},  {"chromaticities", 32},
+        {"tiledesc", 9}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},
+        {"deepImageState", 1}};
+    for (const auto &[name, bytes] : sizes)
+        if (type == name) return bytes;
+    return 0;
+}
+
 // A first look at the EXR header, before OpenEXR reads it: OpenEXR allocates what an
-// attribute's size field or the data window claims (a string attribute of 1.7 GB in a 2 KB
-// buffer, a window of 2^31 rows whose offset table it allocates) before finding the data
-// missing. Table files are single-part scanline images whose attributes lie inside the
-// buffer and whose window fits the table limits; anything else is refused here.
+// attribute's size field, a string vector's entry, a preview or the data window claims (a
+// string attribute of 1.7 GB in a 2 KB buffer, a window of 2^31 rows whose offset table it
+// allocates) before finding the data missing, and reads fixed-size types at their own size,
+// so that a wrong size field makes it read the rest of the header out of step. Table files
+// are single-part scanline images whose attributes are consistent, lie inside the buffer and
+// whose window fits the table limits; anything else is refused here (found by fuzzing).
 Status check_exr_header(const unsigned char *data, size_t size) {
     auto read_int = [&](size_t at) {
         int32_t v = 0;
@@ -97,6 +114,25 @@ Status check_exr_header(const unsigned char *data, size_t size) {
         if (length < 0 || size_t(length) > size - at)
             return file_error("OpenEXR attribute \"" + name + "\" claims " + std::to_string(length) +
                               " bytes; the data holds " + std::to_string(size - at));
+        const int fixed = fixed_attribute_size(type);
+        if (fixed != 0 && length != fixed)
+            return file_error("OpenEXR attribute \"" + name + "\" of type " + type + " has size " +
+                              std::to_string(length) + " (a " + type + " has " + std::to_string(fixed) + ")");
+        if (type == "stringvector") {
+            for (size_t in = 0; in < size_t(length);) {
+                if (size_t(length) - in < 4) return file_error("OpenEXR attribute \"" + name + "\" is corrupt");
+                const int32_t entry = read_int(at + in);
+                in += 4;
+                if (entry < 0 || size_t(entry) > size_t(length) - in)
+                    return file_error("OpenEXR attribute \"" + name + "\" has an entry larger than itself");
+                in += size_t(entry);
+            }
+        }
+        if (type == "preview") {
+            const long long pixels = length >= 8 ? (long long)uint32_t(read_int(at)) * uint32_t(read_int(at + 4)) : -1;
+            if (pixels < 0 || 8 + 4 * pixels != length)
+                return file_error("OpenEXR attribute \"" + name + "\": the preview's size does not match its data");
+        }
         if (name == "dataWindow") {
             if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
             const long long width = (long long)read_int(at + 8) - read_int(at) + 1;

@@ -234,6 +234,14 @@ TEST(TableFile, RefusesAttributeLargerThanTheData) {
     expect_refused(bytes, "claims 2147483632 bytes; the data holds");
 }
 
+TEST(TableFile, RefusesFixedSizeAttributeWithAnotherSize) {
+    // OpenEXR reads a compression attribute as 1 byte whatever its size field says, and then
+    // the rest of the header out of step (found by fuzzing: it then allocated 1.7 GB).
+    std::vector<unsigned char> bytes = encode(small_tables());
+    set_attribute_size(bytes, "compression", "compression", 2);
+    expect_refused(bytes, "of type compression has size 2");
+}
+
 TEST(TableFile, RefusesHugeDataWindowBeforeAllocating) {
     // A window of 4096 x 2^30 pixels in a small buffer: refused before OpenEXR allocates its
     // offset table or the reader its pixels.
