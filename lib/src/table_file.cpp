@@ -128,6 +128,23 @@ Status check_exr_header(const unsigned char *data, size_t size) {
                 in += size_t(entry);
             }
         }
+        if (type == "chlist") {
+            // Entries of a name and 16 bytes, up to an empty name that must end the attribute.
+            size_t in = 0;
+            while (true) {
+                const size_t left = size_t(length) - in;
+                const void *end = std::memchr(data + at + in, 0, std::min(left, max_name + 1));
+                if (!end) return file_error("OpenEXR attribute \"" + name + "\": a channel entry is corrupt");
+                const size_t name_size = size_t(static_cast<const unsigned char *>(end) - (data + at + in));
+                in += name_size + 1;
+                if (name_size == 0) break;
+                if (size_t(length) - in < 16)
+                    return file_error("OpenEXR attribute \"" + name + "\": a channel entry is truncated");
+                in += 16;
+            }
+            if (in != size_t(length))
+                return file_error("OpenEXR attribute \"" + name + "\": the channel list does not fill its size");
+        }
         if (type == "preview") {
             const long long pixels = length >= 8 ? (long long)uint32_t(read_int(at)) * uint32_t(read_int(at + 4)) : -1;
             if (pixels < 0 || 8 + 4 * pixels != length)

@@ -242,6 +242,18 @@ TEST(TableFile, RefusesFixedSizeAttributeWithAnotherSize) {
     expect_refused(bytes, "of type compression has size 2");
 }
 
+TEST(TableFile, RefusesChannelListReadingPastItsSize) {
+    // OpenEXR reads channel names up to their NUL, past the attribute's size if need be
+    // (found by fuzzing: the rest of the header, read out of step, claimed 1.7 GB).
+    std::vector<unsigned char> bytes = encode(small_tables());
+    const std::string key = std::string("channels") + '\0' + "chlist" + '\0';
+    const auto at = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    ASSERT_NE(at, bytes.end());
+    const std::ptrdiff_t last_channel = std::ptrdiff_t(key.size() + 4 + 3 * 18);
+    std::fill(at + last_channel, at + last_channel + 18, (unsigned char)0xff);
+    expect_refused(bytes, "OpenEXR attribute \"channels\": a channel entry");
+}
+
 TEST(TableFile, RefusesHugeDataWindowBeforeAllocating) {
     // A window of 4096 x 2^30 pixels in a small buffer: refused before OpenEXR allocates its
     // offset table or the reader its pixels.
