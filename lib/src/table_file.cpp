@@ -146,8 +146,10 @@ Status check_exr_header(const unsigned char *data, size_t size) {
                 return file_error("OpenEXR attribute \"" + name + "\": the channel list does not fill its size");
         }
         if (type == "preview") {
-            const long long pixels = length >= 8 ? (long long)uint32_t(read_int(at)) * uint32_t(read_int(at + 4)) : -1;
-            if (pixels < 0 || 8 + 4 * pixels != length)
+            // width × height RGBA bytes after the two sizes (unsigned: no overflow).
+            const uint64_t width = length >= 8 ? uint32_t(read_int(at)) : 0;
+            const uint64_t height = length >= 8 ? uint32_t(read_int(at + 4)) : 0;
+            if (length < 8 || width * height != (uint64_t(length) - 8) / 4 || (length - 8) % 4 != 0)
                 return file_error("OpenEXR attribute \"" + name + "\": the preview's size does not match its data");
         }
         if (name == "dataWindow") {
