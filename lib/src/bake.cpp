@@ -84,6 +84,9 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
     t.direct.assign(size_t(n_r) * n_i * n_p, 0.0f);
     t.multiple.assign(size_t(n_r) * n_k * n_i, 0.0f);
 
+    // Progress 0 comes before the dual-scattering set-up (seconds), so that a cancel there
+    // is prompt too.
+    if (progress && !progress(0.0f)) return Error{"cancelled"};
     std::unique_ptr<DualScattering> dual;
     if (options.source == "exact") {
         Expected<DualScattering> ds = DualScattering::create(model, DualScatteringParams{});
@@ -94,7 +97,7 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
     // One θ_r slice at a time keeps progress and cancel responsive; the work inside a slice
     // is parallel and each cell is computed alone, so the result is thread-count independent.
     for (int r = 0; r < n_r; ++r) {
-        if (progress && !progress(float(r) / float(n_r))) return Error{"cancelled"};
+        if (r > 0 && progress && !progress(float(r) / float(n_r))) return Error{"cancelled"};
         const double theta_r = t.theta_r_nodes[size_t(r)];
         float *direct = &t.direct[size_t(r) * n_i * n_p];
         float *multiple = &t.multiple[size_t(r) * n_k * n_i];

@@ -100,6 +100,19 @@ TEST(Bake, CancelStopsWithAnError) {
     EXPECT_EQ(calls, 3);
 }
 
+TEST(Bake, CancelIsPromptBeforeTheSetUp) {
+    // Progress 0 comes before the dual-scattering set-up: a cancel there stops at once.
+    int calls = 0;
+    const auto t = bake_tables(blonde(), {}, small_options(), [&](float fraction) {
+        ++calls;
+        EXPECT_EQ(fraction, 0.0f);
+        return false;
+    });
+    ASSERT_FALSE(t.ok());
+    EXPECT_EQ(t.error().message, "cancelled");
+    EXPECT_EQ(calls, 1);
+}
+
 TEST(Bake, RefusesBadOptions) {
     BakeOptions o = small_options();
     o.theta_i_count = 0;

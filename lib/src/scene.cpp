@@ -450,8 +450,24 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     return Scene(std::move(impl));
 }
 
+namespace {
+
+// Embree's own precondition on a ray (RayK::valid(), asserted in Debian's build): origin and
+// direction components within ±1.844e18 (FLT_LARGE), t range not NaN. Rays outside it come
+// from finite but astronomically large inputs (a camera or vertex at 1e30) and are not
+// traced: a miss for intersect, blocked for shadow rays (found by fuzz_capi_params).
+bool traceable(Vec3 origin, Vec3 dir, float tmin, float tmax) {
+    constexpr float kLarge = 1.844e18f;
+    for (float c : {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z})
+        if (!(std::fabs(c) <= kLarge)) return false;
+    return !std::isnan(tmin) && !std::isnan(tmax);
+}
+
+}  // namespace
+
 std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                     PrimRef skip) const {
+    if (!traceable(origin, dir, tmin, tmax)) return std::nullopt;
     TraceContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.skip_a = skip;
@@ -483,6 +499,7 @@ std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tma
 
 bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip_a,
                      PrimRef skip_b) const {
+    if (!traceable(origin, dir, tmin, tmax)) return true;
     TraceContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.skip_a = skip_a;

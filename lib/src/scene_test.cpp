@@ -174,6 +174,23 @@ TEST(Scene, TrianglesAndSkips) {
     EXPECT_FALSE(scene.occluded({0.2f, 0.3f, 1}, {0, 0, 1}, 0.0f, 5.0f, up->prim));
 }
 
+TEST(Scene, RaysEmbreeCannotTraceAreMissesAndBlockedShadows) {
+    // Embree asserts (and aborts) on origins or directions beyond ±1.8e18 and NaN t; such
+    // rays come from finite but huge inputs (fuzz_capi_params found a camera at ~1e30).
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}};
+    d.meshes = {quad(0.0f, 0)};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1e30f}, {0, 0, -1}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, 0, -1e30f}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, NAN, -1}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, 0, -1}, NAN, INFINITY));
+    EXPECT_TRUE(scene.occluded({0.2f, 0.3f, -1e30f}, {0, 0, 1}, 0.0f, 5.0f));
+    // Large but traceable rays are traced as before.
+    EXPECT_TRUE(scene.intersect({0.2f, 0.3f, 1e6f}, {0, 0, -1}, 0.0f, INFINITY));
+}
+
 TEST(Scene, DegenerateCurvesAreSkippedWithAWarning) {
     SceneDesc d;
     d.materials = {hair_material()};

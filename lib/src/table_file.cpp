@@ -4,8 +4,11 @@
 #include <OpenImageIO/hash.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -54,6 +57,115 @@ std::vector<float> pixels_of(const TableSet &t) {
 }
 
 Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+
+// The size OpenEXR reads for an attribute of a fixed-size type whatever its size field says
+// (0: a variable-size or unknown type, read as `size` bytes).
+int fixed_attribute_size(const std::string &type) {
+    static const std::pair<const char *, int> sizes[] = {
+        {"int", 4},    {"float", 4},     {"double", 8},     {"v2i", 8},        {"v2f", 8},
+        {"v2d", 16},   {"v3i", 12},      {"v3f", 12},       {"v3d", 24},       {"box2i", 16},
+        {"box2f", 16}, {"m33f", 36},     {"m33d", 72},      {"m44f", 64},      {"m44d", 128},
+        {"rational", 8}, {"timecode", 8}, {"keycode", 28},  {"chromaticities", 32},
+        {"tiledesc", 9}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},
+        {"deepImageState", 1}};
+    for (const auto &[name, bytes] : sizes)
+        if (type == name) return bytes;
+    return 0;
+}
+
+// A first look at the EXR header, before OpenEXR reads it: OpenEXR allocates what an
+// attribute's size field, a string vector's entry, a preview or the data window claims (a
+// string attribute of 1.7 GB in a 2 KB buffer, a window of 2^31 rows whose offset table it
+// allocates) before finding the data missing, and reads fixed-size types at their own size,
+// so that a wrong size field makes it read the rest of the header out of step. Table files
+// are single-part scanline images whose attributes are consistent, lie inside the buffer and
+// whose window fits the table limits; anything else is refused here (found by fuzzing).
+Status check_exr_header(const unsigned char *data, size_t size) {
+    auto read_int = [&](size_t at) {
+        int32_t v = 0;
+        for (int b = 3; b >= 0; --b) v = int32_t(uint32_t(v) << 8 | data[at + size_t(b)]);
+        return v;
+    };
+    if (size < 8 || data[0] != 0x76 || data[1] != 0x2f || data[2] != 0x31 || data[3] != 0x01)
+        return file_error("not a readable OpenEXR file (no OpenEXR magic number)");
+    const uint32_t flags = uint32_t(read_int(4)) & ~0xffu;
+    constexpr uint32_t kLongNames = 0x400, kNonImage = 0x800, kMultiPart = 0x1000;
+    if (flags & (kNonImage | kMultiPart))
+        return file_error("a multi-part or deep OpenEXR file is not a table file");
+    const size_t max_name = flags & kLongNames ? 255 : 31;
+    size_t at = 8;
+    auto read_name = [&](std::string &name) -> Status {
+        const void *end = std::memchr(data + at, 0, std::min(size - at, max_name + 1));
+        if (!end) return file_error("the OpenEXR header is truncated or corrupt (attribute name)");
+        name.assign(reinterpret_cast<const char *>(data + at), size_t(static_cast<const unsigned char *>(end) - (data + at)));
+        at += name.size() + 1;
+        return std::nullopt;
+    };
+    std::string name, type;
+    while (true) {
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(name)) return s;
+        if (name.empty()) break;  // the end of the header
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(type)) return s;
+        if (size - at < 4) return file_error("the OpenEXR header is truncated");
+        const int32_t length = read_int(at);
+        at += 4;
+        if (length < 0 || size_t(length) > size - at)
+            return file_error("OpenEXR attribute \"" + name + "\" claims " + std::to_string(length) +
+                              " bytes; the data holds " + std::to_string(size - at));
+        const int fixed = fixed_attribute_size(type);
+        if (fixed != 0 && length != fixed)
+            return file_error("OpenEXR attribute \"" + name + "\" of type " + type + " has size " +
+                              std::to_string(length) + " (a " + type + " has " + std::to_string(fixed) + ")");
+        if (type == "stringvector") {
+            for (size_t in = 0; in < size_t(length);) {
+                if (size_t(length) - in < 4) return file_error("OpenEXR attribute \"" + name + "\" is corrupt");
+                const int32_t entry = read_int(at + in);
+                in += 4;
+                if (entry < 0 || size_t(entry) > size_t(length) - in)
+                    return file_error("OpenEXR attribute \"" + name + "\" has an entry larger than itself");
+                in += size_t(entry);
+            }
+        }
+        if (type == "chlist") {
+            // Entries of a name and 16 bytes, up to an empty name that must end the attribute.
+            size_t in = 0;
+            while (true) {
+                const size_t left = size_t(length) - in;
+                const void *end = std::memchr(data + at + in, 0, std::min(left, max_name + 1));
+                if (!end) return file_error("OpenEXR attribute \"" + name + "\": a channel entry is corrupt");
+                const size_t name_size = size_t(static_cast<const unsigned char *>(end) - (data + at + in));
+                in += name_size + 1;
+                if (name_size == 0) break;
+                if (size_t(length) - in < 16)
+                    return file_error("OpenEXR attribute \"" + name + "\": a channel entry is truncated");
+                in += 16;
+            }
+            if (in != size_t(length))
+                return file_error("OpenEXR attribute \"" + name + "\": the channel list does not fill its size");
+        }
+        if (type == "preview") {
+            // width × height RGBA bytes after the two sizes (unsigned: no overflow).
+            const uint64_t width = length >= 8 ? uint32_t(read_int(at)) : 0;
+            const uint64_t height = length >= 8 ? uint32_t(read_int(at + 4)) : 0;
+            if (length < 8 || width * height != (uint64_t(length) - 8) / 4 || (length - 8) % 4 != 0)
+                return file_error("OpenEXR attribute \"" + name + "\": the preview's size does not match its data");
+        }
+        if (name == "dataWindow") {
+            if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
+            const long long width = (long long)read_int(at + 8) - read_int(at) + 1;
+            const long long height = (long long)read_int(at + 12) - read_int(at + 4) + 1;
+            if (width < 1 || height < 1 || width > kMaxGridAxis ||
+                height > (long long)kMaxThetaRCount * kMaxGridAxis || width * height > kMaxTableCells)
+                return file_error("the image is " + std::to_string(width) + "x" + std::to_string(height) +
+                                  " pixels; a table has at most " + std::to_string(kMaxGridAxis) +
+                                  " columns and " + std::to_string(kMaxTableCells) + " pixels");
+        }
+        at += size_t(length);
+    }
+    return std::nullopt;
+}
 
 }  // namespace
 
@@ -149,6 +261,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
 
 Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
+    if (Status s = check_exr_header(static_cast<const unsigned char *>(data), size)) return *s;
     OIIO::Filesystem::IOMemReader proxy(data, size);
     auto in = OIIO::ImageInput::create("openexr");
     if (!in) return file_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
@@ -182,6 +295,11 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
                                check::count_in_range("theta_i_count", t.theta_i_count, 2, kMaxGridAxis),
                                check::count_in_range("phi_count", t.phi_count, 1, kMaxGridAxis)))
         return file_error(s->message);
+    // Checked before anything is allocated: the header alone can claim any size.
+    const long long cells = (long long)theta_r_count * t.theta_i_count * t.phi_count;
+    if (cells > kMaxTableCells)
+        return file_error("table has " + std::to_string(cells) + " cells; at most " +
+                          std::to_string(kMaxTableCells) + " are allowed");
     if (spec.width != t.phi_count || spec.height != theta_r_count * t.theta_i_count || spec.depth != 1 ||
         spec.x != 0 || spec.y != 0)
         return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
@@ -219,14 +337,25 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
         t.parameters.emplace_back(item.substr(0, eq), v);
     }
 
+    // Read in bands of rows, so memory grows with the data the file really holds: a small file
+    // whose header claims a large table fails at its first missing scanline instead of after
+    // allocating the whole table.
     const size_t width = size_t(spec.width), height = size_t(spec.height);
-    std::vector<float> px(width * height * kChannels);
-    if (!in->read_image(0, 0, 0, kChannels, TypeDesc::FLOAT, px.data()))
-        return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+    constexpr size_t kBandRows = 64;
+    std::vector<float> px, band;
+    OIIO::SHA1 hash;
+    for (size_t y = 0; y < height; y += kBandRows) {
+        const size_t rows = std::min(kBandRows, height - y);
+        band.resize(rows * width * kChannels);
+        if (!in->read_scanlines(0, 0, int(y), int(y + rows), 0, 0, kChannels, TypeDesc::FLOAT, band.data()))
+            return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+        hash.append(band.data(), band.size() * sizeof(float));
+        px.insert(px.end(), band.begin(), band.end());
+    }
     in->close();
 
     const std::string sha = spec.get_string_attribute("hairis:pixel_sha1");
-    if (sha != sha1_of(px))
+    if (sha != hash.digest())
         return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
 
     const int bands = int(t.n_h_values.size());

@@ -5,7 +5,9 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -214,6 +216,60 @@ TEST(TableFile, RefusesInconsistentBand) {
         rehash(spec, px);
     });
     expect_refused(bytes, "differs inside the n_h band");
+}
+
+// Overwrites the 4-byte little-endian size field of header attribute `name` (type `type`).
+void set_attribute_size(std::vector<unsigned char> &bytes, const std::string &name, const std::string &type,
+                        uint32_t size) {
+    const std::string key = name + std::string(1, '\0') + type + std::string(1, '\0');
+    const auto at = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    ASSERT_NE(at, bytes.end()) << name;
+    for (size_t b = 0; b < 4; ++b) at[std::ptrdiff_t(key.size() + b)] = (unsigned char)(size >> (8 * b));
+}
+
+TEST(TableFile, RefusesAttributeLargerThanTheData) {
+    // OpenEXR itself would allocate the 2 GB the size field claims (found by fuzzing).
+    std::vector<unsigned char> bytes = encode(small_tables());
+    set_attribute_size(bytes, "hairis:model", "string", 0x7ffffff0u);
+    expect_refused(bytes, "claims 2147483632 bytes; the data holds");
+}
+
+TEST(TableFile, RefusesFixedSizeAttributeWithAnotherSize) {
+    // OpenEXR reads a compression attribute as 1 byte whatever its size field says, and then
+    // the rest of the header out of step (found by fuzzing: it then allocated 1.7 GB).
+    std::vector<unsigned char> bytes = encode(small_tables());
+    set_attribute_size(bytes, "compression", "compression", 2);
+    expect_refused(bytes, "of type compression has size 2");
+}
+
+TEST(TableFile, RefusesChannelListReadingPastItsSize) {
+    // OpenEXR reads channel names up to their NUL, past the attribute's size if need be
+    // (found by fuzzing: the rest of the header, read out of step, claimed 1.7 GB).
+    std::vector<unsigned char> bytes = encode(small_tables());
+    const std::string key = std::string("channels") + '\0' + "chlist" + '\0';
+    const auto at = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    ASSERT_NE(at, bytes.end());
+    const std::ptrdiff_t last_channel = std::ptrdiff_t(key.size() + 4 + 3 * 18);
+    std::fill(at + last_channel, at + last_channel + 18, (unsigned char)0xff);
+    expect_refused(bytes, "OpenEXR attribute \"channels\": a channel entry");
+}
+
+TEST(TableFile, RefusesHugeDataWindowBeforeAllocating) {
+    // A window of 4096 x 2^30 pixels in a small buffer: refused before OpenEXR allocates its
+    // offset table or the reader its pixels.
+    std::vector<unsigned char> bytes = encode(small_tables());
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const auto at = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    ASSERT_NE(at, bytes.end());
+    const int32_t window[4] = {0, 0, 4095, (1 << 30) - 1};
+    std::memcpy(&*(at + std::ptrdiff_t(key.size() + 4)), window, sizeof window);
+    expect_refused(bytes, "a table has at most 4096 columns");
+}
+
+TEST(TableFile, RefusesMultiPartFiles) {
+    std::vector<unsigned char> bytes = encode(small_tables());
+    bytes[5] |= 0x10;  // the multi-part flag (bit 12 of the version field)
+    expect_refused(bytes, "multi-part or deep");
 }
 
 TEST(TableSetValidate, NamesTheProblem) {

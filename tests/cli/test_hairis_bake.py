@@ -114,6 +114,35 @@ class HairisBakeTest(unittest.TestCase):
         self.assertIn("--param-file", r.stderr)
         self.assert_no_output("x.exr")
 
+    def test_bad_parameter_values_are_refused(self):
+        params = self.path("fiber.txt")
+        cases = [
+            ("ior = 1\n", "ior must be finite and greater than 1"),
+            ("roughness = 2\n", "roughness must be in [0, 1]"),
+            ("radial_roughness = -0.1\n", "radial_roughness must be in [0, 1]"),
+            ("roughness = nan\n", "line 1: roughness must be a finite number"),
+            ("offset_deg = inf\n", "line 1: offset_deg must be a finite number"),
+            ("parametrization = melanin\nmelanin = -1\n", "melanin must be in [0, 1]"),
+            ("model = marschner\neta = 0.9\n", "eta must be in (1, 4]"),
+            ("model = lambert\n", "line 1: model must be chiang or marschner"),
+            ("# fine\nno equals sign\n", "line 2: expected key = value"),
+        ]
+        for text, fragment in cases:
+            with open(params, "w") as f:
+                f.write(text)
+            r = run("bake", *SMALL, "--param-file", params, "-q", "-o", self.path("x.exr"))
+            self.assertNotEqual(r.returncode, 0, text)
+            self.assertIn(fragment, r.stderr, text)
+        self.assert_no_output("x.exr")
+
+    def test_table_too_large_is_refused_before_baking(self):
+        # Each axis is in range, the product is not: refused before anything is allocated.
+        r = run("bake", "--theta-r", "1024", "--theta-i", "4096", "--phi", "4096", "-q",
+                "-o", self.path("huge.exr"))
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("17179869184 cells; at most 67108864 are allowed", r.stderr)
+        self.assert_no_output("huge.exr")
+
     def test_unwritable_output(self):
         locked = self.path("locked")
         os.mkdir(locked)
