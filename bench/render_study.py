@@ -12,7 +12,7 @@ In one run, on the scene of tests/blender/test_cycles_compare.py (helpers.make_c
    engine is favoured; half the mean squared difference of the two halves over two estimates
    the reference's own noise (MSE_ref = mean((hairis − cycles)²)/4), which is subtracted from
    every measured MSE ("noise-corrected" RMSE);
-2. every Hairis strategy (UNIFORM, ANALYTIC, GAUSSIAN, TABLE at the default multiple_weight)
+2. every Hairis strategy (UNIFORM, ANALYTIC, GAUSSIAN at multiple_weight 0.25, TABLE at 0)
    and Cycles at each of SPPS samples per pixel, SEEDS seeds each (seeds other than the
    reference's), timing ``bpy.ops.render.render()`` alone; a warm-up render of each
    strategy and of Cycles comes first, so TABLE's auto-bake and first-render costs are not
@@ -105,6 +105,9 @@ def configure(scene, method, samples):
     helpers.set_samples(scene, samples)
     if method != "CYCLES":
         scene.hairis.strategy = method
+        # Each strategy at its recommended weight: 0 for TABLE (the default), 0.25 for the
+        # seed's Gaussian PDFs, which are heavy-tailed without their multiple-scattering part.
+        scene.hairis.multiple_weight = 0.25 if method == "GAUSSIAN" else 0.0
     return "CYCLES" if method == "CYCLES" else "HAIRIS"
 
 

@@ -71,6 +71,9 @@ def render_native(data, hair_tables, strategy, seed, samples, progress=None):
     lib = library()
     settings = SCENE.hairis
     settings.strategy = strategy
+    # The default weight 0 suits TABLE; the seed's Gaussian PDFs need their multiple-scattering
+    # part (at w = 0 their estimate is too heavy-tailed to compare at this sample count).
+    settings.multiple_weight = 0.25 if strategy == "GAUSSIAN" else 0.0
     settings.seed = seed
     settings.samples = samples
     with engine.build_native_scene(lib, data, hair_tables) as scene:
