@@ -134,17 +134,22 @@ double sample_cone_cosine(double u, double v) {
     return std::clamp(1.0 + v * std::log1p(x), -1.0, 1.0);
 }
 
-double trimmed_logistic(double x, double s) { return logistic(x, s) / logistic_mass(s); }
+TrimmedLogistic::TrimmedLogistic(double s)
+    : s_(s), norm_(1.0 / logistic_mass(s)), mass_(logistic_mass(s)),
+      // CDF(−π) = 1/(1 + e^{π/s}); e^{π/s} may overflow to +inf, which correctly gives 0.
+      cdf_lo_(1.0 / (1.0 + std::exp(kPi / s))) {}
 
-double sample_trimmed_logistic(double u, double s) {
-    // CDF(−π) = 1/(1 + e^{π/s}); e^{π/s} may overflow to +inf, which correctly gives 0.
-    const double cdf_minus_pi = 1.0 / (1.0 + std::exp(kPi / s));
-    const double q = std::clamp(u, 0.0, 1.0) * logistic_mass(s) + cdf_minus_pi;
+double TrimmedLogistic::sample(double u) const {
+    const double q = std::clamp(u, 0.0, 1.0) * mass_ + cdf_lo_;
     if (q <= 0.0) return -kPi;
     if (q >= 1.0) return kPi;
     // The logistic's quantile s·log(q / (1 − q)).
-    return std::clamp(s * (std::log(q) - std::log1p(-q)), -kPi, kPi);
+    return std::clamp(s_ * (std::log(q) - std::log1p(-q)), -kPi, kPi);
 }
+
+double trimmed_logistic(double x, double s) { return TrimmedLogistic(s).density(x); }
+
+double sample_trimmed_logistic(double u, double s) { return TrimmedLogistic(s).sample(u); }
 
 double azimuthal_shift(int p, double gamma_o, double gamma_t) {
     return 2.0 * p * gamma_t - 2.0 * gamma_o + p * kPi;
@@ -201,7 +206,7 @@ Expected<ChiangFiber> ChiangFiber::create(const ChiangParams &p) {
         fiber.tilt_cos_[i] = std::cos(tilts[i]);
     }
     fiber.sigma_ = {p.sigma_a.r, p.sigma_a.g, p.sigma_a.b};
-    fiber.logistic_norm_ = 1.0 / logistic_mass(fiber.s_);
+    fiber.azimuthal_ = chiang::TrimmedLogistic(fiber.s_);
     for (int lobe = 0; lobe < 4; ++lobe)
         fiber.longitudinal_[std::size_t(lobe)] = chiang::longitudinal_constants(fiber.lobe_variance(lobe));
     const double panel = std::min(kFixedPanelPerScale * fiber.s_, kFixedMaxPanel);
@@ -302,7 +307,7 @@ Rgb ChiangFiber::lobe_f_cos_near(int p, Vec3 wi, Vec3 wo, float h) const {
     if (p < 3) {
         const double phi = std::atan2(double(wi.z), double(wi.y)) - o.phi;
         const double shift = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t);
-        azimuthal = logistic(wrap_angle(phi - shift), s_) * logistic_norm_;
+        azimuthal = azimuthal_.density(wrap_angle(phi - shift));
     }
     return to_rgb(scaled(at.a[p], longitudinal * azimuthal));
 }
@@ -318,7 +323,7 @@ Rgb ChiangFiber::f_cos_near(Vec3 wi, Vec3 wo, float h) const {
         double weight = tilted_longitudinal(p, sin_theta_i, cos_theta_i, o);
         if (p < 3) {
             const double shift = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t);
-            weight *= logistic(wrap_angle(phi - shift), s_) * logistic_norm_;
+            weight *= azimuthal_.density(wrap_angle(phi - shift));
         } else {
             weight *= kInvTwoPi;
         }
@@ -383,7 +388,7 @@ float ChiangFiber::pdf(Vec3 wi, Vec3 wo, float h) const {
         double term = w[p] * sampling_longitudinal(p, sin_theta_i, cos_theta_i, o);
         if (p < 3) {
             const double shift = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t);
-            term *= logistic(wrap_angle(phi - shift), s_) * logistic_norm_;
+            term *= azimuthal_.density(wrap_angle(phi - shift));
         } else {
             term *= kInvTwoPi;
         }
@@ -417,7 +422,7 @@ std::optional<ChiangSample> ChiangFiber::sample(Vec3 wo, float h, float u0, floa
     double phi = kTwoPi * u0;  // residual: uniform
     if (p < 3) {
         phi = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t) +
-              chiang::sample_trimmed_logistic(u0, s_);
+              azimuthal_.sample(u0);
     }
     const double phi_i = o.phi + phi;
 
@@ -675,7 +680,7 @@ std::array<double, 3> ChiangFiber::far_azimuthal_uncached(int p, const Outgoing 
         sum[1] += weight[3 * j + 1] * bump;
         sum[2] += weight[3 * j + 2] * bump;
     }
-    const double scale = logistic_norm_ * inv_s;
+    const double scale = azimuthal_.norm() * inv_s;
     Channels result{sum[0] * scale, sum[1] * scale, sum[2] * scale};
 
     // N has a kink where φ − Φ wraps through ±π, which the fixed nodes straddle: its slope
@@ -685,7 +690,7 @@ std::array<double, 3> ChiangFiber::far_azimuthal_uncached(int p, const Outgoing 
     // integrated again, split at it.
     const int panels = fixed_panels_;
     const double panel_width = kPi / panels;
-    const double kink_slope_jump = 4.0 * logistic(kPi, s_) * logistic_norm_ * std::tanh(kHalfPi / s_) * inv_s;
+    const double kink_slope_jump = 4.0 * logistic(kPi, s_) * azimuthal_.norm() * std::tanh(kHalfPi / s_) * inv_s;
     bool negligible = true;
     for (int c = 0; c < 3; ++c) {
         const double kink_error = kink_slope_jump * panel_width * panel_width * slice.total_weight[p][c];
@@ -723,7 +728,7 @@ std::array<double, 3> ChiangFiber::fixed_panel(int p, const FarSlice &slice, dou
     Channels sum{};
     for (int j = 8 * panel; j < 8 * panel + 8; ++j) {
         const std::size_t index = std::size_t(p * n + j);
-        const double bump = logistic(wrap_angle(phi - slice.shift[index]), s_) * logistic_norm_;
+        const double bump = azimuthal_.density(wrap_angle(phi - slice.shift[index]));
         for (int c = 0; c < 3; ++c) sum[c] += slice.weight[3 * index + std::size_t(c)] * bump;
     }
     return sum;
@@ -740,7 +745,7 @@ std::array<double, 3> ChiangFiber::exact_panel(int p, const Outgoing &o, double 
             const Attenuation at = attenuation_at(o, std::sin(gamma));
             const double shift = chiang::azimuthal_shift(p, at.gamma_o, at.gamma_t);
             const double weight = 0.5 * kGaussWeights[node] * half * std::cos(gamma) *
-                                  logistic(wrap_angle(phi - shift), s_) * logistic_norm_;
+                                  azimuthal_.density(wrap_angle(phi - shift));
             for (int c = 0; c < 3; ++c) sum[c] += weight * at.a[p][c];
         }
     }
@@ -761,7 +766,7 @@ std::array<double, 3> ChiangFiber::far_azimuthal_graded(int p, const Outgoing &o
         const double sin_t = o.k * sin_g, cos_t = cos_from_sin(sin_t);
         const double f = fresnel_dielectric(o.cos_theta * cos_g, eta_);
         const double shift = (p > 0 ? 2.0 * p * safe_asin(sin_t) : 0.0) - 2.0 * gamma + p * kPi;
-        const double common = cos_g * logistic(wrap_angle(phi - shift), s) * logistic_norm_;
+        const double common = cos_g * logistic(wrap_angle(phi - shift), s) * azimuthal_.norm();
         for (int c = 0; c < 3; ++c) {
             double a = f;
             if (p > 0) {
@@ -773,7 +778,7 @@ std::array<double, 3> ChiangFiber::far_azimuthal_graded(int p, const Outgoing &o
         }
     };
     auto logistic_at = [&](double gamma) {
-        return logistic(wrap_angle(phi - deflection.value(gamma)), s) * logistic_norm_;
+        return logistic(wrap_angle(phi - deflection.value(gamma)), s) * azimuthal_.norm();
     };
 
     // Monotone pieces of Φ.

@@ -1,5 +1,6 @@
 #include "hairis/near_field_table.h"
 
+#include <boost/math/quadrature/gauss.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -11,11 +12,7 @@ namespace hairis {
 
 namespace {
 
-// 8-point Gauss–Legendre on [−1, 1] (symmetric half).
-constexpr double kNodes[4] = {0.18343464249564980, 0.52553240991632899, 0.79666647741362674,
-                              0.96028985649753623};
-constexpr double kWeights[4] = {0.36268378337836198, 0.31370664587788729, 0.22238103445337447,
-                                0.10122853629037626};
+using GaussLegendre8 = boost::math::quadrature::gauss<double, 8>;
 constexpr int kMaxPanelsPerCell = 64;
 
 // ∫_a^b M_p(θ | θ_o)·cos θ dθ, on panels narrow enough for the lobe's width.
@@ -25,14 +22,11 @@ double cell_mass(const ChiangFiber &fiber, int p, double sin_theta_o, double a, 
     const double step = (b - a) / panels;
     double sum = 0;
     for (int j = 0; j < panels; ++j) {
-        const double mid = a + (j + 0.5) * step, half = 0.5 * step;
-        for (int n = 0; n < 4; ++n) {
-            for (double sign : {-1.0, 1.0}) {
-                const double theta = mid + sign * half * kNodes[n];
-                sum += kWeights[n] * half * fiber.longitudinal(p, std::sin(theta), sin_theta_o) *
-                       std::cos(theta);
-            }
-        }
+        sum += GaussLegendre8::integrate(
+            [&](double theta) {
+                return fiber.longitudinal(p, std::sin(theta), sin_theta_o) * std::cos(theta);
+            },
+            a + j * step, a + (j + 1) * step);
     }
     return sum;
 }
@@ -48,7 +42,6 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
         return *s;
     NearFieldTable table;
     table.fiber_ = std::move(fiber);
-    table.logistic_ = TrimmedLogistic(table.fiber_->logistic_scale());
 
     const int nodes = options.theta_o_nodes, cells = options.theta_i_cells;
     std::vector<float> theta_o(static_cast<size_t>(nodes));
@@ -137,7 +130,8 @@ NearFieldTable::Prepared NearFieldTable::prepare(Vec3 wo, float h) const {
     Prepared q;
     const ChiangFiber::LobeGeometry g = fiber_->lobe_geometry(wo, h);
     for (int p = 0; p < 3; ++p) q.shift[p] = g.shift[size_t(p)];
-    q.blend = nodes_.locate(safe_asin(wo.x));
+    q.theta_o = safe_asin(wo.x);
+    q.blend = nodes_.locate(q.theta_o);
     // Lobe weights luminance(A_p)·I_p at both nodes, normalized per node.
     for (int side = 0; side < 2; ++side) {
         const int r = std::min(q.blend.lower + side, nodes_.count() - 1);
@@ -161,7 +155,7 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
     const double phi = std::atan2(wi.z * q.cos_phi_o - wi.y * q.sin_phi_o,
                                   wi.y * q.cos_phi_o + wi.z * q.sin_phi_o);
     double azimuthal[4];
-    for (int p = 0; p < 3; ++p) azimuthal[p] = logistic_.density(wrap_angle(phi - q.shift[p]));
+    for (int p = 0; p < 3; ++p) azimuthal[p] = fiber_->azimuthal().density(wrap_angle(phi - q.shift[p]));
     azimuthal[3] = kInvTwoPi;
     const float t_in_cell = std::clamp((wi.x - cells_.sin_edge(k)) / cells_.sin_width(k), 0.0f, 1.0f);
 
@@ -213,7 +207,7 @@ std::optional<NearFieldSample> NearFieldTable::sample(const Prepared &q, float u
     const LongitudinalCells::Point point = cells_.point_in_cell(
         c.index, std::min(sample_cell_shape(e[0], e[1], c.fraction), kOneMinusEpsilon));
     double phi = -kPi + kTwoPi * double(clamp_unit(u0));  // residual: uniform
-    if (p < 3) phi = q.shift[p] + logistic_.sample(clamp_unit(u0));
+    if (p < 3) phi = q.shift[p] + fiber_->azimuthal().sample(clamp_unit(u0));
     // φ_i = φ_o + φ, by rotation.
     const double c_phi = std::cos(phi), s_phi = std::sin(phi);
     const double cos_phi_i = q.cos_phi_o * c_phi - q.sin_phi_o * s_phi;

@@ -55,9 +55,9 @@ TEST(NearFieldTable, PdfIsTheDensityItSamples) {
     }
 }
 
-TEST(NearFieldTable, MixtureWithTheMultipleTableIsExactThroughTheStrategy) {
-    // Covered with real baked tables in strategies_test; here the sampler built from the
-    // table alone, with a rough coated fiber at a large tilt.
+TEST(NearFieldTable, ExactForARoughCoatedFiberWithALargeTilt) {
+    // The strategy wrapper alone (its mixture with the multiple table is χ²-tested in
+    // strategies_test), with a rough coated fiber at a large tilt.
     const auto table = std::make_shared<const NearFieldTable>(
         NearFieldTable::create(fiber(0.6f, 8.0f, 0.5f)).value());
     const NearFieldTableSampler sampler(table);

@@ -63,7 +63,7 @@ std::optional<DirectionSample> TableSampler::sample(Vec3 wo, float h, float u0, 
     // is shared between its sample and its density.
     const float w = mixture_.multiple_weight();
     const NearFieldTable::Prepared q = near_->prepare(wo, h);
-    const float theta_o = safe_asin(wo.x);
+    const float theta_o = q.theta_o;
     if (u2 < w) {
         const TableSample s = mixture_.multiple().sample(strand_, theta_o, u0, u1, u2 / w);
         if (!(s.pdf > 0.0f)) return std::nullopt;
@@ -88,8 +88,9 @@ float TableSampler::pdf(Vec3 wi, Vec3 wo, float h) const {
         return mixture_.pdf_sin(o.theta, wi.x, relative_azimuth(phi_i, o.phi));
     }
     const float w = mixture_.multiple_weight();
-    const float single = w < 1.0f ? near_->pdf(wi, wo, h) : 0.0f;
-    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, safe_asin(wo.x), wi.x) : 0.0f;
+    const NearFieldTable::Prepared q = near_->prepare(wo, h);
+    const float single = w < 1.0f ? near_->density(q, wi) : 0.0f;
+    const float multiple = w > 0.0f ? mixture_.multiple().pdf_sin(strand_, q.theta_o, wi.x) : 0.0f;
     return (1.0f - w) * single + w * multiple;
 }
 

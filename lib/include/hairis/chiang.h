@@ -28,6 +28,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -39,6 +40,27 @@
 namespace hairis {
 
 namespace chiang {
+/// The logistic density of scale s > 0 restricted to [−π, π] and renormalized there, with
+/// its constants (the mass inside [−π, π], the CDF at −π) computed once.
+class TrimmedLogistic {
+  public:
+    TrimmedLogistic() = default;
+    explicit TrimmedLogistic(double s);
+    /// Density at x ∈ [−π, π]: e/(s(1 + e)²) / mass with e = e^{−|x|/s} (cannot overflow).
+    double density(double x) const {
+        const double e = std::exp(-std::fabs(x) / s_);
+        return e / (s_ * ((1.0 + e) * (1.0 + e))) * norm_;
+    }
+    /// Inverse CDF: u ∈ [0, 1] to x ∈ [−π, π].
+    double sample(double u) const;
+    double scale() const { return s_; }
+    /// 1 / ∫_{−π}^{π} of the untrimmed logistic.
+    double norm() const { return norm_; }
+
+  private:
+    double s_ = 1, norm_ = 1, mass_ = 1, cdf_lo_ = 0;
+};
+
 /// The parts of d'Eon's longitudinal function that depend on the variance v only: κ = 1/v and
 /// log(csch(κ)/(2v)) (see chiang::longitudinal_scattering).
 struct LongitudinalConstants {
@@ -142,6 +164,8 @@ class ChiangFiber final : public FiberModel {
     double lobe_variance(int p) const;
     /// The mapped logistic scale s.
     double logistic_scale() const { return s_; }
+    /// N_p of R, TT and TRT: the trimmed logistic of scale s.
+    const chiang::TrimmedLogistic &azimuthal() const { return azimuthal_; }
 
   private:
     ChiangFiber() = default;
@@ -173,7 +197,7 @@ class ChiangFiber final : public FiberModel {
     double alpha_ = 0;
     std::array<double, 3> tilt_sin_{}, tilt_cos_{1, 1, 1};  // of δ_p = (2α, −α, −4α)
     std::array<double, 3> sigma_{};
-    double logistic_norm_ = 1;  // 1 / ∫_{−π}^{π} logistic
+    chiang::TrimmedLogistic azimuthal_;  // N_p (R, TT, TRT)
     std::array<chiang::LongitudinalConstants, 4> longitudinal_{};  // of lobe_variance(p)
     int fixed_panels_ = 0;      // far field: γ panels of the fixed rule, 0 = graded rule
     std::uint64_t id_ = 0;      // identifies these parameters in per-thread caches
@@ -209,9 +233,9 @@ double longitudinal_scattering(double sin_theta_i, double cos_theta_i, double si
 /// [−1, 1] (d'Eon's sampling): t = 1 + v·log(u + (1 − u)·exp(−2/v)).
 double sample_cone_cosine(double u, double v);
 
-/// The logistic density of scale s restricted to [−π, π] and renormalized there.
+/// TrimmedLogistic(s).density(x).
 double trimmed_logistic(double x, double s);
-/// Inverse CDF of trimmed_logistic: u in [0, 1] to x in [−π, π].
+/// TrimmedLogistic(s).sample(u).
 double sample_trimmed_logistic(double u, double s);
 
 /// The azimuthal deflection Φ(p, h) = 2p·γ_t − 2γ_o + pπ.

@@ -51,32 +51,6 @@ struct NearFieldSample {
     int lobe = 0;
 };
 
-/// The logistic of scale s restricted to [−π, π], with its constants computed once
-/// (chiang::trimmed_logistic and chiang::sample_trimmed_logistic recompute them per call).
-class TrimmedLogistic {
-  public:
-    TrimmedLogistic() = default;
-    explicit TrimmedLogistic(double s)
-        : s_(s), inv_s_(1.0 / s), norm_(1.0 / std::tanh(kPi / (2.0 * s))),
-          mass_(std::tanh(kPi / (2.0 * s))), cdf_lo_(1.0 / (1.0 + std::exp(kPi / s))) {}
-    /// Density at x ∈ [−π, π].
-    double density(double x) const {
-        const double e = std::exp(-std::fabs(x) * inv_s_);
-        return norm_ * inv_s_ * e / ((1.0 + e) * (1.0 + e));
-    }
-    /// Inverse CDF: u ∈ [0, 1) to x ∈ [−π, π].
-    double sample(double u) const {
-        const double q = u * mass_ + cdf_lo_;
-        if (q <= 0.0) return -kPi;
-        if (q >= 1.0) return kPi;
-        const double x = s_ * std::log(q / (1.0 - q));
-        return x < -kPi ? -kPi : (x > kPi ? kPi : x);
-    }
-
-  private:
-    double s_ = 1, inv_s_ = 1, norm_ = 1, mass_ = 1, cdf_lo_ = 0;
-};
-
 /// Per-θ_o, per-lobe inverse CDFs of Cycles' M_p·cos θ_i, and the near-field sampler on them.
 class NearFieldTable {
   public:
@@ -88,6 +62,7 @@ class NearFieldTable {
     /// What sample() and pdf() need at one shading point (ω_o, h), computed once: the θ_o
     /// nodes and their lobe weights, the lobes' azimuthal centres and the view's azimuth.
     struct Prepared {
+        float theta_o = 0;  // asin(ω_o.x)
         NodeBlend blend;
         float weight[2][4] = {};  // lobe probabilities at the lower and upper node
         double shift[3] = {};
@@ -122,7 +97,6 @@ class NearFieldTable {
     DiscreteCdfs cdfs_;              // row r·4 + p: the cells' masses
     std::vector<float> edge_;        // row r·4 + p: M_p at the cells' edges
     std::vector<double> integral_;  // r·4 + p
-    TrimmedLogistic logistic_;      // N_p of the fiber
 };
 
 /// The near-field table as a strategy (no multiple-scattering part).
