@@ -18,7 +18,6 @@ import json
 import math
 import os
 import sys
-import time
 
 import bpy
 import numpy as np
@@ -46,17 +45,9 @@ LIGHTINGS = {
 
 
 def make_scene(lighting):
-    scene = helpers.reset()
-    scene.render.engine = "HAIRIS"
-    helpers.make_camera(scene, location=(0.0, -7.5, 0.3), resolution=(96, 72), percentage=100)
-    helpers.make_world(scene, color=(0.35, 0.45, 0.6), strength=1.0)
-    hair = helpers.make_hair_material("Hair", "MELANIN", **{
-        "Melanin": 0.45, "Melanin Redness": 0.5, "Roughness": 0.3, "Radial Roughness": 0.3})
-    skin = helpers.make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    helpers.make_particle_hair(scene, count=800, children=10, location=(0.0, 0.0, 0.3),
-                               scale=1.3, hair_material=hair, skin_material=skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=4.0, angle=math.radians(2.0),
-                       rotation=LIGHTINGS[lighting])
+    """The demo head, smaller, under one of LIGHTINGS."""
+    scene = helpers.make_demo_head(resolution=(96, 72), count=800,
+                                   sun_rotation=LIGHTINGS[lighting])
     settings = scene.hairis
     settings.samples = SAMPLES
     settings.max_bounces = 8
@@ -66,19 +57,10 @@ def make_scene(lighting):
     return scene
 
 
-def render(scene):
-    start = time.monotonic()
-    bpy.ops.render.render()
-    seconds = time.monotonic() - start
-    path = os.path.join(ARGS.workdir, "render.exr")
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.data.images["Render Result"].save_render(path, scene=scene)
-    image = bpy.data.images.load(path)
-    pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    return pixels.reshape(-1, 4)[:, :3].astype(np.float64), seconds
+def render(scene, seed):
+    """(pixels × RGB, seconds) of a Hairis render with ``seed``."""
+    image, seconds = helpers.render_pixels(scene, "HAIRIS", seed, ARGS.workdir)
+    return image.reshape(-1, 3), seconds
 
 
 def main():
@@ -93,7 +75,7 @@ def study(lighting):
     scene = make_scene(lighting)
     settings = scene.hairis
     settings.strategy = "TABLE"
-    render(scene)  # warm-up: the auto-bake happens here, not in the timed renders
+    render(scene, 0)  # warm-up: the auto-bake happens here, not in the timed renders
     rows = []
     for strategy, weight, n_h in SETTINGS:
         settings.strategy = strategy
@@ -101,8 +83,7 @@ def study(lighting):
         settings.n_h = str(n_h)
         images, seconds = [], 0.0
         for seed in range(1, SEEDS + 1):
-            settings.seed = seed
-            image, t = render(scene)
+            image, t = render(scene, seed)
             images.append(image)
             seconds += t
         stack = np.stack(images)

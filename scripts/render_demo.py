@@ -8,7 +8,6 @@ builds a head of particle hair (with interpolated children) under a sun and a sk
 .blend, bakes the sampling tables next to it (bpy.ops.hairis.bake_tables), renders with the
 TABLE strategy and writes out/demo/demo.png.
 """
-import math
 import os
 import sys
 
@@ -21,17 +20,7 @@ ARGS, PACKAGE = helpers.setup()
 
 
 def main():
-    scene = helpers.reset()
-    scene.render.engine = "HAIRIS"
-    helpers.make_camera(scene, location=(0.0, -7.5, 0.3), resolution=(480, 360), percentage=100)
-    helpers.make_world(scene, color=(0.35, 0.45, 0.6), strength=1.0)
-    hair = helpers.make_hair_material("Hair", "MELANIN", **{
-        "Melanin": 0.45, "Melanin Redness": 0.5, "Roughness": 0.3, "Radial Roughness": 0.3})
-    skin = helpers.make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    helpers.make_particle_hair(scene, count=1500, children=10, location=(0.0, 0.0, 0.3), scale=1.3,
-                               hair_material=hair, skin_material=skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=4.0, angle=math.radians(2.0),
-                       rotation=(math.radians(50), 0.0, math.radians(30)))
+    scene = helpers.make_demo_head()
     settings = scene.hairis
     settings.samples = 64
     settings.max_bounces = 8

@@ -257,11 +257,4 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         return baked
 
 
-def register():
-    """Registers the engine."""
-    bpy.utils.register_class(HairisRenderEngine)
-
-
-def unregister():
-    """Unregisters the engine."""
-    bpy.utils.unregister_class(HairisRenderEngine)
+register, unregister = bpy.utils.register_classes_factory((HairisRenderEngine,))

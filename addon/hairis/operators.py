@@ -249,13 +249,4 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
 classes = (HAIRIS_OT_bake_tables,)
 
 
-def register():
-    """Registers the operators."""
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    """Unregisters the operators."""
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

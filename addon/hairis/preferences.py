@@ -22,13 +22,4 @@ class HairisPreferences(bpy.types.AddonPreferences):
 classes = (HairisPreferences,)
 
 
-def register():
-    """Registers the preferences."""
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    """Unregisters the preferences."""
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

@@ -98,13 +98,4 @@ class HairisMaterialSettings(bpy.types.PropertyGroup):
 classes = (HairisRenderSettings, HairisMaterialSettings)
 
 
-def register():
-    """Registers the property groups."""
-    for cls in classes:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    """Unregisters the property groups."""
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(classes)

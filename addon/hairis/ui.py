@@ -341,10 +341,12 @@ classes = (
 )
 
 
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
+
+
 def register():
     """Registers the panels and adds Hairis to Blender's generic panels."""
-    for cls in classes:
-        bpy.utils.register_class(cls)
+    _register_classes()
     for panel in compatible_panels():
         panel.COMPAT_ENGINES.add(ENGINE)
 
@@ -355,5 +357,4 @@ def unregister():
         engines = getattr(panel, "COMPAT_ENGINES", None)
         if isinstance(engines, set) and panel not in classes:
             engines.discard(ENGINE)
-    for cls in reversed(classes):
-        bpy.utils.unregister_class(cls)
+    _unregister_classes()

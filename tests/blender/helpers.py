@@ -104,8 +104,8 @@ def reset():
     return bpy.context.scene
 
 
-def make_hair_material(name, parametrization="MELANIN", **inputs):
-    """A material whose output is fed by a Principled Hair BSDF with the given inputs."""
+def make_bsdf_material(name, node_type):
+    """A material whose output is fed by one new ``node_type`` BSDF; returns (material, node)."""
     material = bpy.data.materials.new(name)
     material.use_nodes = True
     tree = material.node_tree
@@ -113,11 +113,17 @@ def make_hair_material(name, parametrization="MELANIN", **inputs):
         if node.type != "OUTPUT_MATERIAL":
             tree.nodes.remove(node)
     output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
-    hair = tree.nodes.new("ShaderNodeBsdfHairPrincipled")
+    bsdf = tree.nodes.new(node_type)
+    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    return material, bsdf
+
+
+def make_hair_material(name, parametrization="MELANIN", **inputs):
+    """A material whose output is fed by a Principled Hair BSDF with the given inputs."""
+    material, hair = make_bsdf_material(name, "ShaderNodeBsdfHairPrincipled")
     hair.parametrization = parametrization
     for key, value in inputs.items():
         hair.inputs[key].default_value = value
-    tree.links.new(hair.outputs["BSDF"], output.inputs["Surface"])
     return material
 
 
@@ -226,6 +232,23 @@ def make_curves(scene, hair_material, location=(0.0, 0.0, 1.0), rotation=(0.0, 0
     return obj, positions, radii
 
 
+def make_demo_head(resolution=(480, 360), count=1500, children=10,
+                   sun_rotation=(math.radians(50), 0.0, math.radians(30))):
+    """The demo scene (scripts/render_demo.py): a head of brown particle hair under a sun and a
+    sky, rendered by Hairis. Returns the scene."""
+    scene = reset()
+    scene.render.engine = "HAIRIS"
+    make_camera(scene, location=(0.0, -7.5, 0.3), resolution=resolution, percentage=100)
+    make_world(scene, color=(0.35, 0.45, 0.6), strength=1.0)
+    hair = make_hair_material("Hair", "MELANIN", **{
+        "Melanin": 0.45, "Melanin Redness": 0.5, "Roughness": 0.3, "Radial Roughness": 0.3})
+    skin = make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    make_particle_hair(scene, count=count, children=children, location=(0.0, 0.0, 0.3),
+                       scale=1.3, hair_material=hair, skin_material=skin)
+    make_light(scene, "SUN", "Sun", energy=4.0, angle=math.radians(2.0), rotation=sun_rotation)
+    return scene
+
+
 def make_test_scene(children=None, with_curves=True):
     """The standard test scene: particle hair, Curves, sun, point, area, spot, world, camera."""
     scene = reset()
@@ -256,16 +279,8 @@ def make_test_scene(children=None, with_curves=True):
 
 def make_diffuse_material(name, color):
     """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
-    material = bpy.data.materials.new(name)
-    material.use_nodes = True
-    tree = material.node_tree
-    for node in list(tree.nodes):
-        if node.type != "OUTPUT_MATERIAL":
-            tree.nodes.remove(node)
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    material, diffuse = make_bsdf_material(name, "ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = color
-    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
-    tree.links.new(diffuse.outputs["BSDF"], output.inputs["Surface"])
     return material
 
 
