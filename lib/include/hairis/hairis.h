@@ -177,6 +177,9 @@ HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hair
 
 /**
  * A direction sampler. `fiber` is needed for ANALYTIC (Chiang only), `tables` for TABLE.
+ * TABLE with a chiang2016 `fiber` (optional) samples its single scattering from the fiber's
+ * near-field table, following the offset h (what a renderer shading Cycles' near field wants);
+ * without one, from the tables' h-averaged 2D distribution. Either way the pdf is exact.
  * `multiple_weight` ∈ [0, 1] is the one-sample mixture weight of the multiple-scattering
  * distribution (TABLE and GAUSSIAN), `n_h` selects which multiple distribution: one of the
  * tables' n_h values (TABLE), one of 1, 2, 4, 8, 16 (GAUSSIAN), ignored otherwise. The sampler
