@@ -822,6 +822,10 @@ static void test_sampling(void)
     hairis_sampler *table = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, NULL, g_tables, 0.25f,
                                                   2);
     CHECK(table != NULL, "TABLE");
+    /* With a Chiang fiber, TABLE follows the near field at h (near_field_table.h). */
+    hairis_sampler *table_near = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, chiang, g_tables,
+                                                       0.25f, 2);
+    CHECK(table_near != NULL, "TABLE with a Chiang fiber");
 
     /* A TABLE sampler stays valid after its tables handle is destroyed. */
     hairis_sampler *orphan = NULL;
@@ -840,6 +844,7 @@ static void test_sampling(void)
     if (analytic) check_sample_pdf_consistency(analytic, "analytic");
     if (gaussian) check_sample_pdf_consistency(gaussian, "gaussian");
     if (table) check_sample_pdf_consistency(table, "table");
+    if (table_near) check_sample_pdf_consistency(table_near, "table with a fiber (near field)");
     if (orphan) check_sample_pdf_consistency(orphan, "table (tables destroyed)");
 
     /* The uniform density. */
@@ -939,6 +944,7 @@ static void test_sampling(void)
     hairis_sampler_destroy(analytic);
     hairis_sampler_destroy(gaussian);
     hairis_sampler_destroy(table);
+    hairis_sampler_destroy(table_near);
     hairis_sampler_destroy(orphan);
     hairis_sampler_destroy(NULL);
     CHECK_NO_ERROR();
