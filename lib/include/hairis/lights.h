@@ -36,7 +36,7 @@
 //
 // Light selection: like Cycles 3.4's light distribution (scene/light.cpp,
 // device_update_distribution): emissive triangles as a group get probability 1/2 when there
-// are also lamps (sun, point, area, and here the world), otherwise all of it; a triangle
+// are also lamps (sun, point, area), otherwise all of it; a triangle
 // within the group is chosen in proportion to its area; lamps share the rest uniformly (not by
 // power). Like Cycles 3.4, which disables the background light when the world shader is not
 // spatially varying, hairis does not sample a constant world as a light: paths find it by BSDF
@@ -136,7 +136,7 @@ inline float power_heuristic(float a, float b) {
 /// A light sample for next-event estimation.
 struct LightSample {
     Vec3 wi;                 ///< unit direction from the shading point towards the light
-    float distance = 0;      ///< to the sampled point; infinity for sun and world
+    float distance = 0;      ///< to the sampled point; infinity for a sun
     /// The light's contribution before the BSDF: the estimate is f·value/pdf. For area-like
     /// lights value is the radiance L; for delta lights (point radius 0, sun angle 0) it is
     /// the irradiance at normal incidence (I/d² or E), and pdf the selection probability.
@@ -164,7 +164,7 @@ class LightSet {
 
     LightSet() = default;
 
-    /// Number of lamps (suns, points, areas and the world if it is not black).
+    /// Number of lamps (suns, points and areas; the world is not one).
     int lamp_count() const { return int(lamps_.size()); }
     /// Number of emissive triangles.
     int emissive_triangle_count() const { return int(triangles_.size()); }

@@ -4,9 +4,9 @@
 // Integrator (per camera sample; the vertex where the camera ray lands has depth 0):
 //  - Emission: a ray that reaches an emitter adds throughput × radiance, weighted by the power
 //    heuristic against light sampling when the emitter can be light-sampled (point-light
-//    disks, area lights, suns with a disc, the world, emissive mesh triangles); camera rays
-//    and emitters that are never light-sampled (delta lights cannot be hit; emissive curves)
-//    take weight 1. Lamps are transparent to rays, as in Cycles (kernel/integrator/
+//    disks, area lights, suns with a disc, emissive mesh triangles); camera rays and emitters
+//    that are never light-sampled (a constant world, as in Cycles 3.4; emissive curves) take
+//    weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in Cycles (kernel/integrator/
 //    shade_light.h): every lamp crossed before the next surface contributes.
 //  - Diffuse and transmission limits the same way, per kind of bounce (see RenderSettings).
 //    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
@@ -30,7 +30,8 @@
 //  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never
 //    accumulated; a non-finite throughput ends the path (counted too).
 //
-// Determinism: every random number is rng.h's hash of (seed, pixel, sample, dimension), pixel
+// Determinism: every random number is rng.h's SobolSampleRng (padded Owen-scrambled Sobol,
+// stratified per pixel), a pure function of (seed, pixel, sample, dimension); pixel
 // = y·width + x with y = 0 the bottom row, and each pixel accumulates its samples in sample
 // order in double precision, so the image is bit-identical for any thread count and tile
 // schedule.
