@@ -34,6 +34,25 @@ std::string join_ints(const std::vector<int> &values) {
     return out;
 }
 
+// OIIO 2.4.7's IOMemReader takes any seek and checks a read's end as size + offset in
+// unsigned arithmetic, so a "negative" offset (OpenEXR seeks wherever a damaged chunk table
+// points) wraps past the check and copies from before the buffer. This reader answers a read
+// outside the buffer with 0 bytes, which OpenEXR reports as a truncated file.
+class BoundedMemReader final : public OIIO::Filesystem::IOMemReader {
+public:
+    using IOMemReader::IOMemReader;
+    size_t read(void *buf, size_t size) override {
+        const size_t n = pread(buf, size, m_pos);
+        m_pos += int64_t(n);
+        return n;
+    }
+    size_t pread(void *buf, size_t size, int64_t offset) override {
+        const size_t total = m_buf.size();
+        if (offset < 0 || uint64_t(offset) >= total) return 0;
+        return IOMemReader::pread(buf, std::min(size, total - size_t(offset)), offset);
+    }
+};
+
 // Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
 int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
 
@@ -262,7 +281,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
 Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
     if (Status s = check_exr_header(static_cast<const unsigned char *>(data), size)) return *s;
-    OIIO::Filesystem::IOMemReader proxy(data, size);
+    BoundedMemReader proxy(data, size);
     auto in = OIIO::ImageInput::create("openexr");
     if (!in) return file_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
     // OIIO 2.4 takes the in-memory proxy through the open() configuration.

@@ -272,6 +272,30 @@ TEST(TableFile, RefusesMultiPartFiles) {
     expect_refused(bytes, "multi-part or deep");
 }
 
+// Where the chunk offset table starts: just past the header's terminating NUL.
+size_t offset_table_start(const std::vector<unsigned char> &bytes) {
+    size_t at = 8;  // magic number and version field
+    while (bytes.at(at) != 0) {
+        for (int strings = 0; strings < 2; ++strings)  // attribute name and type
+            at = size_t(std::find(bytes.begin() + std::ptrdiff_t(at), bytes.end(), 0) - bytes.begin()) + 1;
+        int32_t size = 0;
+        std::memcpy(&size, &bytes.at(at), sizeof size);
+        at += sizeof size + size_t(size);
+    }
+    return at + 1;
+}
+
+TEST(TableFile, RefusesChunkOffsetsBeforeTheData) {
+    // A chunk offset of 2^64 - k: OpenEXR seeks there, and OIIO 2.4's in-memory reader then
+    // copied from k bytes before the buffer (found by fuzzing; AddressSanitizer sees the read).
+    for (const uint64_t back : {1u, 4u, 8u, 4096u}) {
+        std::vector<unsigned char> bytes = encode(small_tables());
+        const uint64_t offset = ~uint64_t(0) - back + 1;
+        std::memcpy(&bytes.at(offset_table_start(bytes)), &offset, sizeof offset);
+        expect_refused(bytes, "the pixel data cannot be read");
+    }
+}
+
 TEST(TableSetValidate, NamesTheProblem) {
     TableSet t = small_tables();
     t.theta_r_nodes[1] = t.theta_r_nodes[0];
