@@ -840,7 +840,26 @@ static void test_sampling(void)
         hairis_fiber_destroy(fiber);
     }
 
+    /* Roughness 0, which Blender's slider allows: lobes narrower than a table cell, and TT's
+       mass at grazing below the smallest double (the near-field table refused it once). */
+    hairis_sampler *smooth = NULL;
+    {
+        hairis_principled_hair node;
+        hairis_principled_hair_defaults(&node);
+        node.roughness = 0.0f;
+        hairis_fiber *fiber = hairis_fiber_create_principled(&node);
+        hairis_bake_options o;
+        tiny_options(&o);
+        o.source = 1; /* the seed's Gaussians: fast, and enough for a sampler */
+        hairis_tables *t = hairis_tables_bake(fiber, &o, NULL, NULL);
+        smooth = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, fiber, t, 0.0f, 1);
+        CHECK(smooth != NULL, "TABLE with a fiber of roughness 0: %s", hairis_last_error());
+        hairis_tables_destroy(t);
+        hairis_fiber_destroy(fiber);
+    }
+
     if (uniform_s) check_sample_pdf_consistency(uniform_s, "uniform");
+    if (smooth) check_sample_pdf_consistency(smooth, "table with a fiber of roughness 0");
     if (analytic) check_sample_pdf_consistency(analytic, "analytic");
     if (gaussian) check_sample_pdf_consistency(gaussian, "gaussian");
     if (table) check_sample_pdf_consistency(table, "table");
@@ -946,6 +965,7 @@ static void test_sampling(void)
     hairis_sampler_destroy(table);
     hairis_sampler_destroy(table_near);
     hairis_sampler_destroy(orphan);
+    hairis_sampler_destroy(smooth);
     hairis_sampler_destroy(NULL);
     CHECK_NO_ERROR();
     hairis_fiber_destroy(chiang);
