@@ -236,15 +236,20 @@ LobeShape ChiangFiber::lobe_shape(int p) const {
     return {float(0.5 * kShiftPerAlpha[p] * alpha_), float(0.5 * std::sqrt(lobe_variance(p)))};
 }
 
-ChiangFiber::Outgoing ChiangFiber::outgoing(Vec3 wo) const {
+ChiangFiber::Outgoing ChiangFiber::outgoing_cones(double sin_theta_o) const {
     Outgoing o;
-    o.sin_theta = std::clamp(double(wo.x), -1.0, 1.0);
+    o.sin_theta = std::clamp(sin_theta_o, -1.0, 1.0);
     o.cos_theta = cos_from_sin(o.sin_theta);
+    for (int p = 0; p < 3; ++p) o.cone[p] = rotate(o.sin_theta, o.cos_theta, {tilt_sin_[p], tilt_cos_[p]});
+    return o;
+}
+
+ChiangFiber::Outgoing ChiangFiber::outgoing(Vec3 wo) const {
+    Outgoing o = outgoing_cones(double(wo.x));
     o.phi = std::atan2(double(wo.z), double(wo.y));
     o.k = o.cos_theta / std::sqrt(eta_ * eta_ - o.sin_theta * o.sin_theta);
     const double cos_theta_t = cos_from_sin(o.sin_theta / eta_);
     o.path_scale = 2.0 / cos_theta_t;
-    for (int p = 0; p < 3; ++p) o.cone[p] = rotate(o.sin_theta, o.cos_theta, {tilt_sin_[p], tilt_cos_[p]});
     return o;
 }
 
@@ -397,6 +402,25 @@ float ChiangFiber::pdf(Vec3 wi, Vec3 wo, float h) const {
     return float(density);
 }
 
+// d'Eon: the cosine t to the cone axis (at θ = −θ'_o), then a uniform angle about it; the
+// projection onto the fiber axis is sin θ_i.
+double ChiangFiber::cone_sample(int p, const Outgoing &o, double u_cone, double u_about) const {
+    const SinCos cone = p < 3 ? o.cone[p] : SinCos{o.sin_theta, o.cos_theta};
+    const double t = chiang::sample_cone_cosine(u_cone, lobe_variance(p));
+    return std::clamp(-t * cone.sin + cos_from_sin(t) * std::cos(kTwoPi * u_about) * cone.cos, -1.0, 1.0);
+}
+
+double ChiangFiber::sample_lobe_sin_theta(int p, double sin_theta_o, double u_cone, double u_about) const {
+    if (p < 0 || p > 3) return 0.0;
+    return cone_sample(p, outgoing_cones(sin_theta_o), std::clamp(u_cone, 0.0, 1.0), u_about);
+}
+
+double ChiangFiber::lobe_sampling_density(int p, double sin_theta_i, double sin_theta_o) const {
+    if (p < 0 || p > 3) return 0.0;
+    sin_theta_i = std::clamp(sin_theta_i, -1.0, 1.0);
+    return sampling_longitudinal(p, sin_theta_i, cos_from_sin(sin_theta_i), outgoing_cones(sin_theta_o));
+}
+
 std::optional<ChiangSample> ChiangFiber::sample(Vec3 wo, float h, float u0, float u1,
                                                 float u2) const {
     const Outgoing o = outgoing(wo);
@@ -411,12 +435,7 @@ std::optional<ChiangSample> ChiangFiber::sample(Vec3 wo, float h, float u0, floa
     while (p < last && u >= w[p]) u -= w[p++];
     const double u_longitudinal = std::clamp(u / w[p], 0.0, 1.0);
 
-    // d'Eon: the cosine t to the cone axis (at θ = −θ'_o), then a uniform angle about it;
-    // the projection onto the fiber axis is sin θ_i.
-    const SinCos cone = p < 3 ? o.cone[p] : SinCos{o.sin_theta, o.cos_theta};
-    const double t = chiang::sample_cone_cosine(u_longitudinal, lobe_variance(p));
-    const double sin_theta_i =
-        std::clamp(-t * cone.sin + cos_from_sin(t) * std::cos(kTwoPi * u1) * cone.cos, -1.0, 1.0);
+    const double sin_theta_i = off_axis(float(cone_sample(p, o, u_longitudinal, u1)));
     const double cos_theta_i = cos_from_sin(sin_theta_i);
 
     double phi = kTwoPi * u0;  // residual: uniform

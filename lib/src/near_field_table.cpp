@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 
 #include "hairis/frame.h"
 
@@ -36,6 +39,39 @@ double lobe_peak(const ChiangFiber &fiber, int p, double theta_o) {
     return best;
 }
 
+// Inside a cell the density is linear in t ∈ [0, 1] between the edge values a and b:
+// g(t) = 2((1 − t)a + tb)/(a + b), uniform when both are zero. The cell's mass comes from
+// the exact integral, so a lobe narrower than a cell keeps its mass even when M_p at both
+// edges underflows.
+// The shape depends only on a : b; scaled so the larger is 1, nothing below underflows
+// (edges of a lobe narrower than its cell can be ~10⁻²⁹, whose square is 0 in float, which
+// made the sampler uniform where the density was linear).
+void normalize_edges(float &a, float &b) {
+    const float m = a > b ? a : b;
+    if (m > 0.0f) {
+        a /= m;
+        b /= m;
+    }
+}
+
+float cell_shape(float a, float b, float t) {
+    normalize_edges(a, b);
+    const float sum = a + b;
+    return sum > 0.0f ? 2.0f * ((1.0f - t) * a + t * b) / sum : 1.0f;
+}
+
+// Calls visit(θ, weight) at the 8 Gauss–Legendre points of [a, b].
+template <typename Visit>
+void for_gauss_points(double a, double b, Visit &&visit) {
+    const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+    const auto &x = GaussLegendre8::abscissa();
+    const auto &w = GaussLegendre8::weights();
+    for (size_t j = 0; j < x.size(); ++j) {
+        visit(mid - half * x[j], half * w[j]);
+        visit(mid + half * x[j], half * w[j]);
+    }
+}
+
 // ∫_a^b M_p(θ | θ_o)·cos θ dθ, on panels narrow enough for the lobe's width where the lobe
 // is (within kFinePanelReach widths of its peak), one 8-point panel elsewhere.
 double cell_mass(const ChiangFiber &fiber, int p, double sin_theta_o, double peak, double a, double b) {
@@ -65,6 +101,9 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
             check::count_in_range("theta_o_nodes", options.theta_o_nodes, 2, kMaxThetaRNodes),
             check::count_in_range("theta_i_cells", options.theta_i_cells, 4, kMaxTableAxisCells)))
         return *s;
+    for (LobeSampling m : options.lobe_sampling)
+        if (m != LobeSampling::Auto && m != LobeSampling::Table && m != LobeSampling::Cone)
+            return Error{"NearFieldTable: lobe_sampling must be Auto, Table or Cone"};
     NearFieldTable table;
     table.fiber_ = std::move(fiber);
 
@@ -122,7 +161,95 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
     });
     if (!cdfs) return cdfs.error();
     table.cdfs_ = std::move(cdfs).value();
+
+    // Per node and lobe, the table row or the cone, whichever is closer to M_p over the
+    // θ_o around the node: the sum of both adjacent intervals' divergences, each averaged
+    // over its interval by Simpson's rule on t ∈ {0, ¼, ½} (symmetric about ½ to first
+    // order): the table is exact at a node and least accurate halfway. Every interval is
+    // probed, as the better choice can flip within a few nodes (probing every 4th chose the
+    // cone for TT at θ_o = 70°, roughness 0.2, with 15× the rows' variance).
+    // Without probing: the residual is not tilted, so the cone samples exactly Cycles' M_p
+    // there; a lobe wider than kWideCells cells is followed by the table to ~10⁻⁶ while the
+    // cone still misplaces it by its tilt.
+    constexpr double kWideCells = 8.0;
+    enum class AutoChoice { Probe, Table, Cone };
+    std::array<AutoChoice, 4> auto_lobe{};
+    for (int p = 0; p < 4; ++p)
+        auto_lobe[size_t(p)] = p == 3 ? AutoChoice::Cone
+                               : std::sqrt(f.lobe_variance(p)) > kWideCells * kPi / cells ? AutoChoice::Table
+                                                                                        : AutoChoice::Probe;
+    const int intervals = nodes - 1;
+    std::vector<Divergences> d(size_t(intervals) * 4);
+    tbb::parallel_for(0, intervals * 4, [&](int i) {
+        const int r = i / 4, p = i % 4;
+        if (auto_lobe[size_t(p)] != AutoChoice::Probe || options.lobe_sampling[size_t(p)] != LobeSampling::Auto)
+            return;
+        Divergences sum;
+        for (const auto &[t, weight] : {std::pair{0.0f, 1.0}, std::pair{0.25f, 4.0}, std::pair{0.5f, 1.0}}) {
+            const Divergences at = table.divergences(r, p, t);
+            sum.table += weight / 6.0 * at.table;
+            sum.cone += weight / 6.0 * at.cone;
+        }
+        d[size_t(i)] = sum;
+    });
+    table.cone_.assign(size_t(rows), 0);
+    for (int r = 0; r < nodes; ++r) {
+        for (int p = 0; p < 4; ++p) {
+            Divergences sum;
+            for (int i : {r - 1, r})
+                if (i >= 0 && i < intervals) {
+                    sum.table += d[size_t(i) * 4 + size_t(p)].table;
+                    sum.cone += d[size_t(i) * 4 + size_t(p)].cone;
+                }
+            const LobeSampling m = options.lobe_sampling[size_t(p)];
+            const bool closer = auto_lobe[size_t(p)] == AutoChoice::Probe ? sum.cone < sum.table
+                                                                           : auto_lobe[size_t(p)] == AutoChoice::Cone;
+            table.cone_[size_t(r) * 4 + size_t(p)] = m == LobeSampling::Cone || (m == LobeSampling::Auto && closer);
+        }
+    }
     return table;
+}
+
+NearFieldTable::Divergences NearFieldTable::divergences(int r, int p, float t_node) const {
+    // χ² divergences ∫ t²/q d(sin θ_i) − 1 of the blend of rows r and r + 1 (q_table) and of
+    // the cone (q_cone) from the lobe's normalized M_p (t = M_p / I_p) at θ_o a fraction
+    // t_node of the way from node r to r + 1: the lobe's relative variance under each.
+    const int cells = cells_.count();
+    const ChiangFiber &f = *fiber_;
+    const double lower = double(nodes_.values()[size_t(r)]), upper = double(nodes_.values()[size_t(r) + 1]);
+    const double theta_o = lower + double(t_node) * (upper - lower);
+    const double sin_o = std::sin(theta_o), peak = lobe_peak(f, p, theta_o);
+    const double width = std::sqrt(f.lobe_variance(p));
+    // Points where M_p is below 1e-12 of its peak carry no mass that matters; there a
+    // candidate's density may underflow to 0 first, which would read as an infinite divergence.
+    const double negligible = 1e-12 * f.longitudinal(p, std::sin(peak), sin_o);
+    double integral = 0, sum_table = 0, sum_cone = 0;
+    for (int k = 0; k < cells; ++k) {
+        const double a = -kHalfPi + kPi * k / cells, b = -kHalfPi + kPi * (k + 1) / cells;
+        const double distance = peak < a ? a - peak : (peak > b ? peak - b : 0.0);
+        const int panels = distance > kFinePanelReach * width
+                               ? 1
+                               : std::clamp(int(std::ceil((b - a) / (0.5 * width))), 1, kMaxPanelsPerCell);
+        const double step = (b - a) / panels;
+        const float *e0 = edge(r * 4 + p) + k, *e1 = edge((r + 1) * 4 + p) + k;
+        const double pmf0 = double(1.0f - t_node) * cdfs_.pmf(r * 4 + p, k);
+        const double pmf1 = double(t_node) * cdfs_.pmf((r + 1) * 4 + p, k);
+        for (int j = 0; j < panels; ++j)
+            for_gauss_points(a + j * step, a + (j + 1) * step, [&](double theta, double weight) {
+                const double s = std::sin(theta), w = weight * std::cos(theta);
+                const double m = f.longitudinal(p, s, sin_o);
+                if (!(m > negligible)) return;
+                const float t = std::clamp(float((s - cells_.sin_edge(k)) / cells_.sin_width(k)), 0.0f, 1.0f);
+                const double q_table = (pmf0 * cell_shape(e0[0], e0[1], t) + pmf1 * cell_shape(e1[0], e1[1], t)) /
+                                       double(cells_.sin_width(k));
+                const double q_cone = f.lobe_sampling_density(p, s, sin_o);
+                integral += w * m;
+                sum_table += q_table > 0.0 ? w * m * m / q_table : std::numeric_limits<double>::infinity();
+                sum_cone += q_cone > 0.0 ? w * m * m / q_cone : std::numeric_limits<double>::infinity();
+            });
+    }
+    if (!(integral > 0.0)) return {};
+    return {sum_table / (integral * integral) - 1.0, sum_cone / (integral * integral) - 1.0};
 }
 
 size_t NearFieldTable::memory_bytes() const {
@@ -135,17 +262,9 @@ namespace {
 
 float clamp_unit(float u) { return u > 0.0f ? (u < kOneMinusEpsilon ? u : kOneMinusEpsilon) : 0.0f; }
 
-// Inside a cell the density is linear in t ∈ [0, 1] between the edge values a and b:
-// g(t) = 2((1 − t)a + tb)/(a + b), uniform when both are zero. The cell's mass comes from
-// the exact integral, so a lobe narrower than a cell keeps its mass even when M_p at both
-// edges underflows.
-float cell_shape(float a, float b, float t) {
-    const float sum = a + b;
-    return sum > 0.0f ? 2.0f * ((1.0f - t) * a + t * b) / sum : 1.0f;
-}
-
 // Inverse of g's CDF: t = u(a + b)/(a + sqrt((1 − u)a² + ub²)), stable also for a = b.
 float sample_cell_shape(float a, float b, float u) {
+    normalize_edges(a, b);
     const float sum = a + b;
     if (!(sum > 0.0f)) return u;
     const float root = std::sqrt((1.0f - u) * a * a + u * b * b);
@@ -160,6 +279,7 @@ NearFieldTable::Prepared NearFieldTable::prepare(Vec3 wo, float h) const {
     const ChiangFiber::LobeGeometry g = fiber_->lobe_geometry(wo, h);
     for (int p = 0; p < 3; ++p) q.shift[p] = g.shift[size_t(p)];
     q.theta_o = safe_asin(wo.x);
+    q.sin_theta_o = std::clamp(double(wo.x), -1.0, 1.0);
     q.blend = nodes_.locate(q.theta_o);
     // Lobe weights luminance(A_p)·I_p at both nodes, normalized per node.
     for (int side = 0; side < 2; ++side) {
@@ -188,6 +308,8 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
     azimuthal[3] = kInvTwoPi;
     const float t_in_cell = std::clamp((wi.x - cells_.sin_edge(k)) / cells_.sin_width(k), 0.0f, 1.0f);
 
+    // Per unit sin θ_i: a table row's cell mass over the cell's width, or a cone lobe's M_p.
+    double longitudinal[4] = {-1, -1, -1, -1};  // cone lobes: computed once, at first use
     double pdf = 0;
     const float node_weight[2] = {1.0f - q.blend.t, q.blend.t};
     for (int side = 0; side < 2; ++side) {
@@ -196,13 +318,21 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
         double d = 0;
         for (int p = 0; p < 4; ++p) {
             if (!(q.weight[side][p] > 0.0f)) continue;
-            const float *e = edge(r * 4 + p) + k;
-            d += double(q.weight[side][p]) * double(cdfs_.pmf(r * 4 + p, k)) *
-                 double(cell_shape(e[0], e[1], t_in_cell)) * azimuthal[p];
+            double m = 0;
+            if (cone_[size_t(r) * 4 + size_t(p)]) {
+                if (longitudinal[p] < 0)
+                    longitudinal[p] = fiber_->lobe_sampling_density(p, double(wi.x), q.sin_theta_o);
+                m = longitudinal[p];
+            } else {
+                const float *e = edge(r * 4 + p) + k;
+                m = double(cdfs_.pmf(r * 4 + p, k)) * double(cell_shape(e[0], e[1], t_in_cell)) /
+                    double(cells_.sin_width(k));
+            }
+            d += double(q.weight[side][p]) * m * azimuthal[p];
         }
         pdf += double(node_weight[side]) * d;
     }
-    return float(pdf / double(cells_.sin_width(k)));
+    return float(pdf);
 }
 
 float NearFieldTable::pdf(Vec3 wi, Vec3 wo, float h) const { return density(prepare(wo, h), wi); }
@@ -231,10 +361,20 @@ std::optional<NearFieldSample> NearFieldTable::sample(const Prepared &q, float u
     }
     while (p > 0 && !(w[p] > 0.0f)) --p;  // rounding left u past the last positive lobe
 
-    const CellChoice c = cdfs_.sample(r * 4 + p, u1);
-    const float *e = edge(r * 4 + p) + c.index;
-    const LongitudinalCells::Point point = cells_.point_in_cell(
-        c.index, std::min(sample_cell_shape(e[0], e[1], c.fraction), kOneMinusEpsilon));
+    float sin_theta = 0, cos_theta = 1;
+    if (cone_[size_t(r) * 4 + size_t(p)]) {
+        // What is left of u inside the lobe's interval picks the cone's cosine; u1 the angle.
+        const double u_cone = w[p] > 0.0f ? std::clamp(double(u) / double(w[p]), 0.0, 1.0) : 0.0;
+        sin_theta = off_axis(float(fiber_->sample_lobe_sin_theta(p, q.sin_theta_o, u_cone, double(clamp_unit(u1)))));
+        cos_theta = std::sqrt((1.0f - sin_theta) * (1.0f + sin_theta));
+    } else {
+        const CellChoice c = cdfs_.sample(r * 4 + p, u1);
+        const float *e = edge(r * 4 + p) + c.index;
+        const LongitudinalCells::Point point = cells_.point_in_cell(
+            c.index, std::min(sample_cell_shape(e[0], e[1], c.fraction), kOneMinusEpsilon));
+        sin_theta = point.sin_theta;
+        cos_theta = point.cos_theta;
+    }
     double phi = -kPi + kTwoPi * double(clamp_unit(u0));  // residual: uniform
     if (p < 3) phi = q.shift[p] + fiber_->azimuthal().sample(clamp_unit(u0));
     // φ_i = φ_o + φ, by rotation.
@@ -243,7 +383,7 @@ std::optional<NearFieldSample> NearFieldTable::sample(const Prepared &q, float u
     const double sin_phi_i = q.sin_phi_o * c_phi + q.cos_phi_o * s_phi;
 
     NearFieldSample s;
-    s.wi = Vec3{point.sin_theta, float(point.cos_theta * cos_phi_i), float(point.cos_theta * sin_phi_i)};
+    s.wi = Vec3{sin_theta, float(cos_theta * cos_phi_i), float(cos_theta * sin_phi_i)};
     s.lobe = p;
     s.pdf = density(q, s.wi);
     if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return std::nullopt;

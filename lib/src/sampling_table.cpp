@@ -96,7 +96,10 @@ Expected<LongitudinalCells> LongitudinalCells::create(int count) {
             return Error{"theta_i_count = " + std::to_string(count) +
                          " leaves a cell with no width in sin(theta) at float precision"};
         c.last_sin_[size_t(k)] =
-            k + 1 == count ? 1.0f : std::nextafter(c.sin_edges_[size_t(k) + 1], -2.0f);
+            k + 1 == count ? kOneMinusEpsilon : std::nextafter(c.sin_edges_[size_t(k) + 1], -2.0f);
+        if (!(c.last_sin_[size_t(k)] >= (k == 0 ? -kOneMinusEpsilon : c.sin_edges_[size_t(k)])))
+            return Error{"theta_i_count = " + std::to_string(count) +
+                         " leaves a cell with no width in sin(theta) at float precision"};
     }
     // Guide over s ∈ [−1, 1] with 4·count (rounded up to 2^m) buckets: entry g is the cell of
     // the bucket's lower end; cell_of_sin() corrects by stepping, which stays short because

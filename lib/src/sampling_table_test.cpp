@@ -464,6 +464,22 @@ TEST(LongitudinalCells, LookupBySinThetaMatchesTheEdges) {
     }
 }
 
+TEST(LongitudinalCells, SamplesStayOffTheFiberAxis) {
+    // On the axis (|sin θ| = 1) φ is undefined: a sample there would carry its φ in name only
+    // and pdf() would read another. Rounding put ~10⁻⁴ of a polar cell's points there.
+    for (int n : {1, 2, 90, 4096}) {
+        const LongitudinalCells c = unwrap(LongitudinalCells::create(n));
+        for (float t : {0.0f, 1e-9f, 1e-5f, kOneMinusEpsilon}) {
+            for (int k : {0, n - 1}) {
+                const LongitudinalCells::Point p = c.point_in_cell(k, t);
+                EXPECT_LT(std::fabs(p.sin_theta), 1.0f) << n << " " << k << " " << t;
+                EXPECT_GT(p.cos_theta, 0.0f) << n << " " << k << " " << t;
+                EXPECT_EQ(c.cell_of_sin(p.sin_theta), k) << n << " " << k << " " << t;
+            }
+        }
+    }
+}
+
 TEST(AzimuthTrig, MatchesCosAndSin) {
     const AzimuthTrig trig;
     for (int k = 0; k <= 100000; ++k) {

@@ -157,6 +157,13 @@ class ChiangFiber final : public FiberModel {
     /// per cos θ_i dθ_i before the tilt), the factor of f_cos_near that does not depend on h.
     double longitudinal(int p, double sin_theta_i, double sin_theta_o) const;
 
+    /// Lobe p's part of sample(): sin θ_i drawn from the sampler's M_p (d'Eon's cone about
+    /// the direction tilted from θ_o by δ_p; u_cone picks its cosine, u_about the angle
+    /// about it). For samplers that pick the lobe themselves (near_field_table.h).
+    double sample_lobe_sin_theta(int p, double sin_theta_o, double u_cone, double u_about) const;
+    /// The density of sample_lobe_sin_theta() per unit sin θ_i: the term pdf() uses for lobe p.
+    double lobe_sampling_density(int p, double sin_theta_i, double sin_theta_o) const;
+
     /// The validated parameters as given.
     const ChiangParams &params() const { return params_; }
     /// The mapped longitudinal variance of lobe p (R: coat-reduced v_m0, TT: v/4, TRT and
@@ -175,11 +182,13 @@ class ChiangFiber final : public FiberModel {
     struct FarSlice;
 
     Outgoing outgoing(Vec3 wo) const;
+    Outgoing outgoing_cones(double sin_theta_o) const;  // θ and the cones only
     Attenuation attenuation_at(const Outgoing &o, double sin_gamma_o) const;
     double tilted_longitudinal(int p, double sin_theta_i, double cos_theta_i,
                                const Outgoing &o) const;
     double sampling_longitudinal(int p, double sin_theta_i, double cos_theta_i,
                                  const Outgoing &o) const;
+    double cone_sample(int p, const Outgoing &o, double u_cone, double u_about) const;
     FarSlice &far_slice(const Outgoing &o) const;
     std::array<double, 3> far_azimuthal(int p, const Outgoing &o, double phi) const;
     std::array<double, 3> far_azimuthal_uncached(int p, const Outgoing &o, double phi,

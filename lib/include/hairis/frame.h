@@ -65,6 +65,14 @@ double wrap_angle(double a);
 inline float relative_azimuth(float phi_i, float phi_o) { return wrap_angle(phi_i - phi_o); }
 
 /// Marschner's half and difference angles: θ_h = (θ_i + θ_o)/2, θ_d = (θ_o − θ_i)/2.
+/// sin θ of a sampled direction kept off the fiber axis (|sin θ| ≤ the largest float below 1):
+/// on the axis φ is undefined, so a sample there would carry its φ in name only while pdf()
+/// and f read another.
+inline float off_axis(float sin_theta) {
+    constexpr float kMax = 0x1.fffffep-1f;
+    return sin_theta < -kMax ? -kMax : (sin_theta > kMax ? kMax : sin_theta);
+}
+
 inline float theta_half(float theta_i, float theta_o) { return 0.5f * (theta_i + theta_o); }
 inline float theta_diff(float theta_i, float theta_o) { return 0.5f * (theta_o - theta_i); }
 

@@ -23,8 +23,17 @@
 // blend between nodes: relative variance ~10⁻⁵ against the analytic sampler's ~10⁻² (whose
 // M_p is tilted on θ_o instead of θ_i). The blend dominates, so the defaults spend memory on
 // nodes rather than cells (bench/results/strategy_study.md, section 4a).
+//
+// Smooth fibers (roughness below ~0.1) have lobes narrower than the cells and the node
+// spacing, which a table in (θ_o, θ_i) cannot follow; the fiber's own cone sampler
+// (ChiangFiber::sample_lobe_sin_theta, d'Eon's, with the tilt on θ_o) follows them at any
+// width but misplaces a wide lobe by its tilt. So each lobe takes whichever of the two has
+// the smaller χ² divergence from Cycles' M_p (∫ M²/q − 1, the lobe's relative variance),
+// measured at build time halfway between nodes, where the table is least accurate. The lobe
+// is still chosen with the table's weights, and its density enters the same mixture.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -38,10 +47,18 @@
 
 namespace hairis {
 
+/// Where a lobe of the near-field table draws θ_i from (NearFieldTableOptions::lobe_sampling).
+enum class LobeSampling { Auto, Table, Cone };
+
 /// Resolution of a NearFieldTable (chosen in docs/performance.md's resolution sweep).
 struct NearFieldTableOptions {
     int theta_o_nodes = 121;  ///< nodes over [−π/2, π/2], ends included (1.5° apart)
     int theta_i_cells = 90;   ///< equal θ_i cells over [−π/2, π/2] (2° wide)
+    /// How lobe p (R, TT, TRT, residual) draws θ_i: from its table row, from the fiber's own
+    /// cone sampler, or (Auto) from whichever of the two is closer to Cycles' M_p, measured
+    /// when the table is built.
+    std::array<LobeSampling, 4> lobe_sampling = {LobeSampling::Auto, LobeSampling::Auto,
+                                                 LobeSampling::Auto, LobeSampling::Auto};
 };
 
 /// A sampled direction of the near-field table, with the lobe it came from.
@@ -63,6 +80,7 @@ class NearFieldTable {
     /// nodes and their lobe weights, the lobes' azimuthal centres and the view's azimuth.
     struct Prepared {
         float theta_o = 0;  // asin(ω_o.x)
+        double sin_theta_o = 0;
         NodeBlend blend;
         float weight[2][4] = {};  // lobe probabilities at the lower and upper node
         double shift[3] = {};
@@ -83,11 +101,17 @@ class NearFieldTable {
     int theta_i_cells() const { return cells_.count(); }
     /// ∫ M_p(θ_i | θ_o node r)·cos θ_i dθ_i: 1 without a tilt, not exactly 1 with one.
     double lobe_integral(int r, int p) const { return integral_[size_t(r) * 4 + size_t(p)]; }
+    /// True when lobe p at θ_o node r draws θ_i from the fiber's cone sampler (see lobe_sampling).
+    bool uses_cone(int r, int p) const { return cone_[size_t(r) * 4 + size_t(p)] != 0; }
     /// Bytes the tables hold (CDFs, guides, integrals).
     size_t memory_bytes() const;
 
   private:
     NearFieldTable() = default;
+    struct Divergences {
+        double table = 0, cone = 0;
+    };
+    Divergences divergences(int r, int p, float t_node) const;
 
     std::shared_ptr<const ChiangFiber> fiber_;
     ThetaRNodes nodes_;
@@ -97,6 +121,7 @@ class NearFieldTable {
     DiscreteCdfs cdfs_;              // row r·4 + p: the cells' masses
     std::vector<float> edge_;        // row r·4 + p: M_p at the cells' edges
     std::vector<double> integral_;  // r·4 + p
+    std::vector<unsigned char> cone_;  // row r·4 + p: 1 when the lobe draws from the cone
 };
 
 /// The near-field table as a strategy (no multiple-scattering part).

@@ -157,10 +157,13 @@ class LongitudinalCells {
         return k;
     }
     /// The point of cell k at fraction t ∈ [0, 1) of its sin θ range, kept inside the cell so
-    /// that cell_of_sin() returns k for it.
+    /// that cell_of_sin() returns k for it, and off the fiber axis (|sin θ| < 1): there φ is
+    /// undefined, so a sample would carry its φ in name only while pdf() and f read another
+    /// (rounding put ~10⁻⁴ of a polar cell's samples exactly on the axis).
     Point point_in_cell(int k, float t) const {
+        const float lo = k == 0 ? -kOneMinusEpsilon : sin_edge(k);
         float s = sin_edge(k) + t * sin_width(k);
-        s = s < sin_edge(k) ? sin_edge(k) : (s > last_sin_[size_t(k)] ? last_sin_[size_t(k)] : s);
+        s = s < lo ? lo : (s > last_sin_[size_t(k)] ? last_sin_[size_t(k)] : s);
         return {s, std::sqrt((1.0f - s) * (1.0f + s))};
     }
 
