@@ -43,19 +43,7 @@ double lobe_peak(const ChiangFiber &fiber, int p, double theta_o) {
 // g(t) = 2((1 − t)a + tb)/(a + b), uniform when both are zero. The cell's mass comes from
 // the exact integral, so a lobe narrower than a cell keeps its mass even when M_p at both
 // edges underflows.
-// The shape depends only on a : b; scaled so the larger is 1, nothing below underflows
-// (edges of a lobe narrower than its cell can be ~10⁻²⁹, whose square is 0 in float, which
-// made the sampler uniform where the density was linear).
-void normalize_edges(float &a, float &b) {
-    const float m = a > b ? a : b;
-    if (m > 0.0f) {
-        a /= m;
-        b /= m;
-    }
-}
-
 float cell_shape(float a, float b, float t) {
-    normalize_edges(a, b);
     const float sum = a + b;
     return sum > 0.0f ? 2.0f * ((1.0f - t) * a + t * b) / sum : 1.0f;
 }
@@ -168,22 +156,21 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
     // order): the table is exact at a node and least accurate halfway. Every interval is
     // probed, as the better choice can flip within a few nodes (probing every 4th chose the
     // cone for TT at θ_o = 70°, roughness 0.2, with 15× the rows' variance).
-    // Without probing: the residual is not tilted, so the cone samples exactly Cycles' M_p
-    // there; a lobe wider than kWideCells cells is followed by the table to ~10⁻⁶ while the
-    // cone still misplaces it by its tilt.
+    // Without probing: a lobe wider than kWideCells cells is followed by the table to ~10⁻⁶
+    // while the cone still misplaces it by its tilt. (The residual is not tilted: the cone
+    // samples exactly Cycles' M_p there, and is taken wherever the row is not good enough.)
     constexpr double kWideCells = 8.0;
-    enum class AutoChoice { Probe, Table, Cone };
-    std::array<AutoChoice, 4> auto_lobe{};
-    for (int p = 0; p < 4; ++p)
-        auto_lobe[size_t(p)] = p == 3 ? AutoChoice::Cone
-                               : std::sqrt(f.lobe_variance(p)) > kWideCells * kPi / cells ? AutoChoice::Table
-                                                                                        : AutoChoice::Probe;
+    // A lobe's relative variance under 10⁻³ is lost next to the ~0.03 that the offset h alone
+    // contributes (bench/strategy_study.cpp): there the row is kept even if the cone would be
+    // closer, as the cone costs time (M_p evaluated at every pdf) for nothing a render sees.
+    constexpr double kGoodEnough = 1e-3;
+    std::array<bool, 4> probe{};
+    for (int p = 0; p < 4; ++p) probe[size_t(p)] = !(std::sqrt(f.lobe_variance(p)) > kWideCells * kPi / cells);
     const int intervals = nodes - 1;
     std::vector<Divergences> d(size_t(intervals) * 4);
     tbb::parallel_for(0, intervals * 4, [&](int i) {
         const int r = i / 4, p = i % 4;
-        if (auto_lobe[size_t(p)] != AutoChoice::Probe || options.lobe_sampling[size_t(p)] != LobeSampling::Auto)
-            return;
+        if (!probe[size_t(p)] || options.lobe_sampling[size_t(p)] != LobeSampling::Auto) return;
         Divergences sum;
         for (const auto &[t, weight] : {std::pair{0.0f, 1.0}, std::pair{0.25f, 4.0}, std::pair{0.5f, 1.0}}) {
             const Divergences at = table.divergences(r, p, t);
@@ -202,8 +189,8 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
                     sum.cone += d[size_t(i) * 4 + size_t(p)].cone;
                 }
             const LobeSampling m = options.lobe_sampling[size_t(p)];
-            const bool closer = auto_lobe[size_t(p)] == AutoChoice::Probe ? sum.cone < sum.table
-                                                                           : auto_lobe[size_t(p)] == AutoChoice::Cone;
+            const int adjacent = (r > 0) + (r < intervals);
+            const bool closer = probe[size_t(p)] && sum.table > kGoodEnough * adjacent && sum.cone < sum.table;
             table.cone_[size_t(r) * 4 + size_t(p)] = m == LobeSampling::Cone || (m == LobeSampling::Auto && closer);
         }
     }
@@ -264,7 +251,14 @@ float clamp_unit(float u) { return u > 0.0f ? (u < kOneMinusEpsilon ? u : kOneMi
 
 // Inverse of g's CDF: t = u(a + b)/(a + sqrt((1 − u)a² + ub²)), stable also for a = b.
 float sample_cell_shape(float a, float b, float u) {
-    normalize_edges(a, b);
+    // Only a : b matters. Edges of a lobe narrower than its cell can be ~10⁻²⁹, whose square
+    // is 0 in float (which made the sampler uniform where the density was linear): such
+    // edges, and any whose square could overflow, are scaled so that the larger is 1.
+    const float larger = a > b ? a : b;
+    if (larger > 0.0f && (larger < 1e-18f || larger > 1e18f)) {
+        a /= larger;
+        b /= larger;
+    }
     const float sum = a + b;
     if (!(sum > 0.0f)) return u;
     const float root = std::sqrt((1.0f - u) * a * a + u * b * b);

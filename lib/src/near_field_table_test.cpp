@@ -183,15 +183,19 @@ TEST(NearFieldTable, EachLobeSourceIsExact) {
 }
 
 TEST(NearFieldTable, ChoosesTheConeForNarrowLobesAndTheTableForWideOnes) {
-    // Roughness 0.05: lobes about a cell wide, which the rows smear; roughness 0.6: lobes
-    // many cells wide, which the rows follow and the tilted cone does not. The residual is
-    // not tilted, so the cone samples it exactly.
+    // Roughness 0: every lobe far narrower than a cell, which the rows smear. Roughness 0.05:
+    // TT about a cell wide. Roughness 0.3 (Cycles' default) and 0.6: the rows follow every
+    // lobe to well under 10⁻³, so they are kept (the cone would cost time at every pdf).
+    const NearFieldTable smoothest = NearFieldTable::create(fiber(0.0f)).value();
     const NearFieldTable smooth = NearFieldTable::create(fiber(0.05f)).value();
-    const NearFieldTable rough = NearFieldTable::create(fiber(0.6f)).value();
     const int r0 = (smooth.theta_o_nodes() - 1) / 2;
+    for (int p = 0; p < 4; ++p) EXPECT_TRUE(smoothest.uses_cone(r0, p)) << p;
     EXPECT_TRUE(smooth.uses_cone(r0, 1));
-    for (int p = 0; p < 3; ++p) EXPECT_FALSE(rough.uses_cone(r0, p)) << p;
-    EXPECT_TRUE(rough.uses_cone(r0, 3));
+    for (float roughness : {0.3f, 0.6f}) {
+        const NearFieldTable rough = NearFieldTable::create(fiber(roughness)).value();
+        for (int r = 0; r < rough.theta_o_nodes(); ++r)
+            for (int p = 0; p < 4; ++p) ASSERT_FALSE(rough.uses_cone(r, p)) << roughness << " " << r << " " << p;
+    }
 }
 
 // Relative variance of luminance(f·cos)/pdf under a sampler (a Monte Carlo estimate).

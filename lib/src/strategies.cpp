@@ -17,7 +17,7 @@ const char *strategy_name(StrategyKind kind) {
 }
 
 std::optional<DirectionSample> UniformSampler::sample(Vec3, float, float u0, float u1, float) const {
-    const float x = 1.0f - 2.0f * u0;
+    const float x = off_axis(1.0f - 2.0f * u0);
     const float r = std::sqrt(std::max(0.0f, 1.0f - x * x));
     const float phi = float(kTwoPi) * u1;
     return DirectionSample{{x, r * std::cos(phi), r * std::sin(phi)}, float(kInvFourPi)};
