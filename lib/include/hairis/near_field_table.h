@@ -54,7 +54,8 @@ namespace hairis {
 /// Where a lobe of the near-field table draws θ_i from (NearFieldTableOptions::lobe_sampling).
 enum class LobeSampling { Auto, Table, Cone };
 
-/// Resolution of a NearFieldTable (chosen in docs/performance.md's resolution sweep).
+/// Resolution and lobe sources of a NearFieldTable (resolution chosen in the sweep of
+/// bench/results/strategy_study.md, section 4a).
 struct NearFieldTableOptions {
     int theta_o_nodes = 121;  ///< nodes over [−π/2, π/2], ends included (1.5° apart)
     int theta_i_cells = 90;   ///< equal θ_i cells over [−π/2, π/2] (2° wide)
