@@ -90,6 +90,7 @@ hairis_camera camera(int width, int height) {
 
 hairis_render_settings settings(int strategy, int samples, int bounces) {
     hairis_render_settings s;
+    std::memset(&s, 0, sizeof s);  // its padding goes into the seed bytes too
     hairis_render_settings_defaults(&s);
     s.strategy = strategy;
     s.samples = samples;
@@ -120,6 +121,13 @@ Blob scene(const std::vector<uint8_t> &first, const std::vector<std::array<float
 
 }  // namespace
 
+// A seed that changes one field of a valid struct.
+template <typename T>
+struct EditCase {
+    const char *name;
+    void (*edit)(T &);
+};
+
 int main(int argc, char **argv) {
     if (argc != 2) {
         std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
@@ -147,8 +155,7 @@ int main(int argc, char **argv) {
         add("marschner_bake_sample", b);
     }
     // Bad Principled inputs, one field at a time.
-    struct NodeCase { const char *name; void (*edit)(hairis_principled_hair &); };
-    const NodeCase node_cases[] = {
+    const EditCase<hairis_principled_hair> node_cases[] = {
         {"principled_nan_roughness", [](hairis_principled_hair &n) { n.roughness = kNaN; }},
         {"principled_inf_melanin", [](hairis_principled_hair &n) { n.melanin = kInf; }},
         {"principled_negative_melanin", [](hairis_principled_hair &n) { n.melanin = -1; }},
@@ -167,16 +174,19 @@ int main(int argc, char **argv) {
          }},
         {"principled_coat_nan", [](hairis_principled_hair &n) { n.coat = kNaN; }},
     };
-    for (const NodeCase &c : node_cases) {
-        hairis_principled_hair n = node();
-        c.edit(n);
-        Blob b;
-        b.op(kPrincipled).put(n);
-        eval(b);
-        add(c.name, b);
-    }
-    struct MarschnerCase { const char *name; void (*edit)(hairis_marschner_params &); };
-    const MarschnerCase marschner_cases[] = {
+    // Each a fiber from the edited struct, then an evaluation with it.
+    auto add_fiber_cases = [&](const auto &cases, const auto &base, Op op) {
+        for (const auto &c : cases) {
+            auto value = base;
+            c.edit(value);
+            Blob b;
+            b.op(op).put(value);
+            eval(b);
+            add(c.name, b);
+        }
+    };
+    add_fiber_cases(node_cases, node(), kPrincipled);
+    const EditCase<hairis_marschner_params> marschner_cases[] = {
         {"marschner_eta_below_1", [](hairis_marschner_params &m) { m.eta = 0.9f; }},
         {"marschner_nan_beta", [](hairis_marschner_params &m) { m.beta_tt = kNaN; }},
         {"marschner_negative_beta", [](hairis_marschner_params &m) { m.beta_r = -0.1f; }},
@@ -184,17 +194,9 @@ int main(int argc, char **argv) {
         {"marschner_inf_eccentricity", [](hairis_marschner_params &m) { m.eccentricity = kInf; }},
         {"marschner_zero_eccentricity", [](hairis_marschner_params &m) { m.eccentricity = 0; }},
     };
-    for (const MarschnerCase &c : marschner_cases) {
-        hairis_marschner_params m = marschner();
-        c.edit(m);
-        Blob b;
-        b.op(kMarschner).put(m);
-        eval(b);
-        add(c.name, b);
-    }
+    add_fiber_cases(marschner_cases, marschner(), kMarschner);
     // Bake options: huge (refused before allocating), large but valid (cancelled), broken.
-    struct BakeCase { const char *name; void (*edit)(hairis_bake_options &); };
-    const BakeCase bake_cases[] = {
+    const EditCase<hairis_bake_options> bake_cases[] = {
         {"bake_huge_resolution", [](hairis_bake_options &o) {
              o.theta_r_count = 1024;
              o.theta_i_count = 4096;
@@ -213,7 +215,7 @@ int main(int argc, char **argv) {
         {"bake_exact_cancelled", [](hairis_bake_options &o) { o.source = 0; }},
         {"bake_negative_threads", [](hairis_bake_options &o) { o.threads = -1; }},
     };
-    for (const BakeCase &c : bake_cases) {
+    for (const auto &c : bake_cases) {
         hairis_bake_options o = tiny_bake();
         c.edit(o);
         Blob b;
