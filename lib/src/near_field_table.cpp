@@ -5,8 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 #include "hairis/frame.h"
@@ -60,14 +58,18 @@ void for_gauss_points(double a, double b, Visit &&visit) {
     }
 }
 
-// ∫_a^b M_p(θ | θ_o)·cos θ dθ, on panels narrow enough for the lobe's width where the lobe
-// is (within kFinePanelReach widths of its peak), one 8-point panel elsewhere.
-double cell_mass(const ChiangFiber &fiber, int p, double sin_theta_o, double peak, double a, double b) {
-    const double width = std::sqrt(fiber.lobe_variance(p));
+// Quadrature panels for [a, b] of a lobe `width` wide peaking at `peak`: narrow enough for
+// the lobe within kFinePanelReach widths of its peak, one 8-point panel elsewhere.
+int panel_count(double width, double peak, double a, double b) {
     const double distance = peak < a ? a - peak : (peak > b ? peak - b : 0.0);
-    const int panels = distance > kFinePanelReach * width
-                           ? 1
-                           : std::clamp(int(std::ceil((b - a) / (0.5 * width))), 1, kMaxPanelsPerCell);
+    return distance > kFinePanelReach * width
+               ? 1
+               : std::clamp(int(std::ceil((b - a) / (0.5 * width))), 1, kMaxPanelsPerCell);
+}
+
+// ∫_a^b M_p(θ | θ_o)·cos θ dθ on panel_count() panels.
+double cell_mass(const ChiangFiber &fiber, int p, double sin_theta_o, double peak, double a, double b) {
+    const int panels = panel_count(std::sqrt(fiber.lobe_variance(p)), peak, a, b);
     const double step = (b - a) / panels;
     double sum = 0;
     for (int j = 0; j < panels; ++j) {
@@ -213,10 +215,7 @@ NearFieldTable::Divergences NearFieldTable::divergences(int r, int p, float t_no
     double integral = 0, sum_table = 0, sum_cone = 0;
     for (int k = 0; k < cells; ++k) {
         const double a = -kHalfPi + kPi * k / cells, b = -kHalfPi + kPi * (k + 1) / cells;
-        const double distance = peak < a ? a - peak : (peak > b ? peak - b : 0.0);
-        const int panels = distance > kFinePanelReach * width
-                               ? 1
-                               : std::clamp(int(std::ceil((b - a) / (0.5 * width))), 1, kMaxPanelsPerCell);
+        const int panels = panel_count(width, peak, a, b);
         const double step = (b - a) / panels;
         const float *e0 = edge(r * 4 + p) + k, *e1 = edge((r + 1) * 4 + p) + k;
         const double pmf0 = double(1.0f - t_node) * cdfs_.pmf(r * 4 + p, k);

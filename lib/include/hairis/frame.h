@@ -69,8 +69,8 @@ inline float relative_azimuth(float phi_i, float phi_o) { return wrap_angle(phi_
 /// on the axis φ is undefined, so a sample there would carry its φ in name only while pdf()
 /// and f read another.
 inline float off_axis(float sin_theta) {
-    constexpr float kMax = 0x1.fffffep-1f;
-    return sin_theta < -kMax ? -kMax : (sin_theta > kMax ? kMax : sin_theta);
+    return sin_theta < -kOneMinusEpsilon ? -kOneMinusEpsilon
+                                         : (sin_theta > kOneMinusEpsilon ? kOneMinusEpsilon : sin_theta);
 }
 
 inline float theta_half(float theta_i, float theta_o) { return 0.5f * (theta_i + theta_o); }

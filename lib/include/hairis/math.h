@@ -13,6 +13,10 @@ inline constexpr double kInvPi = 1.0 / kPi;
 inline constexpr double kInvTwoPi = 1.0 / kTwoPi;
 inline constexpr double kInvFourPi = 1.0 / (4.0 * kPi);
 
+/// The largest float below 1: where uniform numbers are clamped so that u ∈ [0, 1), and the
+/// largest |sin θ| of a sampled direction (frame.h's off_axis).
+inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
 /// Degrees to radians.
 constexpr double radians(double degrees) { return degrees * (kPi / 180.0); }
 /// Radians to degrees.

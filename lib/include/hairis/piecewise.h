@@ -25,11 +25,9 @@
 #include <vector>
 
 #include "hairis/expected.h"
+#include "hairis/math.h"
 
 namespace hairis {
-
-/// The largest float below 1: where uniform numbers are clamped so that u ∈ [0, 1).
-inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
 /// `count` equal-width cells over [lo, hi] and the exact float boundaries between them.
 class UniformCells {
