@@ -9,7 +9,7 @@
 
 #include "commands.h"
 #include "fiber_options.h"
-#include "hairis/bake.h"
+#include "tables/bake.h"
 
 namespace hairis::cli {
 
@@ -95,11 +95,11 @@ void add_bake_command(CLI::App &app, int &exit_code) {
     flags->fiber.add_to(*cmd, "cycles-default");
     BakeOptions &b = flags->bake;
     cmd->add_option("--theta-r", b.theta_r_count, "theta_r nodes over [-90, 90] degrees")
-        ->check(CLI::Range(1, kMaxThetaRCount))->capture_default_str();
+        ->check(CLI::Range(1, kMaxThetaRNodes))->capture_default_str();
     cmd->add_option("--theta-i", b.theta_i_count, "theta_i cells over [-90, 90] degrees")
-        ->check(CLI::Range(2, kMaxGridAxis))->capture_default_str();
+        ->check(CLI::Range(2, kMaxTableAxisCells))->capture_default_str();
     cmd->add_option("--phi", b.phi_count, "phi cells over [-180, 180] degrees")
-        ->check(CLI::Range(1, kMaxGridAxis))->capture_default_str();
+        ->check(CLI::Range(1, kMaxTableAxisCells))->capture_default_str();
     cmd->add_option("--quadrature", b.quadrature_points, "Gauss-Legendre points per cell and axis")
         ->check(CLI::Range(1, 16))->capture_default_str();
     cmd->add_option("--n-h", b.n_h_values, "strand counts of the multiple-scattering tables, increasing")

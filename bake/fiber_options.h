@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "hairis/fiber_spec.h"
+#include "fiber/fiber_spec.h"
 
 namespace hairis::cli {
 

@@ -5,8 +5,8 @@
 
 #include "commands.h"
 #include "fiber_options.h"
-#include "hairis/distributions.h"
-#include "hairis/dual_scattering.h"
+#include "fiber/distributions.h"
+#include "fiber/dual_scattering.h"
 #include "npy.h"
 #include "seed_fits.h"
 #include "seed_tables.h"

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "commands.h"
-#include "hairis/fiber_spec.h"
+#include "fiber/fiber_spec.h"
 #include "seed_fits.h"
 #include "seed_tables.h"
 

@@ -3,8 +3,8 @@
 #include <iostream>
 
 #include "commands.h"
-#include "hairis/math.h"
-#include "hairis/table_file.h"
+#include "core/math.h"
+#include "tables/table_file.h"
 
 namespace hairis::cli {
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "hairis/expected.h"
+#include "core/expected.h"
 
 namespace hairis::cli {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "hairis/frame.h"
+#include "core/frame.h"
 #include "seed_tables.h"
 
 namespace hairis::cli {

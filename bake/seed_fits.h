@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "hairis/distributions.h"
-#include "hairis/dual_scattering.h"
-#include "hairis/gaussian_fit.h"
+#include "fiber/distributions.h"
+#include "fiber/dual_scattering.h"
+#include "fiber/gaussian_fit.h"
 
 namespace hairis::cli {
 

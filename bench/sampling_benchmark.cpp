@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "hairis/frame.h"
-#include "hairis/marschner.h"
+#include "core/frame.h"
+#include "fiber/marschner.h"
 #include "study_common.h"
 
 namespace hairis::bench {

@@ -15,8 +15,8 @@
 #include <memory>
 #include <random>
 
-#include "hairis/scene.h"
-#include "hairis/strategies.h"
+#include "render/scene.h"
+#include "sampling/strategies.h"
 
 namespace hairis::bench {
 namespace {

@@ -25,8 +25,8 @@
 #include <string>
 #include <thread>
 
-#include "hairis/dual_scattering.h"
-#include "hairis/frame.h"
+#include "fiber/dual_scattering.h"
+#include "core/frame.h"
 #include "study_common.h"
 
 using namespace hairis;

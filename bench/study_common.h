@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "hairis/bake.h"
-#include "hairis/fiber_spec.h"
-#include "hairis/strategies.h"
+#include "tables/bake.h"
+#include "fiber/fiber_spec.h"
+#include "sampling/strategies.h"
 
 namespace hairis::bench {
 

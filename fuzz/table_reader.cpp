@@ -9,7 +9,7 @@
 
 #include "fuzz_input.h"
 #include "hairis/hairis.h"
-#include "hairis/table_file.h"
+#include "tables/table_file.h"
 
 namespace {
 

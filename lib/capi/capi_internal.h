@@ -20,13 +20,15 @@
 #include <utility>
 #include <vector>
 
-#include "hairis/chiang.h"
-#include "hairis/expected.h"
-#include "hairis/fiber.h"
-#include "hairis/fiber_spec.h"
+#include "fiber/chiang.h"
+#include "core/expected.h"
+#include "fiber/fiber.h"
+#include "fiber/fiber_spec.h"
+#include "core/options.h"
 #include "hairis/hairis.h"
-#include "hairis/strategies.h"
-#include "hairis/table_file.h"
+#include "sampling/hair_bsdf.h"
+#include "sampling/strategy.h"
+#include "tables/table_file.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -131,9 +133,27 @@ inline void require_array(const void *pointer, size_t n, const char *name) {
 }
 /// Refuses n whose arrays of `per_item` floats would not fit in memory.
 void require_batch_size(size_t n, size_t per_item, const char *name);
-/// Turns a failed core check into a Refusal (INVALID_ARGUMENT), with an optional prefix.
+/// The status code of a core error's kind.
+int code_of(ErrorKind kind);
+/// Turns a failed core check into a Refusal (by its kind), with an optional prefix.
 inline void ok_or_invalid(const Status &status, const std::string &prefix = {}) {
-    if (status) invalid(prefix + status->message);
+    if (status) refuse(code_of(status->kind), prefix + status->message);
+}
+/// The options string `text` (NULL reads as "") described by describe(fields, value): every
+/// name read into `value`, unknown names and bad values refused naming them.
+template <typename T>
+void read_options(const char *text, const std::string &what, T &value) {
+    Expected<OptionReader> reader = OptionReader::parse(text ? text : "", what);
+    if (!reader) invalid(reader.error().message);
+    describe(reader.value(), value);
+    ok_or_invalid(reader.value().finish());
+}
+/// The options string of value's fields.
+template <typename T>
+std::string write_options(T value) {
+    OptionWriter writer;
+    describe(writer, value);
+    return writer.str();
 }
 /// Prints a float for messages (9 significant digits; nan, inf).
 std::string describe(double value);
@@ -147,16 +167,6 @@ void require_non_negative(float value, const std::string &name);
 void require_colour(const float *rgb, const char *name);
 /// Refuses a direction that is not finite or not of unit length (within 1e-3).
 void require_unit_direction(const float *w, const char *name, size_t i);
-/// Reads an enum argument as the int the caller passed, without loading an out-of-range value
-/// through the enum type (undefined behaviour in C++ that UBSan would trap).
-/// Takes the argument by reference: copying it would be such a load.
-template <typename E>
-int enum_value(const E &value) {
-    static_assert(sizeof(E) == sizeof(int), "C enums are passed as int");
-    int v = 0;
-    std::memcpy(&v, &value, sizeof v);
-    return v;
-}
 
 /// Calls f(i) for every i < n: in order for small batches, in parallel (oneTBB) for large
 /// ones. Items must be independent. Exceptions propagate to the caller.
@@ -175,9 +185,6 @@ void for_each_item(size_t n, const F &f) {
 
 // ---- Shared conversions ---------------------------------------------------------------------
 
-/// The C node as hairis' PrincipledHairNode; refuses a parametrization out of range and
-/// non-finite inputs (argument name `name`, e.g. "node").
-PrincipledHairNode to_node(const hairis_principled_hair &node, const char *name);
 /// The canonical "name=value;..." string of a fiber spec (what table metadata records).
 std::string spec_parameters(const FiberSpec &spec);
 
@@ -195,16 +202,16 @@ struct hairis_fiber {
     std::string parameters;  // canonical_parameters(spec.parameters())
 };
 
-/// Baked or loaded tables: the table set (for writing) and the samplers built from it. The
-/// samplers are shared: a hairis_sampler or a scene material copies the shared_ptrs and so
-/// stays valid after this handle is destroyed.
+/// Baked or loaded tables: the table set (for writing) and the samplers' tables built from it,
+/// shared with every sampler and scene material made from them.
 struct hairis_tables {
     hairis::TableSet set;
     hairis::SamplingTables sampling;
     std::string parameters;  // canonical_parameters(set.parameters)
+    std::string info;        // hairis_tables_info
 };
 
-/// A direction sampler (owns everything it samples from).
+/// A direction sampler bound to its fiber (when it reads one): owns everything it samples from.
 struct hairis_sampler {
-    std::shared_ptr<const hairis::DirectionSampler> sampler;
+    hairis::HairShading shading;
 };

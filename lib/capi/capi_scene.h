@@ -1,32 +1,127 @@
-// The hairis_scene handle, shared by scene.cpp (building it) and render.cpp (rendering it).
+// The hairis_scene handle and the option sets of hairis_render.h, shared by scene.cpp
+// (building it), render.cpp (rendering it) and defaults.cpp (hairis_defaults).
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "capi_internal.h"
-#include "hairis/principled_hair.h"
-#include "hairis/scene.h"
+#include "fiber/principled_hair.h"
+#include "hairis/hairis_render.h"
+#include "render/render.h"
+#include "render/scene.h"
+
+namespace hairis {
+
+// Option names of the core's lights (found by describe()'s argument-dependent lookup).
+inline constexpr double kHugeOption = double(std::numeric_limits<float>::max());
+
+/// "type=sun": direction towards the sun, W/m², angular diameter (radians).
+template <typename Fields>
+void describe(Fields &f, SunLight &o) {
+    f.field("direction", o.to_sun);
+    f.field("color", o.color, 0.0, kHugeOption);
+    f.field("strength", o.strength, 0.0, kHugeOption);
+    f.field("angle", o.angle, 0.0, std::nextafter(kPi, 0.0));
+}
+
+/// "type=point": power in W, radius in metres.
+template <typename Fields>
+void describe(Fields &f, PointLight &o) {
+    f.field("position", o.position);
+    f.field("color", o.color, 0.0, kHugeOption);
+    f.field("power", o.power, 0.0, kHugeOption);
+    f.field("radius", o.radius, 0.0, kHugeOption);
+}
+
+/// The world: a constant background of radiance color × strength.
+template <typename Fields>
+void describe(Fields &f, WorldLight &o) {
+    f.field("color", o.color, 0.0, kHugeOption);
+    f.field("strength", o.strength, 0.0, kHugeOption);
+}
+
+}  // namespace hairis
 
 namespace hairis::capi {
 
-/// A hair material as the C API keeps it until a render: the node's fiber and, optionally,
-/// tables (shared with the hairis_tables they came from, so that handle may be destroyed).
-/// The direction sampler is made by hairis_render from its settings.
+inline constexpr double kHuge = double(std::numeric_limits<float>::max());
+
+/// A hair material as the C API keeps it until a render: its fiber and, optionally, tables
+/// (shared with the hairis_tables they came from). The sampler is made by hairis_render from
+/// its settings.
 struct SceneHairMaterial {
     std::shared_ptr<const ChiangFiber> fiber;
-    std::string model;       // "chiang2016"
-    std::string parameters;  // canonical parameters of the node (FiberSpec)
-    bool has_tables = false;
-    SamplingTables tables;
-    std::string tables_model;
-    std::string tables_parameters;
-    std::vector<int> tables_n_h;
+    std::optional<SamplingTables> tables;
 };
 
 using SceneMaterial = std::variant<SceneHairMaterial, DiffuseMaterial>;
+
+/// "type=diffuse": a Lambertian surface with an emission (radiance).
+struct DiffuseOptions {
+    Rgb color{0.8f};
+    Rgb emission{0.0f};
+};
+template <typename Fields>
+void describe(Fields &f, DiffuseOptions &o) {
+    f.field("color", o.color, 0.0, 1.0);
+    f.field("emission", o.emission, 0.0, kHuge);
+}
+
+/// "type=area": the light object's matrix (row-major, with its scale), shape, sizes, power.
+struct AreaOptions {
+    float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    int shape = 0;
+    float size = 1.0f, size_y = 1.0f;
+    Rgb color{1.0f};
+    float power = 10.0f;
+};
+template <typename Fields>
+void describe(Fields &f, AreaOptions &o) {
+    float *matrix = o.matrix;
+    f.field("matrix", matrix, 16, -kHuge, kHuge);
+    f.choice("shape", o.shape, {"square", "rectangle", "disk", "ellipse"});
+    f.field("size", o.size, 0.0, kHuge);
+    f.field("size_y", o.size_y, 0.0, kHuge);
+    f.field("color", o.color, 0.0, kHuge);
+    f.field("power", o.power, 0.0, kHuge);
+}
+
+/// The camera as Blender describes it (Camera.view_frame, matrix_world, resolution, clip).
+struct CameraOptions {
+    float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    bool orthographic = false;
+    float frame[12] = {0.5f, 0.5f, -1, 0.5f, -0.5f, -1, -0.5f, -0.5f, -1, -0.5f, 0.5f, -1};
+    int width = 64, height = 64;
+    float clip_start = 0.0f;
+    float clip_end = float(kHuge);  ///< the largest float: no far clip
+};
+template <typename Fields>
+void describe(Fields &f, CameraOptions &o) {
+    float *matrix = o.matrix, *frame = o.frame;
+    f.field("matrix", matrix, 16, -kHuge, kHuge);
+    f.field("orthographic", o.orthographic);
+    f.field("frame", frame, 12, -kHuge, kHuge);
+    f.field("width", o.width, 1, 65536);
+    f.field("height", o.height, 1, 65536);
+    f.field("clip_start", o.clip_start, 0.0, kHuge);
+    f.field("clip_end", o.clip_end, 0.0, kHuge);
+}
+
+/// Everything hairis_render reads: the renderer's settings and the hair sampler's.
+struct RenderOptions {
+    RenderSettings render;
+    SamplerOptions sampler;
+};
+template <typename Fields>
+void describe(Fields &f, RenderOptions &o) {
+    describe(f, o.render);
+    describe(f, o.sampler);
+}
 
 }  // namespace hairis::capi
 

@@ -10,7 +10,7 @@
 // (as bake/ does); the fallback is kept equal to it by tests/capi (which checks the string
 // against PROJECT_VERSION).
 #ifndef HAIRIS_VERSION
-#define HAIRIS_VERSION "0.1.0"
+#define HAIRIS_VERSION "0.2.0"
 #endif
 
 namespace hairis::capi {
@@ -62,6 +62,16 @@ int report_exception(const char *function, std::exception_ptr error) noexcept {
         set_error(std::string(function) + ": internal error (please report): unknown exception");
     }
     return HAIRIS_ERROR_INTERNAL;
+}
+
+int code_of(ErrorKind kind) {
+    switch (kind) {
+        case ErrorKind::InvalidTable: return HAIRIS_ERROR_INVALID_TABLE;
+        case ErrorKind::Io: return HAIRIS_ERROR_IO;
+        case ErrorKind::Cancelled: return HAIRIS_ERROR_CANCELLED;
+        case ErrorKind::InvalidArgument: break;
+    }
+    return HAIRIS_ERROR_INVALID_ARGUMENT;
 }
 
 void require_batch_size(size_t n, size_t per_item, const char *name) {

@@ -1,4 +1,5 @@
-// C API: direction samplers (strategies.h) and their batch sample/pdf loops.
+// C API: direction samplers (sampling/strategy.h chooses them) and their batch sample/pdf
+// loops, each item prepared at its own hit.
 #include <string>
 
 #include "capi_internal.h"
@@ -6,16 +7,6 @@
 namespace hairis::capi {
 
 namespace {
-
-const char *strategy_c_name(int strategy) {
-    switch (strategy) {
-        case HAIRIS_STRATEGY_UNIFORM: return "UNIFORM";
-        case HAIRIS_STRATEGY_ANALYTIC: return "ANALYTIC";
-        case HAIRIS_STRATEGY_GAUSSIAN: return "GAUSSIAN";
-        case HAIRIS_STRATEGY_TABLE: return "TABLE";
-        default: return "?";
-    }
-}
 
 // Checks wo (unit), h (NULL or in [-1, 1]) for item i.
 void check_view(const float *wo, const float *h, size_t i) {
@@ -26,6 +17,13 @@ void check_view(const float *wo, const float *h, size_t i) {
 
 }  // namespace
 
+// The BSDF of one batch item (thread-local scratch: for_each_item may run in parallel).
+HairBsdf bsdf_at(const hairis_sampler &sampler, const float *wo, const float *h, size_t i) {
+    thread_local ScratchBuffer scratch;
+    scratch.reset();
+    return sampler.shading.at({{wo[3 * i], wo[3 * i + 1], wo[3 * i + 2]}, h ? h[i] : 0.0f}, scratch);
+}
+
 }  // namespace hairis::capi
 
 using namespace hairis;
@@ -33,60 +31,32 @@ using namespace hairis::capi;
 
 extern "C" {
 
-HAIRIS_API hairis_sampler *hairis_sampler_create(hairis_strategy strategy,
-                                                 const hairis_fiber *fiber,
-                                                 const hairis_tables *tables,
-                                                 float multiple_weight, int n_h) {
+HAIRIS_API hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, const hairis_tables *tables,
+                                                 const char *options) {
     return guard_handle<hairis_sampler>("hairis_sampler_create", [&] {
-        const int kind = enum_value(strategy);
-        if (kind < HAIRIS_STRATEGY_UNIFORM || kind > HAIRIS_STRATEGY_TABLE)
-            invalid("strategy must be HAIRIS_STRATEGY_UNIFORM (0), ANALYTIC (1), GAUSSIAN (2) or "
-                    "TABLE (3) (got " + std::to_string(kind) + ")");
-        if (!(multiple_weight >= 0.0f && multiple_weight <= 1.0f))
-            invalid("multiple_weight must be finite and in [0, 1] (got " +
-                    describe(multiple_weight) + ")");
+        SamplerOptions o;
+        read_options(options, "sampler options", o);
+        const StrategyKind kind = StrategyKind(o.strategy);
         StrategyInputs inputs;
-        inputs.multiple_weight = multiple_weight;
-        inputs.n_h = n_h;
-        if (kind == HAIRIS_STRATEGY_ANALYTIC) {
-            if (!fiber)
-                invalid("fiber must not be NULL for HAIRIS_STRATEGY_ANALYTIC (it samples the "
-                        "fiber's own lobes)");
+        inputs.multiple_weight = o.multiple_weight;
+        inputs.n_h = o.n_h;
+        if (kind == StrategyKind::Analytic) {
+            if (!fiber) invalid("fiber must not be NULL for strategy=analytic (it samples the fiber's own lobes)");
             if (!fiber->chiang)
-                invalid("fiber must be a chiang2016 fiber for HAIRIS_STRATEGY_ANALYTIC (got " +
-                        fiber->model_name + ")");
-            inputs.chiang = fiber->chiang;
+                invalid("fiber must be a chiang2016 fiber for strategy=analytic (got " + fiber->model_name + ")");
         }
-        if (kind == HAIRIS_STRATEGY_TABLE) {
-            if (!tables) invalid("tables must not be NULL for HAIRIS_STRATEGY_TABLE");
-            inputs.tables = &tables->sampling;  // make_sampler copies the shared_ptrs
-            // With a Chiang fiber the sampler follows the near field at h (near_field_table.h);
-            // without one it samples the h-averaged direct table.
-            if (fiber && fiber->chiang) inputs.chiang = fiber->chiang;
-        }
-        if (kind == HAIRIS_STRATEGY_GAUSSIAN || kind == HAIRIS_STRATEGY_TABLE) {
-            const std::vector<int> &allowed = kind == HAIRIS_STRATEGY_TABLE
-                                                  ? tables->set.n_h_values
-                                                  : inputs.seed.n_h_values;
-            bool found = false;
-            std::string list;
-            for (int v : allowed) {
-                found = found || v == n_h;
-                list += (list.empty() ? "" : ", ") + std::to_string(v);
-            }
-            if (!found)
-                invalid("n_h must be one of " + list +
-                        (kind == HAIRIS_STRATEGY_TABLE ? " (the tables' n_h values)"
-                                                       : " (the seed's n_h values)") +
-                        " for HAIRIS_STRATEGY_" + strategy_c_name(kind) + " (got " +
-                        std::to_string(n_h) + ")");
-        }
-        Expected<std::shared_ptr<const DirectionSampler>> made =
-            make_sampler(StrategyKind(kind), inputs);
-        if (!made) invalid(made.error().message);
-        auto sampler = std::make_unique<hairis_sampler>();
-        sampler->sampler = std::move(made).value();
-        return sampler.release();
+        if (kind == StrategyKind::Table && !tables)
+            refuse(HAIRIS_ERROR_INVALID_TABLE, "tables must not be NULL for strategy=table");
+        if (kind == StrategyKind::Analytic || kind == StrategyKind::Table) inputs.chiang = fiber ? fiber->chiang : nullptr;
+        if (tables) inputs.tables = &tables->sampling;  // make_sampler copies the shared_ptrs
+        Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
+        if (!made) refuse(code_of(made.error().kind), "sampler options: " + made.error().message);
+        // The sampler reads its fiber's points only when it was built for one.
+        std::shared_ptr<const ShadingModel> model;
+        if (made.value()->model()) model = inputs.chiang;
+        Expected<HairShading> shading = HairShading::create(std::move(model), std::move(made).value());
+        if (!shading) refuse(HAIRIS_ERROR_INTERNAL, shading.error().message);
+        return new hairis_sampler{std::move(shading).value()};
     });
 }
 
@@ -112,11 +82,8 @@ HAIRIS_API int hairis_sample(const hairis_sampler *sampler, size_t n, const floa
                             ")");
             }
         }
-        const DirectionSampler &s = *sampler->sampler;
         for_each_item(n, [&](size_t i) {
-            const Vec3 o{wo[3 * i], wo[3 * i + 1], wo[3 * i + 2]};
-            const std::optional<DirectionSample> d =
-                s.sample(o, h ? h[i] : 0.0f, u[3 * i], u[3 * i + 1], u[3 * i + 2]);
+            const std::optional<BsdfSample> d = bsdf_at(*sampler, wo, h, i).sample(u[3 * i], u[3 * i + 1], u[3 * i + 2]);
             const bool ok = d && d->pdf > 0.0f;
             const Vec3 w = ok ? d->wi : Vec3{};
             wi_out[3 * i] = w.x;
@@ -140,11 +107,8 @@ HAIRIS_API int hairis_pdf(const hairis_sampler *sampler, size_t n, const float *
             require_unit_direction(wi, "wi", i);
             check_view(wo, h, i);
         }
-        const DirectionSampler &s = *sampler->sampler;
         for_each_item(n, [&](size_t i) {
-            const Vec3 a{wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]};
-            const Vec3 o{wo[3 * i], wo[3 * i + 1], wo[3 * i + 2]};
-            pdf_out[i] = s.pdf(a, o, h ? h[i] : 0.0f);
+            pdf_out[i] = bsdf_at(*sampler, wo, h, i).pdf({wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]});
         });
         return HAIRIS_OK;
     });

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "capi_scene.h"
-#include "hairis/camera.h"
-#include "hairis/lights.h"
+#include "render/camera.h"
+#include "render/lights.h"
 
 namespace hairis::capi {
 
@@ -26,12 +26,6 @@ int add_material(hairis_scene &scene, SceneMaterial material) {
 }
 
 Vec3 vec3(const float *v) { return {v[0], v[1], v[2]}; }
-Rgb rgb(const float *v) { return {v[0], v[1], v[2]}; }
-
-void require_finite3(const float *v, const char *name) {
-    require(v, name);
-    for (size_t k = 0; k < 3; ++k) require_finite(v[k], indexed(name, k));
-}
 
 }  // namespace
 
@@ -50,46 +44,31 @@ HAIRIS_API void hairis_scene_destroy(hairis_scene *scene) {
     guard_void("hairis_scene_destroy", [&] { delete scene; });
 }
 
-HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene,
-                                              const hairis_principled_hair *node,
+HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_fiber *fiber,
                                               const hairis_tables *tables) {
     return guard_value<int>("hairis_scene_add_hair_material", -1, [&] {
         require(scene, "scene");
-        require(node, "node");
-        FiberSpec spec;
-        spec.kind = FiberKind::Chiang;
-        spec.node = to_node(*node, "node");
-        Expected<std::unique_ptr<FiberModel>> model = spec.create_model();
-        if (!model) invalid("node." + model.error().message);
+        require(fiber, "fiber");
+        if (!fiber->chiang)
+            invalid("fiber must be a chiang2016 fiber (the renderer shades Principled Hair), got " + fiber->model_name);
         SceneHairMaterial hair;
-        hair.fiber = std::dynamic_pointer_cast<const ChiangFiber>(
-            std::shared_ptr<const FiberModel>(std::move(model).value()));
-        if (!hair.fiber) refuse(HAIRIS_ERROR_INTERNAL, "a Principled Hair node gave no Chiang fiber");
-        hair.model = hair.fiber->name();
-        hair.parameters = spec_parameters(spec);
-        if (tables) {
-            hair.has_tables = true;
-            hair.tables = tables->sampling;
-            hair.tables_model = tables->set.model;
-            hair.tables_parameters = tables->parameters;
-            hair.tables_n_h = tables->set.n_h_values;
-        }
+        hair.fiber = fiber->chiang;
+        if (tables) hair.tables = tables->sampling;
         return add_material(*scene, std::move(hair));
     });
 }
 
-HAIRIS_API int hairis_scene_add_diffuse_material(hairis_scene *scene, const float albedo[3],
-                                                 const float emission[3]) {
-    return guard_value<int>("hairis_scene_add_diffuse_material", -1, [&] {
+HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char *options) {
+    return guard_value<int>("hairis_scene_add_surface_material", -1, [&] {
         require(scene, "scene");
-        require(albedo, "albedo");
-        require(emission, "emission");
-        for (size_t k = 0; k < 3; ++k)
-            if (!(albedo[k] >= 0.0f && albedo[k] <= 1.0f))
-                invalid(indexed("albedo", k) + " must be finite and in [0, 1] (got " +
-                        describe(albedo[k]) + ")");
-        require_colour(emission, "emission");
-        return add_material(*scene, DiffuseMaterial{rgb(albedo), rgb(emission)});
+        Expected<OptionReader> reader = OptionReader::parse(options ? options : "", "surface material");
+        if (!reader) invalid(reader.error().message);
+        int type = 0;
+        reader.value().choice("type", type, {"diffuse"});
+        DiffuseOptions diffuse;
+        describe(reader.value(), diffuse);
+        ok_or_invalid(reader.value().finish());
+        return add_material(*scene, DiffuseMaterial{diffuse.color, diffuse.emission});
     });
 }
 
@@ -172,7 +151,7 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                         ") (got " + std::to_string(m) + ")");
             if (!std::holds_alternative<DiffuseMaterial>(scene->materials[size_t(m)]))
                 invalid(indexed("materials", t) + " = " + std::to_string(m) +
-                        " is a hair material; meshes need a diffuse material");
+                        " is a hair material; meshes need a surface material");
         }
         if (triangle_count == 0) return HAIRIS_OK;  // nothing to draw
         TriangleMesh mesh;
@@ -189,103 +168,71 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
     });
 }
 
-HAIRIS_API int hairis_scene_add_sun(hairis_scene *scene, const float direction[3],
-                                    const float color[3], float strength, float angle) {
-    return guard_status("hairis_scene_add_sun", [&] {
+HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) {
+    return guard_status("hairis_scene_add_light", [&] {
         require(scene, "scene");
-        require_finite3(direction, "direction");
-        require_colour(color, "color");
-        require_non_negative(strength, "strength");
-        if (!(angle >= 0.0f && angle < float(kPi)))
-            invalid("angle must be finite and in [0, pi) radians (got " + describe(angle) + ")");
-        const Vec3 d = vec3(direction);
-        if (!(length(d) > 0.0f)) invalid("direction must not be the zero vector");
-        SunLight sun;
-        sun.to_sun = safe_normalize(d);
-        sun.color = rgb(color);
-        sun.strength = strength;
-        sun.angle = angle;
-        scene->desc.suns.push_back(sun);
+        const std::string what = "light " + std::to_string(scene->desc.suns.size() + scene->desc.point_lights.size() +
+                                                           scene->desc.area_lights.size());
+        Expected<OptionReader> parsed = OptionReader::parse(options ? options : "", what);
+        if (!parsed) invalid(parsed.error().message);
+        OptionReader &reader = parsed.value();
+        if (!reader.has("type")) invalid(what + ": type must be given (sun, point or area)");
+        int type = 0;
+        reader.choice("type", type, {"sun", "point", "area"});
+        if (type == 0) {
+            SunLight sun;
+            describe(reader, sun);
+            ok_or_invalid(reader.finish());
+            if (!(length(sun.to_sun) > 0.0f)) invalid(what + ": direction must not be the zero vector");
+            sun.to_sun = safe_normalize(sun.to_sun);
+            scene->desc.suns.push_back(sun);
+        } else if (type == 1) {
+            PointLight point;
+            describe(reader, point);
+            ok_or_invalid(reader.finish());
+            scene->desc.point_lights.push_back(point);
+        } else {
+            AreaOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            AreaLight light;
+            light.light_to_world = Mat4::from_row_major(o.matrix);
+            if (!(length(light.light_to_world.column(2)) > 0.0f))
+                invalid(what + ": matrix has a zero Z axis (column 2): the light has no emitting direction");
+            light.shape = AreaShape(o.shape);
+            light.size_x = o.size;
+            light.size_y = o.size_y;
+            light.color = o.color;
+            light.power = o.power;
+            scene->desc.area_lights.push_back(light);
+        }
         return HAIRIS_OK;
     });
 }
 
-HAIRIS_API int hairis_scene_add_point_light(hairis_scene *scene, const float position[3],
-                                            const float color[3], float power, float radius) {
-    return guard_status("hairis_scene_add_point_light", [&] {
-        require(scene, "scene");
-        require_finite3(position, "position");
-        require_colour(color, "color");
-        require_non_negative(power, "power");
-        require_non_negative(radius, "radius");
-        PointLight light;
-        light.position = vec3(position);
-        light.color = rgb(color);
-        light.power = power;
-        light.radius = radius;
-        scene->desc.point_lights.push_back(light);
-        return HAIRIS_OK;
-    });
-}
-
-HAIRIS_API int hairis_scene_add_area_light(hairis_scene *scene, const float light_to_world[16],
-                                           int shape, float size_x, float size_y,
-                                           const float color[3], float power) {
-    return guard_status("hairis_scene_add_area_light", [&] {
-        require(scene, "scene");
-        require(light_to_world, "light_to_world");
-        for (size_t k = 0; k < 16; ++k)
-            require_finite(light_to_world[k], indexed("light_to_world", k));
-        if (shape < HAIRIS_AREA_SQUARE || shape > HAIRIS_AREA_ELLIPSE)
-            invalid("shape must be HAIRIS_AREA_SQUARE (0), RECTANGLE (1), DISK (2) or ELLIPSE (3) "
-                    "(got " + std::to_string(shape) + ")");
-        require_non_negative(size_x, "size_x");
-        require_non_negative(size_y, "size_y");
-        require_colour(color, "color");
-        require_non_negative(power, "power");
-        AreaLight light;
-        light.light_to_world = Mat4::from_row_major(light_to_world);
-        if (!(length(light.light_to_world.column(2)) > 0.0f))
-            invalid("light_to_world has a zero Z axis (column 2): the light has no emitting "
-                    "direction");
-        light.shape = AreaShape(shape);
-        light.size_x = size_x;
-        light.size_y = size_y;
-        light.color = rgb(color);
-        light.power = power;
-        scene->desc.area_lights.push_back(light);
-        return HAIRIS_OK;
-    });
-}
-
-HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const float color[3],
-                                      float strength) {
+HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_set_world", [&] {
         require(scene, "scene");
-        require_colour(color, "color");
-        require_non_negative(strength, "strength");
-        scene->desc.world = WorldLight{rgb(color), strength};
+        WorldLight world;
+        read_options(options, "world", world);
+        scene->desc.world = world;
         return HAIRIS_OK;
     });
 }
 
-HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const hairis_camera *camera) {
+HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_set_camera", [&] {
         require(scene, "scene");
-        require(camera, "camera");
-        const hairis_camera &c = *camera;
-        if (c.orthographic != 0 && c.orthographic != 1)
-            invalid("camera.orthographic must be 0 (perspective) or 1 (orthographic) (got " +
-                    std::to_string(c.orthographic) + ")");
-        for (size_t k = 0; k < 16; ++k)
-            require_finite(c.camera_to_world[k], indexed("camera.camera_to_world", k));
-        for (size_t k = 0; k < 12; ++k) require_finite(c.frame[k], indexed("camera.frame", k));
+        CameraOptions c;
+        read_options(options, "camera", c);
         CameraDesc desc;
-        desc.camera_to_world = Mat4::from_row_major(c.camera_to_world);
+        desc.camera_to_world = Mat4::from_row_major(c.matrix);
         desc.projection = c.orthographic ? Projection::Orthographic : Projection::Perspective;
         for (size_t i = 0; i < 4; ++i) desc.frame[i] = vec3(c.frame + 3 * i);
         desc.width = c.width;
         desc.height = c.height;
+        desc.clip_start = c.clip_start;
+        desc.clip_end = double(c.clip_end) >= kHuge ? INFINITY : c.clip_end;
         // Refused now rather than at render time; the messages start with "camera: ".
         Expected<Camera> checked = Camera::create(desc);
         if (!checked) invalid(checked.error().message);

@@ -7,19 +7,24 @@
 #include <vector>
 
 #include "capi_internal.h"
-#include "hairis/bake.h"
+#include "tables/bake.h"
 
 namespace hairis::capi {
 
 namespace {
-
-constexpr int kMaxNhValues = 16;  // hairis_bake_options::n_h_values
 
 hairis_tables *make_tables(TableSet set) {
     Expected<SamplingTables> sampling = SamplingTables::from(set);
     if (!sampling) refuse(HAIRIS_ERROR_INVALID_TABLE, "hairis table: " + sampling.error().message);
     auto tables = std::make_unique<hairis_tables>();
     tables->parameters = canonical_parameters(set.parameters);
+    std::string n_h;
+    for (int v : set.n_h_values) n_h += (n_h.empty() ? "" : ",") + std::to_string(v);
+    tables->info = format_options({{"source", set.source},
+                                   {"theta_r", std::to_string(set.theta_r_count())},
+                                   {"theta_i", std::to_string(set.theta_i_count)},
+                                   {"phi", std::to_string(set.phi_count)},
+                                   {"n_h", n_h}});
     tables->sampling = std::move(sampling).value();
     tables->set = std::move(set);
     return tables.release();
@@ -55,43 +60,13 @@ using namespace hairis::capi;
 
 extern "C" {
 
-HAIRIS_API void hairis_bake_options_defaults(hairis_bake_options *options) {
-    guard_void("hairis_bake_options_defaults", [&] {
-        require(options, "options");
-        const BakeOptions d;
-        hairis_bake_options c{};
-        c.theta_r_count = d.theta_r_count;
-        c.theta_i_count = d.theta_i_count;
-        c.phi_count = d.phi_count;
-        c.n_h_count = int(std::min<size_t>(d.n_h_values.size(), kMaxNhValues));
-        for (int k = 0; k < c.n_h_count; ++k) c.n_h_values[k] = d.n_h_values[size_t(k)];
-        c.source = d.source == "gaussian" ? 1 : 0;
-        c.threads = d.threads;
-        *options = c;
-    });
-}
-
-HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber,
-                                             const hairis_bake_options *options,
+HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *options,
                                              hairis_progress_fn progress, void *user) {
     return guard_handle<hairis_tables>("hairis_tables_bake", [&] {
         require(fiber, "fiber");
-        require(options, "options");
-        const hairis_bake_options &c = *options;
-        if (c.n_h_count < 1 || c.n_h_count > kMaxNhValues)
-            invalid("options.n_h_count must be an integer in [1, 16] (got " +
-                    std::to_string(c.n_h_count) + ")");
-        if (c.source != 0 && c.source != 1)
-            invalid("options.source must be 0 (exact distributions) or 1 (the seed's Gaussian "
-                    "PDFs) (got " + std::to_string(c.source) + ")");
         BakeOptions o;
-        o.theta_r_count = c.theta_r_count;
-        o.theta_i_count = c.theta_i_count;
-        o.phi_count = c.phi_count;
-        o.n_h_values.assign(c.n_h_values, c.n_h_values + c.n_h_count);
-        o.source = c.source == 1 ? "gaussian" : "exact";
-        o.threads = c.threads;
-        ok_or_invalid(o.validate(), "options: ");
+        read_options(options, "bake options", o);
+        ok_or_invalid(o.validate(), "bake options: ");
 
         Expected<std::vector<std::pair<std::string, double>>> parameters = fiber->spec.parameters();
         if (!parameters) invalid("fiber: " + parameters.error().message);
@@ -158,6 +133,13 @@ HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables) {
     return guard_value<const char *>("hairis_tables_parameters", "", [&] {
         require(tables, "tables");
         return tables->parameters.c_str();
+    });
+}
+
+HAIRIS_API const char *hairis_tables_info(const hairis_tables *tables) {
+    return guard_value<const char *>("hairis_tables_info", "", [&] {
+        require(tables, "tables");
+        return tables->info.c_str();
     });
 }
 

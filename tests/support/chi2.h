@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "hairis/math.h"
+#include "core/math.h"
 
 namespace hairis::testing {
 

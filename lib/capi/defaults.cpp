@@ -1,0 +1,43 @@
+// C API: hairis_defaults — every option set's names with their defaults, written from the same
+// descriptions that read them.
+#include <string>
+
+#include "capi_scene.h"
+#include "tables/bake.h"
+
+using namespace hairis;
+using namespace hairis::capi;
+
+namespace {
+
+thread_local std::string t_defaults;
+
+std::string defaults_of(const std::string &kind) {
+    if (kind == "chiang") return FiberSpec{}.options();
+    if (kind == "marschner") return FiberSpec::preset("blonde").value().options();
+    if (kind == "bake") return write_options(BakeOptions{});
+    if (kind == "sampler") return write_options(SamplerOptions{});
+    if (kind == "render") return write_options(RenderOptions{});
+    if (kind == "diffuse") return "type=diffuse;" + write_options(DiffuseOptions{});
+    if (kind == "sun") return "type=sun;" + write_options(SunLight{});
+    if (kind == "point") return "type=point;" + write_options(PointLight{});
+    if (kind == "area") return "type=area;" + write_options(AreaOptions{});
+    if (kind == "world") return write_options(WorldLight{});
+    if (kind == "camera") return write_options(CameraOptions{});
+    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, area, world, camera (got \"" +
+            kind + "\")");
+}
+
+}  // namespace
+
+extern "C" {
+
+HAIRIS_API const char *hairis_defaults(const char *kind) {
+    return guard_value<const char *>("hairis_defaults", nullptr, [&] {
+        require(kind, "kind");
+        t_defaults = defaults_of(kind);
+        return t_defaults.c_str();
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,364 @@
+#include "fiber/dual_scattering.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/frame.h"
+
+namespace hairis {
+
+namespace {
+
+/// Normalised Gaussian g(x; variance).
+double gaussian(double x, double variance) {
+    return std::exp(-0.5 * x * x / variance) / std::sqrt(kTwoPi * variance);
+}
+
+Vec3 dir(double theta, double phi) { return direction_of(float(theta), float(phi)); }
+
+/// Azimuths at which an eccentric fiber is averaged; one azimuth (Cycles' φ_o = −π/2) when the
+/// model only depends on the relative azimuth.
+std::vector<double> orientations(const FiberModel &model, int count) {
+    if (model.rotationally_symmetric()) return {-kHalfPi};
+    std::vector<double> out(static_cast<std::size_t>(count));
+    for (int j = 0; j < count; ++j) out[std::size_t(j)] = -kPi + (j + 0.5) * kTwoPi / count;
+    return out;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Precomputation
+
+Expected<DualScattering> DualScattering::create(const FiberModel &model,
+                                                const DualScatteringParams &params) {
+    const DualScatteringParams &q = params;
+    if (Status s = first_error(
+            check::in_range("DualScatteringParams::d_f", q.d_f, 0.0, 1.0),
+            check::in_range("DualScatteringParams::d_b", q.d_b, 0.0, 1.0),
+            check::count_in_range("DualScatteringParams::n_h", q.n_h, 0, 1 << 20),
+            check::count_in_range("DualScatteringParams::theta_count", q.theta_count, 2, 4096),
+            check::count_in_range("DualScatteringParams::theta_panels", q.theta_panels, 1, 1024),
+            check::count_in_range("DualScatteringParams::phi_panels", q.phi_panels, 1, 1024),
+            check::count_in_range("DualScatteringParams::points_per_panel", q.points_per_panel, 1, 16),
+            check::count_in_range("DualScatteringParams::orientation_count", q.orientation_count, 1, 256),
+            check::in_range("DualScatteringParams::max_series_attenuation", q.max_series_attenuation, 0.5, 0.9999),
+            check::in_range("DualScatteringParams::min_lobe_width", q.min_lobe_width, 1e-6, 0.1),
+            check::greater_than("DualScatteringParams::energy_scale", q.energy_scale, 0.0),
+            check::in_range("DualScatteringParams::energy_scale", q.energy_scale, 0.0, 1.0)))
+        return *s;
+    const int lobes = model.lobe_count();
+    if (Status s = check::count_in_range("FiberModel::lobe_count()", lobes, 1, 16)) return *s;
+
+    DualScattering ds;
+    ds.params_ = params;
+    ds.lobe_count_ = lobes;
+    for (int p = 0; p < lobes; ++p) {
+        const LobeShape shape = model.lobe_shape(p);
+        if (Status s = first_error(check::finite("FiberModel::lobe_shape().alpha", shape.alpha),
+                                   check::non_negative("FiberModel::lobe_shape().beta", shape.beta)))
+            return *s;
+        ds.shapes_.push_back(shape);
+    }
+
+    const int K = q.theta_count;
+    const std::size_t nk = std::size_t(K);
+    const std::size_t nl = std::size_t(lobes);
+    ds.a_f_lobe_.assign(nl * nk, {});
+    ds.a_b_lobe_.assign(nl * nk, {});
+    ds.n_g_lobe_.assign(nl * nk, {});
+
+    const QuadratureRule theta_rule =
+        QuadratureRule::composite(-kHalfPi, kHalfPi, q.theta_panels, q.points_per_panel);
+    // φ quarters: [−π, −π/2] and [π/2, π] are forward, [−π/2, π/2] backward.
+    const QuadratureRule fwd_lo = QuadratureRule::composite(-kPi, -kHalfPi, q.phi_panels, q.points_per_panel);
+    const QuadratureRule fwd_hi = QuadratureRule::composite(kHalfPi, kPi, q.phi_panels, q.points_per_panel);
+    const QuadratureRule back = QuadratureRule::composite(-kHalfPi, kHalfPi, 2 * q.phi_panels, q.points_per_panel);
+    QuadratureRule fwd = fwd_lo;
+    fwd.x.insert(fwd.x.end(), fwd_hi.x.begin(), fwd_hi.x.end());
+    fwd.w.insert(fwd.w.end(), fwd_hi.w.begin(), fwd_hi.w.end());
+    const std::vector<double> orient = orientations(model, q.orientation_count);
+    const double weight_scale = double(q.energy_scale) / double(orient.size());
+
+    // Each task writes only its own table entries: the result does not depend on scheduling.
+    tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
+        std::vector<Rgbd> af(nl), ab(nl), num(nl);
+        std::vector<double> den(nl);
+        for (int k = range.begin(); k != range.end(); ++k) {
+            const double theta_k = ds.table_theta(k);
+            // (1) a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction
+            // of the light from ω_L scattered into the forward half is the model's white-furnace
+            // integral ∫_fwd f(ω, ω_L)|cos θ| dω with ω_L in the viewer's slot: lobe_f_cos(p, ω,
+            // ω_L) integrated against dω = cos θ dθ dφ.
+            std::fill(af.begin(), af.end(), Rgbd{});
+            std::fill(ab.begin(), ab.end(), Rgbd{});
+            for (const double phi_l : orient) {
+                const std::unique_ptr<const FarFieldView> view = model.view(dir(theta_k, phi_l));
+                if (view->separable()) {
+                    // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
+                    for (int p = 0; p < lobes; ++p) {
+                        double longitudinal = 0;
+                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
+                            longitudinal += theta_rule.w[m] * std::cos(theta_rule.x[m]) * weight_scale *
+                                            view->longitudinal(p, theta_rule.x[m]);
+                        for (int half = 0; half < 2; ++half) {
+                            const QuadratureRule &rule = half == 0 ? fwd : back;
+                            Rgbd &acc = (half == 0 ? af : ab)[std::size_t(p)];
+                            for (std::size_t n = 0; n < rule.x.size(); ++n) {
+                                const Rgb v = view->azimuthal(p, rule.x[n]);
+                                for (int ch = 0; ch < 3; ++ch) acc.v[ch] += longitudinal * rule.w[n] * double(v[ch]);
+                            }
+                        }
+                    }
+                    continue;
+                }
+                for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
+                    const double th = theta_rule.x[m];
+                    const double wm = theta_rule.w[m] * std::cos(th) * weight_scale;
+                    for (int half = 0; half < 2; ++half) {
+                        const QuadratureRule &rule = half == 0 ? fwd : back;
+                        std::vector<Rgbd> &acc = half == 0 ? af : ab;
+                        for (std::size_t n = 0; n < rule.x.size(); ++n) {
+                            const Vec3 w = dir(th, phi_l + rule.x[n]);
+                            const double weight = wm * rule.w[n];
+                            for (int p = 0; p < lobes; ++p) {
+                                const Rgb v = view->lobe_f_cos(p, w);
+                                for (int ch = 0; ch < 3; ++ch) acc[std::size_t(p)].v[ch] += weight * double(v[ch]);
+                            }
+                        }
+                    }
+                }
+            }
+            // (2) N_p^G at Marschner's difference angle θ_d = θ_k.
+            std::fill(num.begin(), num.end(), Rgbd{});
+            std::fill(den.begin(), den.end(), 0.0);
+            const double td = theta_k;
+            const double cos_d2 = sqr(std::cos(td));
+            const double h_lo = -kHalfPi + std::fabs(td), h_hi = kHalfPi - std::fabs(td);
+            const QuadratureRule h_rule =
+                QuadratureRule::composite(h_lo, h_hi, q.theta_panels, q.points_per_panel);
+            for (std::size_t m = 0; m < h_rule.x.size(); ++m) {
+                const double th_h = h_rule.x[m];
+                const double th_i = th_h - td, th_o = th_h + td;
+                const double cos_i = std::cos(th_i);
+                for (int p = 0; p < lobes; ++p) {
+                    const double beta = std::max(double(ds.shapes_[std::size_t(p)].beta), double(q.min_lobe_width));
+                    den[std::size_t(p)] += h_rule.w[m] *
+                        gaussian(th_h - ds.shapes_[std::size_t(p)].alpha, beta * beta) * cos_i / cos_d2;
+                }
+                for (const double phi_o : orient) {
+                    const std::unique_ptr<const FarFieldView> view = model.view(dir(th_o, phi_o));
+                    for (int p = 0; p < lobes; ++p) {
+                        // (1/π)∫_fwd … dφ, averaged over orientations.
+                        const double longitudinal = view->separable() ? view->longitudinal(p, th_i) : 1.0;
+                        for (std::size_t n = 0; n < fwd.x.size(); ++n) {
+                            const double w = h_rule.w[m] * fwd.w[n] * kInvPi * weight_scale;
+                            const Rgb v = view->separable() ? view->azimuthal(p, fwd.x[n])
+                                                            : view->lobe_f_cos(p, dir(th_i, phi_o + fwd.x[n]));
+                            for (int ch = 0; ch < 3; ++ch) num[std::size_t(p)].v[ch] += w * longitudinal * double(v[ch]);
+                        }
+                    }
+                }
+            }
+            for (std::size_t p = 0; p < nl; ++p) {
+                ds.a_f_lobe_[p * nk + std::size_t(k)] = af[p];
+                ds.a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
+                Rgbd ng;
+                for (int ch = 0; ch < 3; ++ch) ng.v[ch] = den[p] > 0 ? num[p].v[ch] / den[p] : 0.0;
+                ds.n_g_lobe_[p * nk + std::size_t(k)] = ng;
+            }
+        }
+    });
+
+    // (3) Averages and the multiple-backscatter terms (cheap, serial).
+    ds.a_f_.assign(nk, {});
+    ds.a_b_.assign(nk, {});
+    ds.alpha_f_.assign(nk, {});
+    ds.alpha_b_.assign(nk, {});
+    ds.beta2_f_.assign(nk, {});
+    ds.beta2_b_.assign(nk, {});
+    ds.big_a_b_.assign(nk, {});
+    ds.delta_b_.assign(nk, {});
+    ds.sigma2_b_.assign(nk, {});
+    const double amax = q.max_series_attenuation;
+    const double db = q.d_b;
+    for (std::size_t k = 0; k < nk; ++k) {
+        for (int ch = 0; ch < 3; ++ch) {
+            double sf = 0, sb = 0, alf = 0, alb = 0, bf = 0, bb = 0;
+            double mean_alpha = 0, mean_beta2 = 0;
+            for (std::size_t p = 0; p < nl; ++p) {
+                const double wf = std::max(0.0, ds.a_f_lobe_[p * nk + k].v[ch]);
+                const double wb = std::max(0.0, ds.a_b_lobe_[p * nk + k].v[ch]);
+                const double al = ds.shapes_[p].alpha, be2 = sqr(double(ds.shapes_[p].beta));
+                sf += wf;
+                sb += wb;
+                alf += wf * al;
+                alb += wb * al;
+                bf += wf * be2;
+                bb += wb * be2;
+                mean_alpha += al / double(nl);
+                mean_beta2 += be2 / double(nl);
+            }
+            const double a_f = sf, a_b = sb;
+            const double alpha_f = sf > 0 ? alf / sf : mean_alpha;
+            const double alpha_b = sb > 0 ? alb / sb : mean_alpha;
+            const double beta2_f = sf > 0 ? bf / sf : mean_beta2;
+            const double beta2_b = sb > 0 ? bb / sb : mean_beta2;
+            ds.a_f_[k].v[ch] = a_f;
+            ds.a_b_[k].v[ch] = a_b;
+            ds.alpha_f_[k].v[ch] = alpha_f;
+            ds.alpha_b_[k].v[ch] = alpha_b;
+            ds.beta2_f_[k].v[ch] = beta2_f;
+            ds.beta2_b_[k].v[ch] = beta2_b;
+
+            if (a_f > amax || a_b > amax) ++ds.clamped_entries_;
+            const double af = std::clamp(a_f, 0.0, amax), ab = std::clamp(a_b, 0.0, amax);
+            const double af2 = af * af, ab2 = ab * ab, ab3 = ab2 * ab;
+            const double om = 1.0 - af2;
+            const double big_a_b = ab * af2 / om + ab3 * af2 / (om * om * om);
+            const double delta_b = alpha_b * (1.0 - 2.0 * ab2 / (om * om)) +
+                                   alpha_f * (2.0 * om * om + 4.0 * af2 * ab2) / (om * om * om);
+            const double bf_ = beta2_f, bb_ = beta2_b;
+            const double sig_den = ab + ab3;
+            const double sigma_b =
+                sig_den > 0 ? (1.0 + db * af2) *
+                                  (ab * std::sqrt(2.0 * bf_ + bb_) + ab3 * std::sqrt(2.0 * bf_ + 3.0 * bb_)) /
+                                  sig_den
+                            : (1.0 + db * af2) * std::sqrt(2.0 * bf_ + bb_);
+            ds.big_a_b_[k].v[ch] = big_a_b;
+            ds.delta_b_[k].v[ch] = delta_b;
+            ds.sigma2_b_[k].v[ch] = sigma_b * sigma_b;
+        }
+    }
+    return ds;
+}
+
+// ------------------------------------------------------------------------------------------
+// Lookups
+
+double DualScattering::table_theta(int k) const {
+    return -kHalfPi + (k + 0.5) * kPi / params_.theta_count;
+}
+
+DualScattering::Rgbd DualScattering::lookup(const std::vector<Rgbd> &table, double theta,
+                                            std::size_t offset) const {
+    const int K = params_.theta_count;
+    const double t = (theta + kHalfPi) * K / kPi - 0.5;  // fractional node index
+    if (!(t > 0)) return table[offset];                   // also NaN
+    if (t >= K - 1) return table[offset + std::size_t(K - 1)];
+    const int i = int(t);
+    const double f = t - i;
+    const Rgbd &lo = table[offset + std::size_t(i)], &hi = table[offset + std::size_t(i) + 1];
+    Rgbd out;
+    for (int ch = 0; ch < 3; ++ch) out.v[ch] = (1 - f) * lo.v[ch] + f * hi.v[ch];
+    return out;
+}
+
+Rgb DualScattering::to_rgb(const Rgbd &c) { return {float(c.v[0]), float(c.v[1]), float(c.v[2])}; }
+
+Rgb DualScattering::lobe_forward_attenuation(int p, double theta) const {
+    if (p < 0 || p >= lobe_count_) return {};
+    return to_rgb(lookup(a_f_lobe_, theta, std::size_t(p) * std::size_t(params_.theta_count)));
+}
+Rgb DualScattering::lobe_backward_attenuation(int p, double theta) const {
+    if (p < 0 || p >= lobe_count_) return {};
+    return to_rgb(lookup(a_b_lobe_, theta, std::size_t(p) * std::size_t(params_.theta_count)));
+}
+Rgb DualScattering::lobe_forward_azimuthal(int p, double theta_d) const {
+    if (p < 0 || p >= lobe_count_) return {};
+    return to_rgb(lookup(n_g_lobe_, theta_d, std::size_t(p) * std::size_t(params_.theta_count)));
+}
+LobeShape DualScattering::lobe_shape(int p) const {
+    if (p < 0 || p >= lobe_count_) return {};
+    return shapes_[std::size_t(p)];
+}
+
+Rgb DualScattering::forward_attenuation(double t) const { return to_rgb(lookup(a_f_, t)); }
+Rgb DualScattering::backward_attenuation(double t) const { return to_rgb(lookup(a_b_, t)); }
+Rgb DualScattering::forward_shift(double t) const { return to_rgb(lookup(alpha_f_, t)); }
+Rgb DualScattering::backward_shift(double t) const { return to_rgb(lookup(alpha_b_, t)); }
+Rgb DualScattering::backscatter_attenuation(double t) const { return to_rgb(lookup(big_a_b_, t)); }
+Rgb DualScattering::backscatter_shift(double t) const { return to_rgb(lookup(delta_b_, t)); }
+
+Rgb DualScattering::forward_width(double t) const {
+    const Rgbd v = lookup(beta2_f_, t);
+    return {float(std::sqrt(v.v[0])), float(std::sqrt(v.v[1])), float(std::sqrt(v.v[2]))};
+}
+Rgb DualScattering::backward_width(double t) const {
+    const Rgbd v = lookup(beta2_b_, t);
+    return {float(std::sqrt(v.v[0])), float(std::sqrt(v.v[1])), float(std::sqrt(v.v[2]))};
+}
+Rgb DualScattering::backscatter_width(double t) const {
+    const Rgbd v = lookup(sigma2_b_, t);
+    return {float(std::sqrt(v.v[0])), float(std::sqrt(v.v[1])), float(std::sqrt(v.v[2]))};
+}
+
+Rgb DualScattering::forward_transmittance(double theta, int n_h) const {
+    if (n_h < 0) return {};
+    if (n_h == 0) return Rgb(1.0f);
+    const Rgbd a = lookup(a_f_, theta);
+    Rgb out;
+    const double df = params_.d_f;
+    out = {float(df * std::pow(std::max(0.0, a.v[0]), n_h)), float(df * std::pow(std::max(0.0, a.v[1]), n_h)),
+           float(df * std::pow(std::max(0.0, a.v[2]), n_h))};
+    return out;
+}
+
+Rgb DualScattering::forward_spread_variance(double theta, int n_h) const {
+    if (n_h <= 0) return {};
+    // The paper's σ_f² = n_h β̄_f² (the seed's source had n_h β̄_f, without the square).
+    const Rgbd b2 = lookup(beta2_f_, theta);
+    return {float(n_h * b2.v[0]), float(n_h * b2.v[1]), float(n_h * b2.v[2])};
+}
+
+// ------------------------------------------------------------------------------------------
+// Shading
+
+Rgb DualScattering::multiple_f_cos(float theta_i_f, float theta_o_f, int n_h) const {
+    if (n_h < 0) return {};
+    const double theta_i = theta_i_f, theta_o = theta_o_f;
+    const double theta_h = 0.5 * (theta_i + theta_o);
+    const double theta_d = 0.5 * (theta_o - theta_i);
+    const double cos_i = std::max(0.0, std::cos(theta_i));
+    const double cos_d2 = std::max(sqr(std::cos(theta_d)), 1e-12);
+    const double db = params_.d_b, df = params_.d_f;
+
+    const Rgbd big_a = lookup(big_a_b_, theta_i);
+    const Rgbd delta = lookup(delta_b_, theta_i);
+    const Rgbd sig2 = lookup(sigma2_b_, theta_i);
+
+    Rgbd out;
+    if (n_h == 0) {
+        for (int ch = 0; ch < 3; ++ch) {
+            const double v = std::max(sig2.v[ch], 1e-12);
+            const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], v) / (kPi * cos_d2);
+            out.v[ch] = db * f_back * cos_i;
+        }
+        return to_rgb(out);
+    }
+
+    const Rgbd a_f = lookup(a_f_, theta_i);
+    const Rgbd b2f = lookup(beta2_f_, theta_i);
+    std::array<Rgbd, 16> ng{};
+    for (int p = 0; p < lobe_count_; ++p)
+        ng[std::size_t(p)] = lookup(n_g_lobe_, theta_d, std::size_t(p) * std::size_t(params_.theta_count));
+    for (int ch = 0; ch < 3; ++ch) {
+        const double t_f = df * std::pow(std::max(0.0, a_f.v[ch]), n_h);
+        const double s_f2 = n_h * b2f.v[ch];
+        double f_s = 0;
+        for (int p = 0; p < lobe_count_; ++p) {
+            const LobeShape &s = shapes_[std::size_t(p)];
+            const double var = std::max(sqr(double(s.beta)) + s_f2, 1e-12);
+            f_s += gaussian(theta_h - s.alpha, var) * ng[std::size_t(p)].v[ch] / cos_d2;
+        }
+        const double var_b = std::max(sig2.v[ch] + s_f2, 1e-12);
+        const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], var_b) / (kPi * cos_d2);
+        out.v[ch] = t_f * df * (f_s + kPi * db * f_back) * cos_i;
+    }
+    return to_rgb(out);
+}
+
+}  // namespace hairis

@@ -1,0 +1,49 @@
+// A fiber's scattering at one shading point (pbrt-v4 builds a HairBxDF per hit the same way):
+// what depends on where the ray met the fiber is computed once, and f is evaluated from it for
+// any number of ω_i (the light sample, the BSDF sample).
+#pragma once
+
+#include "core/math.h"
+#include "core/scratch.h"
+
+namespace hairis {
+
+/// Where a ray met a fiber, in the fiber frame of frame.h (x = tangent).
+struct FiberHit {
+    Vec3 wo;      ///< unit direction towards the viewer
+    float h = 0;  ///< offset across the fiber, in [−1, 1] (frame.h)
+};
+
+/// A sampled incident direction and the density it was drawn from.
+struct DirectionSample {
+    Vec3 wi;        ///< unit direction towards the light, fiber frame
+    float pdf = 0;  ///< solid-angle density of wi, > 0
+    int lobe = -1;  ///< the lobe drawn from, when the sampler knows it (−1 otherwise)
+};
+
+/// A fiber model prepared at one hit. Trivially destructible (lives in a ScratchBuffer).
+class FiberPoint {
+  public:
+    /// f(ω_i, ω_o, h)·|cos θ_i| for this hit: the value the path tracer multiplies by.
+    virtual Rgb f(Vec3 wi) const = 0;
+    const FiberHit &hit() const { return hit_; }
+
+  protected:
+    explicit FiberPoint(const FiberHit &hit) : hit_(hit) {}
+    FiberPoint(const FiberPoint &) = default;
+    FiberPoint &operator=(const FiberPoint &) = default;
+    ~FiberPoint() = default;
+
+  private:
+    FiberHit hit_;
+};
+
+/// A fiber model a renderer shades: it prepares a FiberPoint per hit.
+class ShadingModel {
+  public:
+    virtual ~ShadingModel() = default;
+    /// The model at `hit`, made in `scratch` (valid until its reset).
+    virtual const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const = 0;
+};
+
+}  // namespace hairis

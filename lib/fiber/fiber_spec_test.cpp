@@ -1,0 +1,80 @@
+#include "fiber/fiber_spec.h"
+
+#include <gtest/gtest.h>
+
+namespace hairis {
+namespace {
+
+TEST(FiberSpec, Presets) {
+    auto b = FiberSpec::preset("blonde");
+    ASSERT_TRUE(b.ok());
+    EXPECT_EQ(b.value().kind, FiberKind::Marschner);
+    EXPECT_FLOAT_EQ(b.value().marschner.sigma_a.r, 0.15f);
+    auto d = FiberSpec::preset("cycles-default");
+    ASSERT_TRUE(d.ok());
+    EXPECT_EQ(d.value().kind, FiberKind::Chiang);
+    auto bad = FiberSpec::preset("ginger");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().message.find("blonde, brunette, cycles-default"), std::string::npos);
+}
+
+TEST(FiberSpec, ParsesAParameterFile) {
+    const auto spec = parse_fiber_spec(
+        "# a dark fiber\nmodel = chiang\nparametrization = melanin\nmelanin = 0.5  # half\n"
+        "tint = 1, 0.9, 0.8\nroughness=0.25\noffset_deg = 3\n");
+    ASSERT_TRUE(spec.ok()) << spec.error().message;
+    const FiberSpec &s = spec.value();
+    EXPECT_EQ(s.node.parametrization, HairParametrization::Melanin);
+    EXPECT_FLOAT_EQ(s.node.melanin, 0.5f);
+    EXPECT_FLOAT_EQ(s.node.tint.b, 0.8f);
+    EXPECT_FLOAT_EQ(s.node.roughness, 0.25f);
+    EXPECT_NEAR(s.node.offset, radians(3.0), 1e-7);
+    EXPECT_TRUE(s.create_model().ok());
+    const auto params = s.parameters();
+    ASSERT_TRUE(params.ok());
+    EXPECT_EQ(params.value().front().first, "sigma_a.r");
+}
+
+TEST(FiberSpec, MarschnerKeys) {
+    const auto spec = parse_fiber_spec("preset = brunette\neccentricity = 1\nbeta_r_deg = 5\n");
+    ASSERT_TRUE(spec.ok()) << spec.error().message;
+    EXPECT_EQ(spec.value().kind, FiberKind::Marschner);
+    EXPECT_DOUBLE_EQ(spec.value().marschner.eccentricity, 1.0);
+    EXPECT_NEAR(spec.value().marschner.beta_r, radians(5.0), 1e-12);
+    auto model = spec.value().create_model();
+    ASSERT_TRUE(model.ok());
+    EXPECT_EQ(model.value()->name(), "marschner2003");
+}
+
+TEST(FiberSpec, ErrorsNameLineAndKey) {
+    auto s = parse_fiber_spec("model = chiang\nroughness = lots\n");
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().message.find("line 2: roughness must be a finite number"), std::string::npos) << s.error().message;
+    s = parse_fiber_spec("shinyness = 3\n");
+    EXPECT_NE(s.error().message.find("unknown parameter \"shinyness\""), std::string::npos);
+    s = parse_fiber_spec("color = 1 2\n");
+    EXPECT_NE(s.error().message.find("three finite numbers"), std::string::npos);
+    s = parse_fiber_spec("just words\n");
+    EXPECT_NE(s.error().message.find("expected key = value"), std::string::npos);
+    s = parse_fiber_spec("model = lambert\n");
+    EXPECT_NE(s.error().message.find("model must be chiang or marschner"), std::string::npos);
+    // Values are checked when the model is built, with the model's own message.
+    s = parse_fiber_spec("ior = 0.9\n");
+    ASSERT_TRUE(s.ok());
+    const auto m = s.value().create_model();
+    ASSERT_FALSE(m.ok());
+    EXPECT_NE(m.error().message.find("ior"), std::string::npos) << m.error().message;
+}
+
+TEST(FiberSpec, EqualScatteringGivesEqualParameters) {
+    // The same σ_a through two parametrizations gives the same table parameters.
+    FiberSpec a = FiberSpec::preset("cycles-default").value();
+    auto mapped = to_chiang_params(a.node).value();
+    FiberSpec b = a;
+    b.node.parametrization = HairParametrization::AbsorptionCoefficient;
+    b.node.absorption_coefficient = mapped.sigma_a;
+    EXPECT_EQ(a.parameters().value(), b.parameters().value());
+}
+
+}  // namespace
+}  // namespace hairis

@@ -1,0 +1,79 @@
+/* hairis render API: a scene of hair curves, meshes, materials, lights, world and camera, and
+ * the hair path tracer behind the Blender add-on's "Hairis" engine (lib/render/render.h).
+ * Conventions as hairis.h: options strings, status codes, hairis_last_error().
+ *
+ * Lights, materials, the world, the camera and the render settings are option strings
+ * (hairis_defaults("sun"), ... list every name with its default); geometry is arrays.
+ * Matrices are 16 numbers, row-major, object-to-world, as Blender's matrix_world.
+ */
+#ifndef HAIRIS_RENDER_H
+#define HAIRIS_RENDER_H
+
+#include "hairis/hairis.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct hairis_scene hairis_scene;
+
+HAIRIS_API hairis_scene *hairis_scene_create(void);
+HAIRIS_API void hairis_scene_destroy(hairis_scene *scene);
+
+/**
+ * Adds a hair material of `fiber` (a Chiang fiber); `tables` (may be NULL) are what the TABLE
+ * strategy samples and must have been baked for the fiber. Returns the material index, or -1.
+ * The scene keeps what it needs (the handles may be destroyed). Whether the tables fit is
+ * checked by hairis_render for the TABLE strategy: HAIRIS_ERROR_INVALID_TABLE naming the
+ * material otherwise.
+ */
+HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_fiber *fiber,
+                                              const hairis_tables *tables);
+/** Adds a surface material from options ("diffuse": color, emission); returns its index or -1. */
+HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char *options);
+/**
+ * Adds hair curves drawn as round Catmull-Rom curves (Cycles' "3D Curves"): curve c has points
+ * first[c] .. first[c+1]-1 (first has curve_count+1 entries), positions xyz in world space,
+ * one radius per point. `material` must already be in the scene.
+ */
+HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t curve_count,
+                                       const uint32_t *first, size_t point_count,
+                                       const float *positions, const float *radii);
+/** Adds a triangle mesh in world space; `materials` holds one material index per triangle. */
+HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
+                                     const float *positions, size_t triangle_count,
+                                     const uint32_t *indices, const int32_t *materials);
+/**
+ * Adds a light from options, in Blender's units and names: "type=sun" (direction towards the
+ * sun, color, strength W/m², angle), "type=point" (position, color, power W, radius),
+ * "type=area" (matrix, shape square | rectangle | disk | ellipse, size, size_y, color, power).
+ */
+HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options);
+/** The world from options: color, strength (a constant background). */
+HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const char *options);
+/**
+ * The camera from options: matrix (camera-to-world; Blender's camera looks down -Z, +Y up),
+ * orthographic (0 | 1), frame (Camera.view_frame's 4 corners in camera space, 12 numbers: top
+ * right, bottom right, bottom left, top left), width and height in pixels.
+ */
+HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options);
+/**
+ * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
+ * wants). Settings (options): samples, max_bounces, max_diffuse_bounces,
+ * max_transmission_bounces, strategy, multiple_weight, n_h, seed, threads, tile_size,
+ * film_transparent. progress may be NULL; non-zero from it cancels (HAIRIS_ERROR_CANCELLED,
+ * promptly; rgba then holds the samples finished so far); it is only called on the calling
+ * thread. A scene without camera or geometry is refused. Each call builds the scene anew, so
+ * a scene can be rendered again with other settings, also from several threads at once.
+ */
+HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
+                             hairis_progress_fn progress, void *user);
+/** What the calling thread's last hairis_render did, as options: seconds, camera_rays, rays,
+ * shadow_rays, dropped_samples, peak_memory_bytes, threads; "" before any render. */
+HAIRIS_API const char *hairis_last_render_stats(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* HAIRIS_RENDER_H */

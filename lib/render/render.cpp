@@ -1,0 +1,439 @@
+#include "render/render.h"
+
+
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/frame.h"
+#include "core/rng.h"
+#include "core/scratch.h"
+
+namespace hairis {
+
+namespace {
+
+// Random-number dimensions: 2 for the pixel jitter, then a fixed block per path vertex.
+constexpr std::uint32_t kDimJitterU = 0, kDimJitterV = 1;
+constexpr std::uint32_t kDimFirstVertex = 2;
+// SobolSampleRng stratifies dimensions 2k and 2k + 1 together, so the layout keeps the pairs
+// that belong together: jitter (0, 1), light position (4, 5), BSDF φ and θ (6, 7) per vertex.
+constexpr std::uint32_t kDimsPerVertex = 8;
+enum VertexDim : std::uint32_t {
+    kDimRoulette = 0,
+    kDimLightSelect = 1,
+    kDimLightU = 2,
+    kDimLightV = 3,
+    kDimBsdf0 = 4,
+    kDimBsdf1 = 5,
+    kDimBsdf2 = 6,
+};
+
+constexpr std::uint32_t dim(int depth, VertexDim d) {
+    return kDimFirstVertex + std::uint32_t(depth) * kDimsPerVertex + std::uint32_t(d);
+}
+
+bool finite(Rgb c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b); }
+bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
+
+struct Counters {
+    std::uint64_t rays = 0, shadow_rays = 0, dropped = 0;
+};
+
+// A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
+// Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`.
+class Bsdf {
+  public:
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, ScratchBuffer &scratch) {
+        if (const auto *hair = std::get_if<HairMaterial>(&material)) {
+            frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
+            const float h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
+            hair_.emplace(hair->shading.at({frame_.to_local(wo), h}, scratch));
+        } else {
+            const auto &d = std::get<DiffuseMaterial>(material);
+            albedo_ = d.albedo;
+            n_ = dot(sp.normal, wo) >= 0.0f ? sp.normal : -sp.normal;
+            orthonormal_basis(n_, a_, b_);
+        }
+    }
+
+    bool black() const { return !hair_ && is_black(albedo_); }
+    bool is_hair() const { return hair_.has_value(); }
+
+    // f·|cos θ_i| and the density with which sample() draws wi.
+    Rgb eval(Vec3 wi, float &pdf) const {
+        if (hair_) {
+            const Vec3 wi_local = frame_.to_local(wi);
+            pdf = hair_->pdf(wi_local);
+            return hair_->f(wi_local);
+        }
+        const float c = dot(n_, wi);
+        if (!(c > 0.0f)) {
+            pdf = 0.0f;
+            return {};
+        }
+        pdf = c * float(kInvPi);
+        return albedo_ * (c * float(kInvPi));
+    }
+
+    // Draws wi; returns false when there is none. weight = f·|cos|/pdf.
+    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf) const {
+        if (hair_) {
+            const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
+            if (!s || !(s->pdf > 0.0f)) return false;
+            wi = safe_normalize(frame_.to_world(s->wi));
+            pdf = s->pdf;
+            weight = s->f / pdf;
+            return dot(wi, wi) > 0.0f;
+        }
+        float x, y;
+        concentric_disk(u0, u1, x, y);
+        const float z = std::sqrt(std::max(0.0f, 1.0f - x * x - y * y));
+        wi = safe_normalize(a_ * x + b_ * y + n_ * z);
+        const float c = dot(n_, wi);
+        if (!(c > 0.0f)) return false;
+        pdf = c * float(kInvPi);
+        weight = albedo_;  // (albedo/π · cos) / (cos/π)
+        return true;
+    }
+
+  private:
+    std::optional<HairBsdf> hair_;
+    FiberFrame frame_;
+    Rgb albedo_;
+    Vec3 n_, a_, b_;
+};
+
+// One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
+Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
+               std::uint64_t sample, float &alpha, Counters &counters, ScratchBuffer &scratch) {
+    const Camera &camera = scene.camera();
+    const LightSet &lights = scene.lights();
+    const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x);
+    // Stratified per pixel (jitter, light and BSDF pairs): hair is thinner than a pixel, and
+    // stratifying where a sample lands in the pixel is what Cycles' Sobol patterns buy it.
+    const SobolSampleRng rng(settings.seed, pixel, sample);
+
+    const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
+    Vec3 origin = cr.origin, dir = cr.direction;
+    float tmin = cr.tmin, tmax = cr.tmax;
+    PrimRef skip;
+    Rgb beta(1.0f), radiance;
+    float bsdf_pdf = 0.0f;
+    bool use_mis = false;  // camera rays take emission at full weight
+    int diffuse_bounces = 0, transmission_bounces = 0;
+    bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
+    alpha = 1.0f;
+
+    auto add = [&](Rgb contribution) {
+        if (!finite(contribution)) {
+            ++counters.dropped;
+            return;
+        }
+        radiance += contribution;
+    };
+
+    for (int depth = 0;; ++depth) {
+        const std::optional<Hit> hit = scene.intersect(origin, dir, tmin, tmax, skip);
+        ++counters.rays;
+        const float t_end = hit ? hit->t : tmax;
+
+        // Lamps are transparent: every one crossed before the surface contributes.
+        const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis);
+        if (!is_black(lamps)) add(beta * lamps);
+
+        if (!hit) {
+            const bool transparent = depth == 0 && settings.film_transparent;
+            if (transparent) alpha = 0.0f;
+            const Rgb escaped = lights.escaped(dir, bsdf_pdf, use_mis, !transparent);
+            if (!is_black(escaped)) add(beta * escaped);
+            break;
+        }
+
+        const SurfacePoint sp = scene.surface_point(origin, dir, *hit);
+        const Material &material = scene.materials()[sp.material];
+        const Vec3 wo = -dir;
+
+        // Surface emission (mesh triangles are light-sampled, curves are not).
+        if (const auto *diffuse = std::get_if<DiffuseMaterial>(&material)) {
+            if (!is_black(diffuse->emission)) {
+                float w = 1.0f;
+                if (use_mis && sp.is_light) {
+                    const float abs_cos = std::fabs(dot(sp.normal, dir));
+                    w = power_heuristic(bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
+                }
+                add(beta * diffuse->emission * w);
+            }
+        }
+
+        if (depth > settings.max_bounces || last_segment) break;
+
+        // Russian roulette.
+        if (depth >= settings.rr_start_bounce) {
+            const float q = std::min(1.0f, std::sqrt(beta.max_component()));
+            if (!(rng.get(dim(depth, kDimRoulette)) < q)) break;
+            beta = beta / q;
+        }
+
+        scratch.reset();  // the previous vertex's BSDF is done with
+        const Bsdf bsdf(material, sp, wo, scratch);
+        if (bsdf.black()) break;
+
+        // Next-event estimation.
+        if (!lights.empty()) {
+            const auto ls = lights.sample(sp.position, rng.get(dim(depth, kDimLightSelect)),
+                                          rng.get(dim(depth, kDimLightU)),
+                                          rng.get(dim(depth, kDimLightV)));
+            if (ls && ls->pdf > 0.0f) {
+                float pdf_bsdf = 0.0f;
+                const Rgb f = bsdf.eval(ls->wi, pdf_bsdf);
+                if (!is_black(f)) {
+                    const float shadow_tmax =
+                        std::isinf(ls->distance) ? INFINITY : ls->distance * (1.0f - 1e-5f);
+                    ++counters.shadow_rays;
+                    const PrimRef target{ls->skip_geometry, ls->skip_primitive};
+                    if (!scene.occluded(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax,
+                                        sp.self, target)) {
+                        const float w = ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf);
+                        add(beta * f * ls->value * (w / ls->pdf));
+                    }
+                }
+            }
+        }
+
+        // Continue along a BSDF sample.
+        Vec3 wi;
+        Rgb weight;
+        float pdf = 0.0f;
+        if (!bsdf.sample(rng.get(dim(depth, kDimBsdf0)), rng.get(dim(depth, kDimBsdf1)),
+                         rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf))
+            break;
+        if (bsdf.is_hair())
+            last_segment = ++transmission_bounces > settings.max_transmission_bounces;
+        else
+            last_segment = ++diffuse_bounces > settings.max_diffuse_bounces;
+        beta *= weight;
+        if (!finite(beta)) {
+            ++counters.dropped;
+            break;
+        }
+        if (is_black(beta)) break;
+        origin = sp.spawn_point(wi);
+        dir = wi;
+        tmin = 0.0f;
+        tmax = INFINITY;
+        skip = sp.self;
+        bsdf_pdf = pdf;
+        use_mis = true;
+    }
+    return radiance;
+}
+
+Status validate(const RenderSettings &s) {
+    return first_error(check::count_in_range("samples", s.samples, 1, 1 << 24),
+                       check::count_in_range("max_bounces", s.max_bounces, 0, 1024),
+                       check::count_in_range("max_diffuse_bounces", s.max_diffuse_bounces, 0,
+                                             1024),
+                       check::count_in_range("max_transmission_bounces",
+                                             s.max_transmission_bounces, 0, 1024),
+                       check::count_in_range("threads", s.threads, 0, 1024),
+                       check::count_in_range("tile_size", s.tile_size, 1, 4096),
+                       check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024));
+}
+
+struct Tile {
+    int x0, y0, x1, y1;
+};
+
+}  // namespace
+
+float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo) {
+    const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);
+    return std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);
+}
+
+Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int y,
+                  std::uint64_t sample, float *alpha) {
+    Counters counters;
+    ScratchBuffer scratch;
+    float a = 1.0f;
+    const Rgb l = trace_path(scene, settings, x, y, sample, a, counters, scratch);
+    if (alpha) *alpha = a;
+    return l;
+}
+
+Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
+              const std::function<bool(float)> &progress, RenderStats *stats_out) {
+    if (auto e = validate(settings)) return e;
+    if (!rgba) return Error{"rgba must not be null"};
+    const auto start = std::chrono::steady_clock::now();
+
+    const int width = scene.camera().width(), height = scene.camera().height();
+    const int ts = settings.tile_size;
+    std::vector<Tile> tiles;
+    for (int y0 = 0; y0 < height; y0 += ts)
+        for (int x0 = 0; x0 < width; x0 += ts)
+            tiles.push_back({x0, y0, std::min(x0 + ts, width), std::min(y0 + ts, height)});
+    std::fill(rgba, rgba + std::size_t(width) * std::size_t(height) * 4, 0.0f);
+
+    const int threads =
+        settings.threads > 0 ? settings.threads : std::max(1, tbb::info::default_concurrency());
+    const std::uint64_t total_passes =
+        std::uint64_t(tiles.size()) * std::uint64_t(settings.samples);
+
+    std::atomic<bool> cancel{false};
+    std::atomic<std::uint64_t> passes_done{0}, camera_rays{0}, rays{0}, shadow_rays{0},
+        dropped{0};
+
+    auto render_tile = [&](const Tile &tile) {
+        const int tw = tile.x1 - tile.x0, th = tile.y1 - tile.y0;
+        std::vector<double> sum(std::size_t(tw) * std::size_t(th) * 4, 0.0);
+        Counters counters;
+        ScratchBuffer scratch;
+        int done = 0;
+        for (int s = 0; s < settings.samples; ++s) {
+            if (cancel.load(std::memory_order_relaxed)) break;
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    float alpha = 1.0f;
+                    const Rgb l = trace_path(scene, settings, x, y, std::uint64_t(s), alpha,
+                                             counters, scratch);
+                    double *p = &sum[(std::size_t(y - tile.y0) * std::size_t(tw) +
+                                      std::size_t(x - tile.x0)) * 4];
+                    p[0] += l.r;
+                    p[1] += l.g;
+                    p[2] += l.b;
+                    p[3] += alpha;
+                }
+            ++done;
+            passes_done.fetch_add(1, std::memory_order_relaxed);
+        }
+        if (done > 0) {
+            const double inv = 1.0 / double(done);
+            for (int y = tile.y0; y < tile.y1; ++y)
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const double *p = &sum[(std::size_t(y - tile.y0) * std::size_t(tw) +
+                                            std::size_t(x - tile.x0)) * 4];
+                    float *out = rgba + (std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4;
+                    for (int c = 0; c < 4; ++c) out[c] = float(p[c] * inv);
+                }
+        }
+        camera_rays.fetch_add(std::uint64_t(done) * std::uint64_t(tw) * std::uint64_t(th));
+        rays.fetch_add(counters.rays);
+        shadow_rays.fetch_add(counters.shadow_rays);
+        dropped.fetch_add(counters.dropped);
+    };
+
+    std::mutex mutex;
+    std::condition_variable cv;
+    bool finished = false;
+    std::exception_ptr failure, callback_failure;
+    std::thread worker;
+    try {
+        worker = std::thread([&] {
+            try {
+                tbb::task_arena arena(threads);
+                arena.execute([&] {
+                    tbb::parallel_for(
+                        tbb::blocked_range<std::size_t>(0, tiles.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t> &r) {
+                            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                                if (cancel.load(std::memory_order_relaxed)) return;
+                                render_tile(tiles[i]);
+                            }
+                        },
+                        tbb::simple_partitioner());
+                });
+            } catch (...) {
+                failure = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(mutex);
+            finished = true;
+            cv.notify_all();
+        });
+    } catch (const std::exception &e) {
+        return Error{std::string("render: could not start the render thread: ") + e.what()};
+    }
+
+    {
+        std::unique_lock<std::mutex> lock(mutex);
+        bool first = true;
+        while (!finished) {
+            if (!first) cv.wait_for(lock, std::chrono::milliseconds(50));
+            first = false;
+            if (finished) break;
+            if (progress && !cancel.load()) {
+                const float fraction = float(double(passes_done.load()) / double(total_passes));
+                lock.unlock();
+                bool go_on = false;
+                try {
+                    go_on = progress(fraction);
+                } catch (...) {
+                    // Never leave the worker running: stop it and report the exception.
+                    callback_failure = std::current_exception();
+                }
+                lock.lock();
+                if (!go_on) cancel.store(true);
+            }
+        }
+    }
+    worker.join();
+
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const bool cancelled = cancel.load();
+    const float fraction = float(double(passes_done.load()) / double(total_passes));
+    if (!cancelled && progress && !failure) {
+        try {
+            progress(1.0f);
+        } catch (...) {
+            callback_failure = std::current_exception();
+        }
+    }
+    if (stats_out) {
+        RenderStats &st = *stats_out;
+        st = RenderStats{};
+        st.seconds = seconds;
+        st.camera_rays = camera_rays.load();
+        st.rays = rays.load();
+        st.shadow_rays = shadow_rays.load();
+        st.dropped_samples = dropped.load();
+        st.samples_per_second = seconds > 0 ? double(st.camera_rays) / seconds : 0.0;
+        st.cancelled = cancelled;
+        st.progress = fraction;
+        st.threads = threads;
+        st.peak_memory_bytes =
+            std::uint64_t(scene.stats().estimated_peak_bytes) +
+            std::uint64_t(threads) * std::uint64_t(ts) * std::uint64_t(ts) * 4 * sizeof(double) +
+            std::uint64_t(tiles.size()) * sizeof(Tile);
+    }
+    if (callback_failure && !failure) failure = callback_failure;
+    if (failure) {
+        try {
+            std::rethrow_exception(failure);
+        } catch (const std::exception &e) {
+            return Error{std::string("render failed: ") + e.what()};
+        } catch (...) {
+            return Error{"render failed: unknown exception"};
+        }
+    }
+    if (cancelled)
+        return Error{"cancelled by the progress callback after " +
+                     std::to_string(int(fraction * 100.0f)) + "% of the work"};
+    return std::nullopt;
+}
+
+}  // namespace hairis

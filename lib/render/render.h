@@ -1,0 +1,131 @@
+// The hair path tracer behind the "Hairis" render engine: renders a Scene the way Cycles 3.4
+// renders the same Blender scene (same light units, curve shape, hair BSDF and bounce count).
+//
+// Integrator (per camera sample; the vertex where the camera ray lands has depth 0):
+//  - Emission: a ray that reaches an emitter adds throughput × radiance, weighted by the power
+//    heuristic against light sampling when the emitter can be light-sampled (point-light
+//    disks, area lights, suns with a disc, emissive mesh triangles); camera rays and emitters
+//    that are never light-sampled (a constant world, as in Cycles 3.4; emissive curves) take
+//    weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in Cycles (kernel/integrator/
+//    shade_light.h): every lamp crossed before the next surface contributes.
+//  - Diffuse and transmission limits the same way, per kind of bounce (see RenderSettings).
+//    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
+//    glossy bounce; hairis never blurs: compare against Cycles with Filter Glossy 0.
+//  - Max bounces as Cycles' "Max Bounces: Total" (scene/integrator.cpp stores max_bounce + 1
+//    "so that a bounce of 0 indicates no global illumination, only direct illumination"):
+//    vertices of depth ≤ max_bounces are shaded (next-event estimation + a BSDF-sampled
+//    continuation); the continuation ray of the last shaded vertex still collects MIS-weighted
+//    emission, then the path ends. max_bounces = 0 is direct lighting only.
+//  - Next-event estimation at every shaded vertex: one light chosen as LightSet::sample
+//    documents (uniformly among lamps, Cycles 3.4's choice; emissive triangles by area),
+//    a shadow ray (hair, like everything, is opaque to it), MIS with the BSDF's density.
+//  - BSDF sampling: diffuse surfaces sample the cosine-weighted hemisphere around the normal
+//    facing ω_o. Hair uses its material's DirectionSampler: in the fiber frame of frame.h
+//    (FiberFrame::from_tangent_and_view(tangent, ω_o), Cycles' frame) and at
+//    h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves),
+//    ω_i = frame.to_world(sample.wi), and the throughput is multiplied by
+//    f_cos_near(ω_i, ω_o, h) / pdf (ChiangFiber, Cycles-exact).
+//  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
+//    min(1, sqrt(max throughput component)) and division by it (unbiased).
+//  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never
+//    accumulated; a non-finite throughput ends the path (counted too).
+//
+// Determinism: every random number is rng.h's SobolSampleRng (padded Owen-scrambled Sobol,
+// stratified per pixel), a pure function of (seed, pixel, sample, dimension); pixel
+// = y·width + x with y = 0 the bottom row, and each pixel accumulates its samples in sample
+// order in double precision, so the image is bit-identical for any thread count and tile
+// schedule.
+//
+// Threads and cancelling: the image is cut into tile_size² tiles rendered by oneTBB on at most
+// `threads` threads (a task arena). Each tile renders all samples of its pixels, one pass of
+// one sample per pixel at a time, and checks the cancel flag before every pass, so a cancel
+// takes effect within one pass of one tile (milliseconds). The progress callback is only ever
+// called on the thread that called render(), about every 50 ms; returning false cancels.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "core/expected.h"
+#include "render/scene.h"
+
+namespace hairis {
+
+/// How to render.
+struct RenderSettings {
+    /// Samples per pixel, in [1, 2^24].
+    int samples = 64;
+    /// Cycles' Max Bounces (Total), in [0, 1024]; Blender's default is 12.
+    int max_bounces = 12;
+    /// Cycles' Max Bounces: Diffuse, in [0, 1024] (Blender's default 4): counts bounces off
+    /// diffuse materials.
+    int max_diffuse_bounces = 4;
+    /// Cycles' Max Bounces: Transmission, in [0, 1024] (Blender's default 12): counts hair
+    /// bounces. Cycles counts a hair bounce drawn from the R lobe as a glossy bounce (limit
+    /// Max Bounces: Glossy, default 4) and the other lobes as transmission; a DirectionSampler
+    /// does not say which lobe it drew from, so hairis counts every hair bounce here and has
+    /// no glossy limit (paths with more than 4 R-lobe bounces are vanishingly rare).
+    int max_transmission_bounces = 12;
+    /// Same seed, same image.
+    std::uint64_t seed = 0;
+    /// Threads to use, in [0, 1024]; 0 = oneTBB's default concurrency (all cores).
+    int threads = 0;
+    /// Tile edge in pixels, in [1, 4096].
+    int tile_size = 16;
+    /// Russian roulette applies at vertices of depth >= this, in [1, 1024]. Cycles with
+    /// "Min Light Bounces" 0 (the default) stores min_bounce 1 and plays roulette from depth 2.
+    int rr_start_bounce = 2;
+    /// Blender's Film > Transparent: camera rays that miss everything add neither the world
+    /// nor alpha (suns seen directly still add their disc, as in Cycles). Alpha is otherwise 1.
+    bool film_transparent = false;
+};
+
+/// The option names of RenderSettings (core/options.h's field descriptions).
+template <typename Fields>
+void describe(Fields &f, RenderSettings &s) {
+    f.field("samples", s.samples, 1, 1 << 24);
+    f.field("max_bounces", s.max_bounces, 0, 1024);
+    f.field("max_diffuse_bounces", s.max_diffuse_bounces, 0, 1024);
+    f.field("max_transmission_bounces", s.max_transmission_bounces, 0, 1024);
+    f.field("seed", s.seed);
+    f.field("threads", s.threads, 0, 1024);
+    f.field("tile_size", s.tile_size, 1, 4096);
+    f.field("rr_start_bounce", s.rr_start_bounce, 1, 1024);
+    f.field("film_transparent", s.film_transparent);
+}
+
+/// What a render did.
+struct RenderStats {
+    double seconds = 0;
+    std::uint64_t camera_rays = 0;        ///< camera samples traced (= pixel samples done)
+    std::uint64_t rays = 0;               ///< closest-hit rays (camera and continuation)
+    std::uint64_t shadow_rays = 0;
+    std::uint64_t dropped_samples = 0;    ///< NaN/inf contributions or throughputs dropped
+    double samples_per_second = 0;        ///< camera_rays / seconds
+    bool cancelled = false;               ///< the progress callback returned false
+    float progress = 0;                   ///< fraction of the work done when render() returned
+    std::uint64_t peak_memory_bytes = 0;  ///< scene estimate + render buffers
+    int threads = 0;                      ///< threads actually allowed
+};
+
+/// Renders `scene` into rgba (width·height·4 floats, bottom row first, as Blender's render
+/// result wants; alpha in the 4th channel). `progress` (may be empty) receives the fraction
+/// done; returning false cancels: render() then returns an error whose message starts with
+/// "cancelled", sets stats->cancelled, and rgba holds the average of the samples finished so
+/// far (zero for pixels not started). Invalid settings are refused before anything is
+/// written. `stats` may be null.
+Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
+              const std::function<bool(float progress)> &progress, RenderStats *stats);
+
+/// Cycles' fiber offset for 3D curves (bsdf_principled_hair_setup): with the frame
+/// X = tangent, Y = normalize(cross(X, ω_o)), Z = cross(X, Y) (FiberFrame's), and Ng the
+/// thick-curve normal, h = dot(cross(Ng, X), Z), clamped to [−1, 1].
+float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo);
+
+/// The radiance estimate of one camera sample (for tests and debugging): the path of sample
+/// `sample` through raster position (x + u, y + v) where (u, v) are the sample's own jitter.
+/// `alpha` receives the sample's alpha when not null.
+Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int y,
+                  std::uint64_t sample, float *alpha = nullptr);
+
+}  // namespace hairis

@@ -1,0 +1,697 @@
+#include "render/render.h"
+#include "fiber/seed_pdfs.h"
+
+#include <gtest/gtest.h>
+
+#include "sampling/analytic_sampler.h"
+#include "sampling/strategy.h"
+#include "sampling/uniform_sampler.h"
+
+#include <cstdio>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace hairis {
+namespace {
+
+HairMaterial hair(std::shared_ptr<const ChiangFiber> fiber, std::shared_ptr<const Sampler> sampler) {
+    return HairMaterial{HairShading::create(std::move(fiber), std::move(sampler)).value()};
+}
+
+std::shared_ptr<const Sampler> gaussian_sampler(float w, int n_h) {
+    StrategyInputs in;
+    in.multiple_weight = w;
+    in.n_h = n_h;
+    return make_sampler(StrategyKind::Gaussian, in).value();
+}
+
+constexpr double kPiD = kPi;
+
+// ---- Scene helpers ------------------------------------------------------------------------
+
+CameraDesc ortho_down(float half_x, float half_y, int w, int h, Vec3 position = {0, 0, 5}) {
+    CameraDesc c;
+    c.camera_to_world = Mat4::translation(position);  // looks down −Z
+    c.projection = Projection::Orthographic;
+    c.frame = {Vec3{half_x, half_y, -1}, Vec3{half_x, -half_y, -1}, Vec3{-half_x, -half_y, -1},
+               Vec3{-half_x, half_y, -1}};
+    c.width = w;
+    c.height = h;
+    return c;
+}
+
+CameraDesc perspective(Vec3 position, float tan_half, int w, int h) {
+    CameraDesc c;
+    c.camera_to_world = Mat4::translation(position);
+    c.frame = {Vec3{tan_half, tan_half, -1}, Vec3{tan_half, -tan_half, -1},
+               Vec3{-tan_half, -tan_half, -1}, Vec3{-tan_half, tan_half, -1}};
+    c.width = w;
+    c.height = h;
+    return c;
+}
+
+TriangleMesh quad(float half, float z, std::uint32_t material, bool facing_up = true) {
+    TriangleMesh m;
+    m.positions = {{-half, -half, z}, {half, -half, z}, {half, half, z}, {-half, half, z}};
+    m.indices = facing_up ? std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}
+                          : std::vector<std::uint32_t>{0, 2, 1, 0, 3, 2};
+    m.materials = {material};
+    return m;
+}
+
+TriangleMesh sphere(float radius, int rings, int segments, std::uint32_t material) {
+    TriangleMesh m;
+    for (int i = 0; i <= rings; ++i) {
+        const double theta = kPiD * i / rings;
+        for (int j = 0; j < segments; ++j) {
+            const double phi = 2.0 * kPiD * j / segments;
+            m.positions.push_back({float(radius * std::sin(theta) * std::cos(phi)),
+                                   float(radius * std::sin(theta) * std::sin(phi)),
+                                   float(radius * std::cos(theta))});
+        }
+    }
+    for (int i = 0; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const std::uint32_t a = std::uint32_t(i * segments + j),
+                                b = std::uint32_t(i * segments + (j + 1) % segments),
+                                c = std::uint32_t((i + 1) * segments + j),
+                                d = std::uint32_t((i + 1) * segments + (j + 1) % segments);
+            m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+        }
+    m.materials = {material};
+    return m;
+}
+
+std::shared_ptr<const ChiangFiber> fiber_with(Rgb sigma_a) {
+    ChiangParams p;
+    p.sigma_a = sigma_a;
+    auto f = ChiangFiber::create(p);
+    EXPECT_TRUE(f.ok());
+    return std::make_shared<const ChiangFiber>(std::move(f).value());
+}
+
+// Parallel straight hairs along X in the plane z = 0, spaced along Y.
+HairCurves parallel_hairs(int count, float spacing, float radius, float half_length = 1.5f) {
+    HairCurves c;
+    c.first.push_back(0);
+    for (int i = 0; i < count; ++i) {
+        const float y = (float(i) - 0.5f * float(count - 1)) * spacing;
+        for (int k = 0; k < 4; ++k) {
+            c.points.push_back({-half_length + 2.0f * half_length * float(k) / 3.0f, y,
+                                0.02f * float(k % 2)});
+            c.radii.push_back(radius);
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    return c;
+}
+
+// A tuft of wavy hairs standing on the XY plane: `count` curves of `points` points.
+HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    HairCurves c;
+    c.first.push_back(0);
+    for (int i = 0; i < count; ++i) {
+        const Vec3 root{0.5f * u(rng), 0.5f * u(rng), 0.0f};
+        const Vec3 lean{0.3f * u(rng), 0.3f * u(rng), 1.0f};
+        for (int k = 0; k < points; ++k) {
+            const float t = float(k) / float(points - 1);
+            const Vec3 wiggle{0.03f * std::sin(9.0f * t + float(i)),
+                              0.03f * std::cos(7.0f * t + float(i)), 0.0f};
+            c.points.push_back(root + lean * t + wiggle);
+            c.radii.push_back(radius * (1.0f - 0.5f * t));
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    return c;
+}
+
+Scene build(SceneDesc d) {
+    auto s = Scene::build(std::move(d));
+    EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+    return std::move(s).value();
+}
+
+std::vector<float> render_ok(const Scene &scene, const RenderSettings &settings,
+                             RenderStats *stats = nullptr) {
+    std::vector<float> rgba(std::size_t(scene.camera().width()) * scene.camera().height() * 4);
+    const Status st = render(scene, settings, rgba.data(), {}, stats);
+    EXPECT_FALSE(st.has_value()) << (st ? st->message : "");
+    return rgba;
+}
+
+// Mean and per-sample standard deviation of one pixel's estimator (channel c).
+struct PixelEstimate {
+    double mean = 0, sigma = 0;
+};
+PixelEstimate estimate(const Scene &scene, const RenderSettings &s, int x, int y, int n,
+                       int c = 0) {
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < n; ++i) {
+        const double v = render_sample(scene, s, x, y, std::uint64_t(i))[c];
+        sum += v;
+        sum2 += v * v;
+    }
+    const double mean = sum / n;
+    return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean))};
+}
+
+float at(const std::vector<float> &rgba, int w, int x, int y, int c) {
+    return rgba[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 4 + std::size_t(c)];
+}
+
+// ---- Tests --------------------------------------------------------------------------------
+
+TEST(Render, WhiteFurnaceDiffuseSphere) {
+    // A Lambertian sphere of albedo 1 in a uniform white world reflects exactly the world:
+    // every pixel's expectation is 1, on the sphere and off it. The world is found by cosine
+    // sampling alone (it is not light-sampled), so on a convex sphere every path weighs exactly
+    // 1 and the spread may be zero; the bounds then allow float rounding only.
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(1.0f), Rgb(0.0f)}};
+    d.meshes = {sphere(1.0f, 24, 48, 0)};
+    d.world = {Rgb(1.0f), 1.0f};
+    d.camera = perspective({0, 0, 4}, 0.35f, 12, 12);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 64;
+    s.seed = 7;
+    const auto img = render_ok(scene, s);
+    // The estimator's per-sample spread, measured on the sphere's centre pixel.
+    const PixelEstimate centre = estimate(scene, s, 6, 6, 4096);
+    EXPECT_NEAR(centre.mean, 1.0, std::max(5.0 * centre.sigma / 64.0, 1e-5));
+    const double bound = std::max(6.0 * centre.sigma / std::sqrt(double(s.samples)), 1e-5);
+    double sum = 0;
+    for (int y = 0; y < 12; ++y)
+        for (int x = 0; x < 12; ++x)
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(at(img, 12, x, y, c), 1.0, bound) << x << "," << y;
+                if (c == 0) sum += at(img, 12, x, y, c);
+            }
+    EXPECT_NEAR(sum / 144.0, 1.0, std::max(4.0 * centre.sigma / std::sqrt(144.0 * s.samples), 1e-5));
+}
+
+TEST(Render, DiffusePlaneUnderTheSun) {
+    // L = albedo/π · E · cos θ for a Lambertian plane under a sun of irradiance E.
+    const float theta = float(radians(40.0)), strength = 3.0f, albedo = 0.5f;
+    for (const float angle : {0.0f, float(radians(5.0))}) {
+        SceneDesc d;
+        d.materials = {DiffuseMaterial{Rgb(albedo), Rgb(0.0f)}};
+        d.meshes = {quad(100.0f, 0.0f, 0)};
+        SunLight sun;
+        sun.to_sun = {std::sin(theta), 0.0f, std::cos(theta)};
+        sun.strength = strength;
+        sun.angle = angle;
+        d.suns = {sun};
+        d.camera = ortho_down(1, 1, 8, 8);
+        const Scene scene = build(std::move(d));
+        RenderSettings s;
+        s.samples = 64;
+        const auto img = render_ok(scene, s);
+        // The disc's irradiance on the plane: E · E[cos] over the sun's disc (quadrature of
+        // uniform points on the disc of radius tan(angle/2) at distance 1, as Cycles samples).
+        double mean_cos = std::cos(theta);
+        if (angle > 0.0f) {
+            const Vec3 c = sun.to_sun;
+            const Vec3 a{std::cos(theta), 0.0f, -std::sin(theta)}, b{0, 1, 0};
+            const double r = std::tan(0.5 * angle);
+            double sum = 0, n = 0;
+            for (int i = 0; i < 400; ++i)
+                for (int j = 0; j < 400; ++j) {
+                    const double x = -1 + (i + 0.5) / 200.0, y = -1 + (j + 0.5) / 200.0;
+                    if (x * x + y * y > 1) continue;
+                    const Vec3 dir = safe_normalize(c + a * float(r * x) + b * float(r * y));
+                    sum += dir.z;
+                    n += 1;
+                }
+            mean_cos = sum / n;
+        }
+        const double expected = albedo / kPiD * strength * mean_cos;
+        if (angle == 0.0f) {
+            // A delta sun and a black world: no noise at all.
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x)
+                    EXPECT_NEAR(at(img, 8, x, y, 1), expected, 1e-5 * expected);
+        } else {
+            const PixelEstimate p = estimate(scene, s, 3, 3, 4096, 1);
+            EXPECT_NEAR(p.mean, expected, 5.0 * p.sigma / 64.0 + 1e-6);
+            double sum = 0;
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x) {
+                    EXPECT_NEAR(at(img, 8, x, y, 1), expected, 6.0 * p.sigma / 8.0 + 1e-6);
+                    sum += at(img, 8, x, y, 1);
+                }
+            EXPECT_NEAR(sum / 64.0, expected, 4.0 * p.sigma / std::sqrt(64.0 * 64.0) + 1e-6);
+        }
+    }
+}
+
+TEST(Render, PointLightInverseSquareWithCyclesNormalisation) {
+    // Blender point light of power P and radius 0 at height d over a white Lambertian floor:
+    // Cycles' intensity is P/(4π) W/sr, so L(x, y) = (1/π) · P/(4π) · d / (x² + y² + d²)^(3/2).
+    const float power = 100.0f, d = 1.0f;
+    SceneDesc desc;
+    desc.materials = {DiffuseMaterial{Rgb(1.0f), Rgb(0.0f)}};
+    desc.meshes = {quad(100.0f, 0.0f, 0)};
+    desc.point_lights = {{Vec3{0, 0, d}, Rgb(1.0f), power, 0.0f}};
+    desc.camera = ortho_down(2, 2, 8, 8);
+    const Scene scene = build(std::move(desc));
+    RenderSettings s;
+    s.samples = 256;
+    const auto img = render_ok(scene, s);
+    auto radiance = [&](double x, double y) {
+        return (1.0 / kPiD) * (power / (4.0 * kPiD)) * d / std::pow(x * x + y * y + d * d, 1.5);
+    };
+    for (int py = 0; py < 8; ++py)
+        for (int px = 0; px < 8; ++px) {
+            // The pixel's footprint is [−2 + px/2, −2 + (px+1)/2] × (the same in y): average
+            // and spread of L over it, by a midpoint rule.
+            double sum = 0, sum2 = 0;
+            const int n = 48;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) {
+                    const double v = radiance(-2.0 + 0.5 * (px + (i + 0.5) / n),
+                                              -2.0 + 0.5 * (py + (j + 0.5) / n));
+                    sum += v;
+                    sum2 += v * v;
+                }
+            const double mean = sum / (n * n);
+            const double spread = std::sqrt(std::max(0.0, sum2 / (n * n) - mean * mean));
+            EXPECT_NEAR(at(img, 8, px, py, 0), mean, 5.0 * spread / 16.0 + 1e-4 * mean)
+                << "pixel " << px << "," << py;
+        }
+
+    // With a radius r, on the axis: E = P/(4π(d² + r²)) (a facing disk of radiance
+    // P/(4π·πr²)), L = E/π.
+    const float r = 0.5f;
+    SceneDesc desc2;
+    desc2.materials = {DiffuseMaterial{Rgb(1.0f), Rgb(0.0f)}};
+    desc2.meshes = {quad(100.0f, 0.0f, 0)};
+    desc2.point_lights = {{Vec3{0, 0, d}, Rgb(1.0f), power, r}};
+    desc2.camera = ortho_down(0.001f, 0.001f, 1, 1, {0, 0, 0.5f});
+    const Scene scene2 = build(std::move(desc2));
+    const PixelEstimate p = estimate(scene2, s, 0, 0, 20000);
+    const double expected = power / (4.0 * kPiD * (d * d + r * r)) / kPiD;
+    EXPECT_NEAR(p.mean, expected, 5.0 * p.sigma / std::sqrt(20000.0) + 1e-4 * expected);
+}
+
+TEST(Render, AreaLightsWithMis) {
+    // A disk light of diameter 2R at height d facing down over a white floor, on the axis:
+    // E = P/(4(R² + d²)), L = E/π. Close and large, so BSDF samples hit it often (MIS).
+    const float power = 50.0f, radius = 1.0f, d = 0.5f;
+    for (const AreaShape shape : {AreaShape::Disk, AreaShape::Square}) {
+        SceneDesc desc;
+        desc.materials = {DiffuseMaterial{Rgb(1.0f), Rgb(0.0f)}};
+        desc.meshes = {quad(100.0f, 0.0f, 0)};
+        AreaLight a;
+        a.shape = shape;
+        a.size_x = 2.0f * radius;
+        a.power = power;
+        a.light_to_world = Mat4::translation({0, 0, d});
+        desc.area_lights = {a};
+        desc.camera = ortho_down(0.001f, 0.001f, 1, 1, {0, 0, 0.25f});
+        const Scene scene = build(std::move(desc));
+        RenderSettings s;
+        s.samples = 1;
+        double expected;
+        if (shape == AreaShape::Disk) {
+            expected = power / (4.0 * (radius * radius + d * d)) / kPiD;
+        } else {
+            // A square of half side a at distance d, point on its axis:
+            // E = 4 L · a/√(a²+d²) · atan(a/√(a²+d²)), L = P/(4·(2a)²).
+            const double L = power * 0.25 / 4.0, q = radius / std::sqrt(radius * radius + d * d);
+            expected = 4.0 * L * q * std::atan(q) / kPiD;
+        }
+        const PixelEstimate p = estimate(scene, s, 0, 0, 20000);
+        EXPECT_NEAR(p.mean, expected, 5.0 * p.sigma / std::sqrt(20000.0))
+            << (shape == AreaShape::Disk ? "disk" : "square");
+    }
+}
+
+TEST(Render, HairInAWhiteWorldStaysAtMostOne) {
+    // σ_a = 0: the fiber absorbs nothing, so in a white furnace no pixel can exceed the world.
+    const auto clear = fiber_with(Rgb(0.0f));
+    SceneDesc d;
+    d.materials = {hair(clear, std::make_shared<const AnalyticSampler>(clear))};
+    d.curves = {parallel_hairs(5, 0.15f, 0.06f)};
+    d.world = {Rgb(1.0f), 1.0f};
+    d.camera = ortho_down(0.5f, 0.5f, 10, 10);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 64;
+    s.film_transparent = true;  // alpha = hair coverage; rgb/alpha = hair radiance
+    const auto img = render_ok(scene, s);
+    int hair_pixels = 0;
+    double sum = 0;
+    for (int y = 0; y < 10; ++y)
+        for (int x = 0; x < 10; ++x) {
+            const float alpha = at(img, 10, x, y, 3);
+            if (alpha < 0.5f) continue;
+            ++hair_pixels;
+            for (int c = 0; c < 3; ++c) {
+                const float v = at(img, 10, x, y, c) / alpha;
+                EXPECT_GT(v, 0.0f);
+                EXPECT_LE(v, 1.0f + 0.15f) << x << "," << y;  // 64 samples of noise
+            }
+            sum += at(img, 10, x, y, 1) / alpha;
+        }
+    ASSERT_GT(hair_pixels, 10);
+    const double mean = sum / hair_pixels;
+    EXPECT_GT(mean, 0.8);
+    EXPECT_LE(mean, 1.0 + 0.02);
+    // A full-coverage pixel measured with many samples.
+    int cx = -1, cy = -1;
+    for (int y = 0; y < 10 && cx < 0; ++y)
+        for (int x = 0; x < 10; ++x)
+            if (at(img, 10, x, y, 3) == 1.0f) {
+                cx = x;
+                cy = y;
+                break;
+            }
+    ASSERT_GE(cx, 0);
+    const PixelEstimate p = estimate(scene, s, cx, cy, 8192, 1);
+    EXPECT_LE(p.mean, 1.0 + 4.0 * p.sigma / std::sqrt(8192.0));
+    EXPECT_GT(p.mean, 0.5);
+}
+
+TEST(Render, HairStrategiesAgree) {
+    // The same hair lit by a sun and a world, with ω_i drawn by the uniform sampler or by
+    // Chiang's analytic sampler: the same expectation (MIS and f/pdf weights are unbiased).
+    const auto fiber = fiber_with(Rgb(0.4f, 0.8f, 1.6f));
+    auto make = [&](std::shared_ptr<const Sampler> sampler) {
+        SceneDesc d;
+        d.materials = {hair(fiber, std::move(sampler))};
+        d.curves = {parallel_hairs(3, 0.14f, 0.06f)};
+        d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
+        SunLight sun;
+        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.strength = 2.0f;
+        sun.angle = 0.2f;
+        d.suns = {sun};
+        d.camera = ortho_down(0.05f, 0.25f, 1, 5);
+        return build(std::move(d));
+    };
+    const Scene analytic = make(std::make_shared<const AnalyticSampler>(fiber));
+    const Scene uniform = make(std::make_shared<const UniformSampler>());
+    RenderSettings s;
+    s.max_bounces = 4;
+    for (int y = 0; y < 5; ++y) {
+        const PixelEstimate a = estimate(analytic, s, 0, y, 3000, 1);
+        const PixelEstimate u = estimate(uniform, s, 0, y, 3000, 1);
+        const double se = std::sqrt((a.sigma * a.sigma + u.sigma * u.sigma) / 3000.0);
+        EXPECT_NEAR(a.mean, u.mean, 4.5 * se + 1e-6) << "row " << y;
+        // The analytic strategy is the better one.
+        if (a.mean > 0.01) {
+            EXPECT_LT(a.sigma, u.sigma * 1.05) << "row " << y;
+        }
+    }
+}
+
+TEST(Render, HairStrategiesAgreeOnDeepPaths) {
+    // Twelve bounces among dense hairs under a sun and a sky: the analytic and the gaussian
+    // strategies (very different densities) must give the same expectation. The uniform
+    // strategy is left out on purpose: its path weight's second moment grows like
+    // E[(f/pdf)²]^depth ≈ 26^depth, so at this depth its unbiased estimate is so heavy-tailed
+    // that 2·10^6 samples still come out 1-3% low (at depth ≤ 1 it agrees to 0.1%).
+    const auto fiber = fiber_with(Rgb(0.1f, 0.3f, 0.9f));
+    auto make = [&](std::shared_ptr<const Sampler> sampler) {
+        SceneDesc d;
+        d.materials = {hair(fiber, std::move(sampler))};
+        d.curves = {parallel_hairs(9, 0.1f, 0.05f)};
+        d.world = {Rgb(0.4f, 0.5f, 0.7f), 1.0f};
+        SunLight sun;
+        sun.to_sun = safe_normalize({0.3f, -0.6f, 0.5f});
+        sun.strength = 3.0f;
+        sun.angle = 0.05f;
+        d.suns = {sun};
+        d.camera = ortho_down(0.05f, 0.05f, 1, 1);
+        return build(std::move(d));
+    };
+    const Scene analytic = make(std::make_shared<const AnalyticSampler>(fiber));
+    const Scene gauss =
+        make(gaussian_sampler(0.3f, 2));
+    RenderSettings s;
+    s.max_bounces = 12;
+    const PixelEstimate a = estimate(analytic, s, 0, 0, 20000, 1);
+    const PixelEstimate g = estimate(gauss, s, 0, 0, 300000, 1);
+    const double se = std::sqrt(a.sigma * a.sigma / 20000.0 + g.sigma * g.sigma / 300000.0);
+    EXPECT_NEAR(a.mean, g.mean, 4.5 * se);
+    EXPECT_GT(a.mean, 0.1);
+}
+
+TEST(Render, HairOffsetIsCyclesH) {
+    SceneDesc d;
+    d.materials = {hair(fiber_with(Rgb(0.5f)), std::make_shared<const UniformSampler>())};
+    d.curves = {parallel_hairs(1, 0.1f, 0.1f)};
+    d.camera = ortho_down(1, 1, 2, 2);
+    const Scene scene = build(std::move(d));
+    for (const float y : {0.05f, -0.05f, 0.0f, 0.099f}) {
+        const Vec3 o{0.2f, y, 3.0f}, dir{0, 0, -1};
+        const auto hit = scene.intersect(o, dir, 0.0f, INFINITY);
+        ASSERT_TRUE(hit.has_value());
+        const SurfacePoint sp = scene.surface_point(o, dir, *hit);
+        const float h = cycles_hair_offset(sp.normal, sp.tangent, -dir);
+        // |h| is the offset across the width over the radius; its sign follows the side.
+        EXPECT_NEAR(std::fabs(h), std::fabs(y) / 0.1f, 2e-2f) << y;
+        if (y != 0.0f) {
+            const auto mirrored = scene.intersect({0.2f, -y, 3.0f}, dir, 0.0f, INFINITY);
+            const SurfacePoint sm = scene.surface_point({0.2f, -y, 3.0f}, dir, *mirrored);
+            EXPECT_LT(h * cycles_hair_offset(sm.normal, sm.tangent, -dir), 0.0f);
+        }
+    }
+}
+
+TEST(Render, MaxBouncesCountLikeCycles) {
+    // Camera between an infinite white-ish floor (albedo a_f) and an emissive, reflective
+    // ceiling (emission L_e, albedo a_c). Light reaching the floor after j round trips needs
+    // 2j shaded bounces, so L(k) = a_f L_e Σ_{j ≤ k/2} (a_f a_c)^j: 0 and 1 bounce give the
+    // same (direct light only at 0, as in Cycles), 2 adds one round trip.
+    const float af = 0.8f, ac = 0.5f, le = 1.0f;
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(af), Rgb(0.0f)}, DiffuseMaterial{Rgb(ac), Rgb(le)}};
+    d.meshes = {quad(400.0f, 0.0f, 0), quad(400.0f, 2.0f, 1, false)};
+    d.camera = ortho_down(0.5f, 0.5f, 4, 4, {0, 0, 1});
+    const Scene scene = build(std::move(d));
+    auto mean_of = [&](int bounces, int rr_start, int diffuse = 1024) {
+        RenderSettings s;
+        s.max_bounces = bounces;
+        s.max_diffuse_bounces = diffuse;
+        s.rr_start_bounce = rr_start;
+        return estimate(scene, s, 1, 2, 6000);
+    };
+    for (int k : {0, 1, 2, 3, 4}) {
+        double expected = 0;
+        for (int j = 0; 2 * j <= k; ++j) expected += af * le * std::pow(af * ac, j);
+        const PixelEstimate p = mean_of(k, 100);
+        EXPECT_NEAR(p.mean, expected, 5.0 * p.sigma / std::sqrt(6000.0) + 2e-3 * expected)
+            << "max_bounces " << k;
+    }
+    // The diffuse limit counts the same way (all bounces here are diffuse).
+    {
+        const PixelEstimate limited = mean_of(12, 100, 2);
+        const double expected = af * le * (1.0 + af * ac);
+        EXPECT_NEAR(limited.mean, expected,
+                    5.0 * limited.sigma / std::sqrt(6000.0) + 2e-3 * expected);
+    }
+    // Russian roulette does not change the expectation.
+    const PixelEstimate no_rr = mean_of(8, 100), rr = mean_of(8, 1);
+    EXPECT_NEAR(no_rr.mean, rr.mean,
+                4.5 * std::sqrt((no_rr.sigma * no_rr.sigma + rr.sigma * rr.sigma) / 6000.0));
+}
+
+TEST(Render, ImageIsWrittenBottomRowFirst) {
+    // An emitter covering only the upper half of an orthographic view (camera space y > 0).
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.0f), Rgb(2.0f)}};
+    TriangleMesh m;
+    m.positions = {{-1, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 1, 0}};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    d.meshes = {m};
+    d.camera = ortho_down(1, 1, 4, 6);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 4;
+    const auto img = render_ok(scene, s);
+    for (int y = 0; y < 6; ++y)
+        for (int x = 0; x < 4; ++x) {
+            EXPECT_FLOAT_EQ(at(img, 4, x, y, 0), y >= 3 ? 2.0f : 0.0f) << x << "," << y;
+            EXPECT_FLOAT_EQ(at(img, 4, x, y, 3), 1.0f);
+        }
+}
+
+Scene hair_tuft_scene(int width, int height, int curves = 64) {
+    const auto fiber = fiber_with(Rgb(0.3f, 0.6f, 1.2f));
+    SceneDesc d;
+    d.materials = {hair(fiber, std::make_shared<const AnalyticSampler>(fiber)),
+                   DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}};
+    d.curves = {tuft(curves, 8, 0.01f)};
+    d.meshes = {quad(3.0f, 0.0f, 1)};
+    d.world = {Rgb(0.2f, 0.25f, 0.3f), 1.0f};
+    SunLight sun;
+    sun.to_sun = safe_normalize({0.4f, -0.3f, 1.0f});
+    sun.strength = 3.0f;
+    sun.angle = float(radians(2.0));
+    d.suns = {sun};
+    d.point_lights = {{Vec3{1, 1, 2}, Rgb(1.0f, 0.9f, 0.8f), 200.0f, 0.2f}};
+    // Looking at the tuft from the side and above.
+    CameraDesc c = perspective({0, 0, 0}, 0.45f, width, height);
+    const float v[16] = {1, 0, 0, 0,        //
+                         0, 0.8f, -0.6f, -3.0f,  //
+                         0, 0.6f, 0.8f, 2.8f,   //
+                         0, 0, 0, 1};
+    c.camera_to_world = Mat4::from_row_major(v);
+    d.camera = c;
+    return build(std::move(d));
+}
+
+TEST(Render, BitIdenticalWhateverTheThreadCount) {
+    const Scene scene = hair_tuft_scene(24, 20);
+    RenderSettings s;
+    s.samples = 4;
+    s.seed = 1234;
+    s.threads = 1;
+    const auto one = render_ok(scene, s);
+    s.threads = 2;
+    const auto two = render_ok(scene, s);
+    s.tile_size = 5;  // another tile schedule
+    const auto tiles = render_ok(scene, s);
+    ASSERT_EQ(one.size(), two.size());
+    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(one.data(), tiles.data(), one.size() * sizeof(float)), 0);
+    s.seed = 1235;
+    const auto other = render_ok(scene, s);
+    EXPECT_NE(std::memcmp(one.data(), other.data(), one.size() * sizeof(float)), 0);
+    double sum = 0;
+    for (std::size_t i = 0; i < one.size(); ++i) sum += one[i];
+    EXPECT_GT(sum, 0.0);
+}
+
+TEST(Render, CancelStopsPromptlyAndSaysSo) {
+    const Scene scene = hair_tuft_scene(64, 64);
+    RenderSettings s;
+    s.samples = 1 << 20;  // hours of work
+    s.threads = 2;
+    std::vector<float> rgba(64 * 64 * 4, -1.0f);
+    RenderStats stats;
+    // Cancel at the first call.
+    auto t0 = std::chrono::steady_clock::now();
+    Status st = render(scene, s, rgba.data(), [](float) { return false; }, &stats);
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(st.has_value());
+    EXPECT_EQ(st->message.rfind("cancelled", 0), 0u) << st->message;
+    EXPECT_TRUE(stats.cancelled);
+    EXPECT_LT(stats.progress, 1.0f);
+    EXPECT_LT(seconds, 1.0);
+    for (float v : rgba) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f);
+
+    // Cancel once some work is done: render() returns well under a second later.
+    std::chrono::steady_clock::time_point cancelled_at{};
+    float last = 0;
+    int calls = 0;
+    st = render(
+        scene, s, rgba.data(),
+        [&](float p) {
+            ++calls;
+            last = p;
+            if (p > 0.0f || calls > 40) {
+                cancelled_at = std::chrono::steady_clock::now();
+                return false;
+            }
+            return true;
+        },
+        &stats);
+    const double latency =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - cancelled_at).count();
+    ASSERT_TRUE(st.has_value());
+    EXPECT_TRUE(stats.cancelled);
+    EXPECT_LT(latency, 0.5);
+    EXPECT_LT(stats.progress, 0.01f);
+    EXPECT_GT(stats.camera_rays, 0u);
+    double sum = 0;
+    for (std::size_t i = 0; i < rgba.size(); i += 4) sum += rgba[i + 3];
+    EXPECT_GT(sum, 0.0);  // finished samples were written
+}
+
+class NanPoint final : public SamplerPoint {
+  public:
+    std::optional<DirectionSample> sample(float u0, float u1, float) const override {
+        const float z = 1.0f - 2.0f * u0, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        // A density so small that f/pdf overflows to infinity.
+        return DirectionSample{{z, r * std::cos(6.2831853f * u1), r * std::sin(6.2831853f * u1)}, 1e-44f};
+    }
+    float pdf(Vec3) const override { return NAN; }
+};
+
+class NanSampler final : public Sampler {
+  public:
+    const SamplerPoint &at(const FiberHit &, const FiberPoint *, ScratchBuffer &scratch) const override {
+        return scratch.make<NanPoint>();
+    }
+};
+
+TEST(Render, NonFiniteContributionsAreDroppedAndCounted) {
+    const auto fiber = fiber_with(Rgb(0.5f));
+    SceneDesc d;
+    d.materials = {hair(fiber, std::make_shared<NanSampler>())};
+    d.curves = {parallel_hairs(3, 0.14f, 0.06f)};
+    d.world = {Rgb(1.0f), 1.0f};
+    d.camera = ortho_down(0.5f, 0.5f, 8, 8);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 4;
+    RenderStats stats;
+    const auto img = render_ok(scene, s, &stats);
+    EXPECT_GT(stats.dropped_samples, 0u);
+    for (float v : img) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(Render, RefusesInvalidSettings) {
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}};
+    d.meshes = {quad(1.0f, 0.0f, 0)};
+    d.camera = ortho_down(1, 1, 2, 2);
+    const Scene scene = build(std::move(d));
+    std::vector<float> rgba(16);
+    RenderSettings s;
+    s.samples = 0;
+    auto st = render(scene, s, rgba.data(), {}, nullptr);
+    ASSERT_TRUE(st.has_value());
+    EXPECT_NE(st->message.find("samples"), std::string::npos);
+    s = {};
+    s.max_bounces = -1;
+    st = render(scene, s, rgba.data(), {}, nullptr);
+    ASSERT_TRUE(st.has_value());
+    EXPECT_NE(st->message.find("max_bounces"), std::string::npos);
+    st = render(scene, RenderSettings{}, nullptr, {}, nullptr);
+    ASSERT_TRUE(st.has_value());
+    EXPECT_NE(st->message.find("rgba"), std::string::npos);
+}
+
+TEST(Render, HairThroughput) {
+    // Not a pass/fail check of speed: reports samples per second on a small hair scene.
+    const Scene scene = hair_tuft_scene(48, 48, 200);
+    RenderSettings s;
+    s.samples = 8;
+    s.threads = 2;
+    RenderStats stats;
+    render_ok(scene, s, &stats);
+    std::printf("hair tuft: %zu curves, %zu segments; 48x48 px x %d spp, %d threads: %.3f s, "
+                "%.0f samples/s, %.0f rays/s (+ %.0f shadow rays/s), scene peak %.1f KiB, "
+                "build %.3f s\n",
+                scene.stats().curves, scene.stats().curve_segments, s.samples, stats.threads,
+                stats.seconds, stats.samples_per_second, double(stats.rays) / stats.seconds,
+                double(stats.shadow_rays) / stats.seconds,
+                double(scene.stats().estimated_peak_bytes) / 1024.0, scene.stats().build_seconds);
+    RecordProperty("samples_per_second", int(stats.samples_per_second));
+    EXPECT_EQ(stats.camera_rays, 48u * 48u * 8u);
+    EXPECT_GT(stats.samples_per_second, 0.0);
+}
+
+}  // namespace
+}  // namespace hairis

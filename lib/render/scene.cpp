@@ -1,0 +1,582 @@
+#include "render/scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <string>
+#include <sys/types.h>
+
+namespace hairis {
+
+namespace {
+
+struct alignas(16) Float4 {
+    float x, y, z, w;
+};
+
+struct CurveGeometry {
+    std::vector<Float4> cvs;              // n + 2 control points per curve (ends duplicated)
+    std::vector<std::uint32_t> segments;  // first control point of each segment
+    std::vector<std::uint32_t> curve_of;  // the curve of each segment
+    std::uint32_t material = 0;
+};
+
+struct MeshGeometry {
+    std::vector<float> vertices;            // xyz per vertex, plus one float of padding
+    std::vector<std::uint32_t> indices;     // 3 per kept triangle
+    std::vector<std::uint32_t> materials;   // 1 per kept triangle
+    std::vector<std::uint8_t> emissive;     // 1 per kept triangle: in the light set
+};
+
+struct GeometryInfo {
+    bool is_curve = false;
+    std::uint32_t index = 0;  // into curves or meshes
+};
+
+// The context handed to Embree: the primitives a ray must ignore.
+struct TraceContext {
+    RTCIntersectContext rtc;
+    PrimRef skip_a, skip_b;
+};
+
+bool skipped(const TraceContext *ctx, unsigned geom, unsigned prim) {
+    return (geom == ctx->skip_a.geometry && prim == ctx->skip_a.primitive) ||
+           (geom == ctx->skip_b.geometry && prim == ctx->skip_b.primitive);
+}
+
+// Triangles: ignore the primitives the ray starts or ends on.
+void triangle_filter(const RTCFilterFunctionNArguments *args) {
+    const auto *ctx = reinterpret_cast<const TraceContext *>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        if (skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
+                    RTCHitN_primID(args->hit, args->N, i)))
+            args->valid[i] = 0;
+    }
+}
+
+// Round curves: ignore hits on the inside of the tube (Cycles' backface culling) and on any
+// segment of the curve the ray starts on (the geometry's user data maps segments to curves).
+void curve_filter(const RTCFilterFunctionNArguments *args) {
+    const auto *ctx = reinterpret_cast<const TraceContext *>(args->context);
+    const auto *curve_of = static_cast<const std::uint32_t *>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const float d = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
+                        RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
+                        RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
+        if (d > 0.0f || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
+                                curve_of[RTCHitN_primID(args->hit, args->N, i)]))
+            args->valid[i] = 0;
+    }
+}
+
+bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
+
+std::string describe(Vec3 v) {
+    return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
+           ")";
+}
+
+// Embree's uniform Catmull-Rom basis on the segment p1..p2 and its derivative.
+void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Float4 &p3, float t,
+                 Float4 &value, Float4 &derivative) {
+    const float t2 = t * t, t3 = t2 * t;
+    const float b0 = 0.5f * (-t3 + 2.0f * t2 - t);
+    const float b1 = 0.5f * (3.0f * t3 - 5.0f * t2 + 2.0f);
+    const float b2 = 0.5f * (-3.0f * t3 + 4.0f * t2 + t);
+    const float b3 = 0.5f * (t3 - t2);
+    const float d0 = 0.5f * (-3.0f * t2 + 4.0f * t - 1.0f);
+    const float d1 = 0.5f * (9.0f * t2 - 10.0f * t);
+    const float d2 = 0.5f * (-9.0f * t2 + 8.0f * t + 1.0f);
+    const float d3 = 0.5f * (3.0f * t2 - 2.0f * t);
+    value = {b0 * p0.x + b1 * p1.x + b2 * p2.x + b3 * p3.x,
+             b0 * p0.y + b1 * p1.y + b2 * p2.y + b3 * p3.y,
+             b0 * p0.z + b1 * p1.z + b2 * p2.z + b3 * p3.z,
+             b0 * p0.w + b1 * p1.w + b2 * p2.w + b3 * p3.w};
+    derivative = {d0 * p0.x + d1 * p1.x + d2 * p2.x + d3 * p3.x,
+                  d0 * p0.y + d1 * p1.y + d2 * p2.y + d3 * p3.y,
+                  d0 * p0.z + d1 * p1.z + d2 * p2.z + d3 * p3.z,
+                  d0 * p0.w + d1 * p1.w + d2 * p2.w + d3 * p3.w};
+}
+
+}  // namespace
+
+struct Scene::Impl {
+    RTCDevice device = nullptr;
+    RTCScene rtc_scene = nullptr;
+    std::vector<CurveGeometry> curves;
+    std::vector<MeshGeometry> meshes;
+    std::vector<GeometryInfo> geometries;  // by Embree geometry id
+    std::vector<Material> materials;
+    LightSet lights;
+    std::optional<Camera> camera;
+    SceneStats stats;
+
+    std::atomic<long long> embree_bytes{0};
+    std::atomic<long long> embree_peak{0};
+    std::mutex error_mutex;
+    std::string embree_error;
+
+    ~Impl() {
+        if (rtc_scene) rtcReleaseScene(rtc_scene);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    static bool memory_monitor(void *user, ssize_t bytes, bool) {
+        auto *self = static_cast<Impl *>(user);
+        const long long now = self->embree_bytes.fetch_add(bytes) + bytes;
+        long long peak = self->embree_peak.load();
+        while (now > peak && !self->embree_peak.compare_exchange_weak(peak, now)) {
+        }
+        return true;  // never refuse an allocation
+    }
+
+    static void error_function(void *user, RTCError code, const char *message) {
+        auto *self = static_cast<Impl *>(user);
+        std::lock_guard<std::mutex> lock(self->error_mutex);
+        if (self->embree_error.empty())
+            self->embree_error = "Embree error " + std::to_string(int(code)) + ": " +
+                                 (message ? message : "(no message)");
+    }
+
+    Status embree_status(const char *what) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (embree_error.empty() && device && rtcGetDeviceError(device) == RTC_ERROR_NONE)
+            return std::nullopt;
+        return Error{std::string("scene: ") + what + " failed: " +
+                     (embree_error.empty() ? std::string("unknown Embree error") : embree_error)};
+    }
+};
+
+Scene::Scene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Scene::Scene(Scene &&) noexcept = default;
+Scene &Scene::operator=(Scene &&) noexcept = default;
+Scene::~Scene() = default;
+
+const Camera &Scene::camera() const { return *impl_->camera; }
+const LightSet &Scene::lights() const { return impl_->lights; }
+const std::vector<Material> &Scene::materials() const { return impl_->materials; }
+const SceneStats &Scene::stats() const { return impl_->stats; }
+
+Expected<Scene> Scene::build(SceneDesc desc) {
+    const auto start = std::chrono::steady_clock::now();
+    auto impl = std::make_unique<Impl>();
+    SceneStats &stats = impl->stats;
+
+    // Materials.
+    for (std::size_t m = 0; m < desc.materials.size(); ++m) {
+        if (const auto *hair = std::get_if<HairMaterial>(&desc.materials[m])) {
+            if (!hair->shading.model())
+                return Error{"material " + std::to_string(m) + ": hair material has no fiber"};
+        } else {
+            const auto &d = std::get<DiffuseMaterial>(desc.materials[m]);
+            for (int i = 0; i < 3; ++i) {
+                const std::string name = "material " + std::to_string(m);
+                if (auto e = check::in_range((name + ": albedo").c_str(), d.albedo[i], 0.0, 1.0))
+                    return *e;
+                if (auto e = check::non_negative((name + ": emission").c_str(), d.emission[i]))
+                    return *e;
+            }
+        }
+    }
+    const std::size_t material_count = desc.materials.size();
+    auto material_error = [&](const std::string &what, std::uint32_t m) -> Status {
+        if (m >= material_count)
+            return Error{what + ": material index " + std::to_string(m) +
+                         " is out of range (the scene has " + std::to_string(material_count) +
+                         " materials)"};
+        return std::nullopt;
+    };
+
+    // Lights: validated now (cheap) so that a bad light fails before the BVH is built; the
+    // light set itself is built at the end, with the emissive triangles.
+    {
+        auto lights = LightSet::build(desc.suns, desc.point_lights, desc.area_lights, desc.world,
+                                      {}, nullptr);
+        if (!lights) return lights.error();
+    }
+
+    // Camera.
+    {
+        auto cam = Camera::create(desc.camera);
+        if (!cam) return cam.error();
+        impl->camera.emplace(std::move(cam).value());
+    }
+
+    // Hair curves.
+    for (std::size_t s = 0; s < desc.curves.size(); ++s) {
+        HairCurves &hc = desc.curves[s];
+        const std::string set = "curve set " + std::to_string(s);
+        if (auto e = material_error(set, hc.material)) return *e;
+        if (hc.radii.size() != hc.points.size())
+            return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
+                         " entries but points has " + std::to_string(hc.points.size()) +
+                         " (one radius per point)"};
+        if (hc.first.empty() || hc.first.front() != 0 || hc.first.back() != hc.points.size())
+            return Error{set + ": first must start at 0 and end at the point count (" +
+                         std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
+        if (hc.points.size() > (std::size_t(1) << 31))
+            return Error{set + ": too many points (at most 2^31)"};
+        CurveGeometry geo;
+        geo.material = hc.material;
+        std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
+        const std::size_t curve_count = hc.first.size() - 1;
+        for (std::size_t c = 0; c < curve_count; ++c) {
+            const std::uint32_t b = hc.first[c], e = hc.first[c + 1];
+            if (e < b)
+                return Error{set + ": first must not decrease (curve " + std::to_string(c) + ")"};
+            const std::uint32_t n = e - b;
+            if (n < 2)
+                return Error{set + ", curve " + std::to_string(c) + ": has " + std::to_string(n) +
+                             " point(s); a curve needs at least 2"};
+            float max_step = 0, max_radius = 0;
+            for (std::uint32_t k = b; k < e; ++k) {
+                if (!finite3(hc.points[k]))
+                    return Error{set + ", curve " + std::to_string(c) + ", point " +
+                                 std::to_string(k - b) + ": position must be finite (got " +
+                                 describe(hc.points[k]) + ")"};
+                const float r = hc.radii[k];
+                if (!std::isfinite(r) || r < 0.0f)
+                    return Error{set + ", curve " + std::to_string(c) + ", point " +
+                                 std::to_string(k - b) + ": radius must be finite and >= 0 (got " +
+                                 std::to_string(r) + ")"};
+                max_radius = std::max(max_radius, r);
+                if (k > b) max_step = std::max(max_step, length(hc.points[k] - hc.points[k - 1]));
+            }
+            if (!(max_step > 0.0f)) {
+                ++zero_length;
+                continue;
+            }
+            if (!(max_radius > 0.0f)) {
+                ++zero_radius;
+                continue;
+            }
+            const std::uint32_t base = std::uint32_t(geo.cvs.size());
+            auto cv = [&](std::uint32_t k) {
+                return Float4{hc.points[k].x, hc.points[k].y, hc.points[k].z, hc.radii[k]};
+            };
+            geo.cvs.push_back(cv(b));
+            for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
+            geo.cvs.push_back(cv(e - 1));
+            const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
+            for (std::uint32_t k = 0; k + 1 < n; ++k) {
+                geo.segments.push_back(base + k);
+                geo.curve_of.push_back(curve_index);
+            }
+            ++stats.curves;
+            stats.curve_points += n;
+        }
+        if (zero_length)
+            stats.warnings.push_back(set + ": skipped " + std::to_string(zero_length) +
+                                     " curve(s) of zero length");
+        if (zero_radius)
+            stats.warnings.push_back(set + ": skipped " + std::to_string(zero_radius) +
+                                     " curve(s) of zero radius");
+        stats.skipped_curves += zero_length + zero_radius;
+        stats.curve_segments += geo.segments.size();
+        // Free the caller's copy early: the scene keeps its own Embree layout.
+        hc.points = {};
+        hc.radii = {};
+        hc.first = {};
+        if (!geo.segments.empty()) impl->curves.push_back(std::move(geo));
+    }
+
+    // Meshes.
+    std::vector<EmissiveTriangle> emissive;
+    std::vector<std::size_t> mesh_geometry_ids;
+    for (std::size_t s = 0; s < desc.meshes.size(); ++s) {
+        TriangleMesh &tm = desc.meshes[s];
+        const std::string name = "mesh " + std::to_string(s);
+        if (tm.indices.size() % 3 != 0)
+            return Error{name + ": indices has " + std::to_string(tm.indices.size()) +
+                         " entries, not a multiple of 3"};
+        const std::size_t tri_count = tm.indices.size() / 3;
+        if (tm.materials.size() != 1 && tm.materials.size() != tri_count)
+            return Error{name + ": materials must hold 1 entry or one per triangle (" +
+                         std::to_string(tri_count) + "), got " +
+                         std::to_string(tm.materials.size())};
+        for (std::size_t v = 0; v < tm.positions.size(); ++v)
+            if (!finite3(tm.positions[v]))
+                return Error{name + ", vertex " + std::to_string(v) +
+                             ": position must be finite (got " + describe(tm.positions[v]) + ")"};
+        for (std::uint32_t m : tm.materials) {
+            if (auto e = material_error(name, m)) return *e;
+            if (std::holds_alternative<HairMaterial>(desc.materials[m]))
+                return Error{name + ": material " + std::to_string(m) +
+                             " is a hair material; meshes need a diffuse material"};
+        }
+        MeshGeometry geo;
+        std::size_t degenerate = 0;
+        for (std::size_t t = 0; t < tri_count; ++t) {
+            const std::uint32_t i0 = tm.indices[3 * t], i1 = tm.indices[3 * t + 1],
+                                i2 = tm.indices[3 * t + 2];
+            if (i0 >= tm.positions.size() || i1 >= tm.positions.size() ||
+                i2 >= tm.positions.size())
+                return Error{name + ", triangle " + std::to_string(t) +
+                             ": vertex index out of range (the mesh has " +
+                             std::to_string(tm.positions.size()) + " vertices)"};
+            const Vec3 p0 = tm.positions[i0], p1 = tm.positions[i1], p2 = tm.positions[i2];
+            if (!(length(cross(p1 - p0, p2 - p0)) > 0.0f)) {
+                ++degenerate;
+                continue;
+            }
+            const std::uint32_t m = tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t];
+            const Rgb emission = std::get<DiffuseMaterial>(desc.materials[m]).emission;
+            geo.indices.insert(geo.indices.end(), {i0, i1, i2});
+            geo.materials.push_back(m);
+            geo.emissive.push_back(is_black(emission) ? 0 : 1);
+        }
+        if (degenerate) {
+            stats.warnings.push_back(name + ": skipped " + std::to_string(degenerate) +
+                                     " degenerate triangle(s)");
+            stats.skipped_triangles += degenerate;
+        }
+        if (geo.indices.empty()) continue;
+        geo.vertices.reserve(3 * tm.positions.size() + 1);
+        for (const Vec3 &p : tm.positions) geo.vertices.insert(geo.vertices.end(), {p.x, p.y, p.z});
+        geo.vertices.push_back(0.0f);  // Embree reads float3 vertices with 16-byte loads
+        stats.triangles += geo.materials.size();
+        tm = {};
+        impl->meshes.push_back(std::move(geo));
+    }
+
+    if (stats.curves == 0 && stats.triangles == 0) {
+        std::string why = "scene has no geometry: add at least one hair curve or triangle";
+        if (stats.skipped_curves || stats.skipped_triangles)
+            why += " (" + std::to_string(stats.skipped_curves) + " curve(s) and " +
+                   std::to_string(stats.skipped_triangles) +
+                   " triangle(s) were skipped as degenerate)";
+        return Error{why};
+    }
+
+    // Embree.
+    impl->device = rtcNewDevice(nullptr);
+    if (!impl->device)
+        return Error{"scene: could not create the Embree device (error " +
+                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")"};
+    rtcSetDeviceErrorFunction(impl->device, &Impl::error_function, impl.get());
+    rtcSetDeviceMemoryMonitorFunction(impl->device, &Impl::memory_monitor, impl.get());
+    impl->rtc_scene = rtcNewScene(impl->device);
+    rtcSetSceneFlags(impl->rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(impl->rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
+
+    for (std::size_t i = 0; i < impl->curves.size(); ++i) {
+        CurveGeometry &geo = impl->curves[i];
+        RTCGeometry g = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE);
+        rtcSetGeometryTessellationRate(g, 5.0f);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, geo.cvs.data(),
+                                   0, sizeof(Float4), geo.cvs.size());
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                   geo.segments.data(), 0, sizeof(std::uint32_t),
+                                   geo.segments.size());
+        rtcSetGeometryUserData(g, geo.curve_of.data());
+        rtcSetGeometryIntersectFilterFunction(g, &curve_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &curve_filter);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(impl->rtc_scene, g);
+        rtcReleaseGeometry(g);
+        if (impl->geometries.size() <= id) impl->geometries.resize(id + 1);
+        impl->geometries[id] = {true, std::uint32_t(i)};
+    }
+    for (std::size_t i = 0; i < impl->meshes.size(); ++i) {
+        MeshGeometry &geo = impl->meshes[i];
+        RTCGeometry g = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   geo.vertices.data(), 0, 3 * sizeof(float),
+                                   (geo.vertices.size() - 1) / 3);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                   geo.indices.data(), 0, 3 * sizeof(std::uint32_t),
+                                   geo.indices.size() / 3);
+        rtcSetGeometryIntersectFilterFunction(g, &triangle_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &triangle_filter);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(impl->rtc_scene, g);
+        rtcReleaseGeometry(g);
+        if (impl->geometries.size() <= id) impl->geometries.resize(id + 1);
+        impl->geometries[id] = {false, std::uint32_t(i)};
+        for (std::size_t t = 0; t < geo.materials.size(); ++t) {
+            if (!geo.emissive[t]) continue;
+            auto vertex = [&](std::uint32_t k) {
+                return Vec3{geo.vertices[3 * k], geo.vertices[3 * k + 1], geo.vertices[3 * k + 2]};
+            };
+            EmissiveTriangle et;
+            et.p0 = vertex(geo.indices[3 * t]);
+            et.p1 = vertex(geo.indices[3 * t + 1]);
+            et.p2 = vertex(geo.indices[3 * t + 2]);
+            et.radiance = std::get<DiffuseMaterial>(desc.materials[geo.materials[t]]).emission;
+            et.geometry = id;
+            et.primitive = std::uint32_t(t);
+            emissive.push_back(et);
+        }
+    }
+    rtcCommitScene(impl->rtc_scene);
+    if (auto e = impl->embree_status("building the BVH")) return *e;
+
+    // Lights.
+    stats.emissive_triangles = emissive.size();
+    {
+        auto lights = LightSet::build(desc.suns, desc.point_lights, desc.area_lights, desc.world,
+                                      std::move(emissive), &stats.warnings);
+        if (!lights) return lights.error();
+        impl->lights = std::move(lights).value();
+    }
+    stats.lamps = std::size_t(impl->lights.lamp_count());
+    impl->materials = std::move(desc.materials);
+
+    // Memory.
+    std::size_t bytes = sizeof(Impl) + impl->lights.memory_bytes() +
+                        impl->geometries.capacity() * sizeof(GeometryInfo);
+    for (const auto &c : impl->curves)
+        bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
+                 c.curve_of.capacity() * 4;
+    for (const auto &m : impl->meshes)
+        bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
+                 m.materials.capacity() * 4 + m.emissive.capacity();
+    stats.scene_bytes = bytes;
+    stats.embree_peak_bytes = std::size_t(std::max(0ll, impl->embree_peak.load()));
+    stats.embree_bytes = std::size_t(std::max(0ll, impl->embree_bytes.load()));
+    stats.estimated_peak_bytes = stats.scene_bytes + stats.embree_peak_bytes;
+    stats.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return Scene(std::move(impl));
+}
+
+namespace {
+
+// Embree's own precondition on a ray (RayK::valid(), asserted in Debian's build): origin and
+// direction components within ±1.844e18 (FLT_LARGE), t range not NaN. Rays outside it come
+// from finite but astronomically large inputs (a camera or vertex at 1e30) and are not
+// traced: a miss for intersect, blocked for shadow rays (found by fuzz_capi_params).
+bool traceable(Vec3 origin, Vec3 dir, float tmin, float tmax) {
+    constexpr float kLarge = 1.844e18f;
+    for (float c : {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z})
+        if (!(std::fabs(c) <= kLarge)) return false;
+    return !std::isnan(tmin) && !std::isnan(tmax);
+}
+
+}  // namespace
+
+std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                    PrimRef skip) const {
+    if (!traceable(origin, dir, tmin, tmax)) return std::nullopt;
+    TraceContext ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.skip_a = skip;
+    RTCRayHit rh;
+    rh.ray.org_x = origin.x;
+    rh.ray.org_y = origin.y;
+    rh.ray.org_z = origin.z;
+    rh.ray.tnear = tmin;
+    rh.ray.dir_x = dir.x;
+    rh.ray.dir_y = dir.y;
+    rh.ray.dir_z = dir.z;
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->rtc_scene, &ctx.rtc, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+    Hit hit;
+    hit.t = rh.ray.tfar;
+    hit.prim = {rh.hit.geomID, rh.hit.primID};
+    hit.u = rh.hit.u;
+    hit.v = rh.hit.v;
+    return hit;
+}
+
+bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip_a,
+                     PrimRef skip_b) const {
+    if (!traceable(origin, dir, tmin, tmax)) return true;
+    TraceContext ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.skip_a = skip_a;
+    ctx.skip_b = skip_b;
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.tnear = tmin;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.time = 0.0f;
+    ray.tfar = tmax;
+    ray.mask = ~0u;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(impl_->rtc_scene, &ctx.rtc, &ray);
+    return ray.tfar < 0.0f;  // Embree sets tfar to −inf on a hit
+}
+
+Vec3 Scene::curve_point(PrimRef segment, float u, Vec3 *derivative, float *radius) const {
+    const GeometryInfo &info = impl_->geometries.at(segment.geometry);
+    const CurveGeometry &geo = impl_->curves.at(info.index);
+    const std::uint32_t k = geo.segments.at(segment.primitive);
+    Float4 value, d;
+    catmull_rom(geo.cvs[k], geo.cvs[k + 1], geo.cvs[k + 2], geo.cvs[k + 3], u, value, d);
+    if (derivative) *derivative = {d.x, d.y, d.z};
+    if (radius) *radius = value.w;
+    return {value.x, value.y, value.z};
+}
+
+SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
+    SurfacePoint sp;
+    sp.prim = hit.prim;
+    sp.position = origin + dir * hit.t;
+    const GeometryInfo &info = impl_->geometries[hit.prim.geometry];
+    if (info.is_curve) {
+        const CurveGeometry &geo = impl_->curves[info.index];
+        Vec3 dpdu;
+        const Vec3 centre = curve_point(hit.prim, hit.u, &dpdu);
+        sp.is_curve = true;
+        sp.self = {hit.prim.geometry, geo.curve_of[hit.prim.primitive]};
+        sp.material = geo.material;
+        const Vec3 n = safe_normalize(sp.position - centre);
+        sp.normal = dot(n, n) > 0.0f ? n : -dir;
+        sp.tangent = safe_normalize(dpdu);
+        if (dot(sp.tangent, sp.tangent) == 0.0f) {
+            // dP/du vanishes (repeated points): the chord, or any direction across the normal.
+            const std::uint32_t k = geo.segments[hit.prim.primitive];
+            const Float4 &a = geo.cvs[k + 1], &b = geo.cvs[k + 2];
+            sp.tangent = safe_normalize(Vec3{b.x - a.x, b.y - a.y, b.z - a.z});
+            if (dot(sp.tangent, sp.tangent) == 0.0f) {
+                Vec3 t1, t2;
+                orthonormal_basis(sp.normal, t1, t2);
+                sp.tangent = t1;
+            }
+        }
+    } else {
+        const MeshGeometry &geo = impl_->meshes[info.index];
+        const std::uint32_t t = hit.prim.primitive;
+        auto vertex = [&](std::uint32_t k) {
+            return Vec3{geo.vertices[3 * k], geo.vertices[3 * k + 1], geo.vertices[3 * k + 2]};
+        };
+        const Vec3 p0 = vertex(geo.indices[3 * t]), p1 = vertex(geo.indices[3 * t + 1]),
+                   p2 = vertex(geo.indices[3 * t + 2]);
+        sp.normal = safe_normalize(cross(p1 - p0, p2 - p0));
+        // The position from Embree's barycentrics (more accurate than origin + t·dir) and a
+        // bound on its rounding error, a few float ulps of the largest coordinate involved.
+        const float u = hit.u, v = hit.v;
+        sp.position = p0 * (1.0f - u - v) + p1 * u + p2 * v;
+        float extent = 0.0f;
+        for (const Vec3 &q : {p0, p1, p2, sp.position})
+            extent = std::max({extent, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+        sp.offset = 2e-6f * extent + 1e-9f;
+        sp.material = geo.materials[t];
+        sp.is_light = geo.emissive[t] != 0;
+        sp.self = hit.prim;
+    }
+    return sp;
+}
+
+}  // namespace hairis

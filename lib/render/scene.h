@@ -1,0 +1,195 @@
+// A render scene: hair curves, triangle meshes, materials, lights, world and camera, given as
+// plain data, validated, and built into an Embree 3 BVH.
+//
+// Hair curves are Embree ROUND Catmull-Rom curves, like Cycles' "3D Curves" shape
+// (intern/cycles/bvh/embree.cpp, add_curves and set_curve_vertex_buffer): per curve of n
+// points, Embree gets n + 2 control points — the first and the last point duplicated — and
+// n − 1 segments, so the curve passes through every point from the first to the last. The
+// radius is per point (Embree's 4th vertex component). Hits on the inside of a tube (ray
+// direction · Embree's Ng > 0) are ignored, as Cycles' backface-culling filter does for
+// round curves, and a ray never hits the curve it starts on — any segment of it — as Cycles'
+// self-intersection test does (kernel/device/cpu/bvh.h, kernel_embree_is_self_intersection
+// maps a hair segment to its curve before comparing), so no origin offset is needed. The
+// Embree tessellation rate is Cycles' default: Curves > Subdivisions 2 (addon properties.py),
+// SceneParams::curve_subdivisions() = 2² = 4, rtcSetGeometryTessellationRate(4 + 1).
+//
+// Curve shading data, as Cycles' curve_shader_setup for thick curves (kernel/geom/curve.h):
+// the hit P, P_curve = the Catmull-Rom centre line at the hit's u, Ng = normalize(P − P_curve),
+// tangent = normalize(dP/du). The renderer then builds the fiber frame from the tangent and
+// ω_o and h = dot(cross(Ng, X), Z) (bsdf_principled_hair_setup).
+//
+// Validation (errors name the object and what is allowed):
+//  - refused: NaN/inf positions or radii, negative radii, a curve with fewer than 2 points,
+//    inconsistent curve offsets, mesh indices out of range, material indices out of range,
+//    a hair material on a mesh, a hair material without fiber or sampler, invalid lights or
+//    camera, and a scene with no geometry left (no curve and no triangle).
+//  - skipped with a counted warning: curves of zero length (all points equal) or zero radius
+//    everywhere — they would never be hit — and degenerate (zero-area) triangles.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "render/camera.h"
+#include "core/expected.h"
+#include "render/lights.h"
+#include "core/math.h"
+#include "sampling/hair_bsdf.h"
+
+namespace hairis {
+
+/// A hair material: the Cycles-exact fiber and the strategy that draws ω_i for it.
+struct HairMaterial {
+    HairShading shading;
+};
+
+/// A Lambertian surface with optional emission (radiance, on both sides as in Cycles). A pure
+/// emitter is albedo 0; the emission of mesh triangles is sampled as a light.
+struct DiffuseMaterial {
+    Rgb albedo{0.8f};
+    Rgb emission{0.0f};
+};
+
+using Material = std::variant<HairMaterial, DiffuseMaterial>;
+
+/// Hair curves sharing one material. Curve c has points first[c] .. first[c + 1] − 1; first
+/// has curve count + 1 entries, starts at 0 and ends at points.size(). One radius per point.
+struct HairCurves {
+    std::vector<Vec3> points;
+    std::vector<float> radii;
+    std::vector<std::uint32_t> first;
+    std::uint32_t material = 0;
+};
+
+/// A triangle mesh in world space. indices holds 3 vertex indices per triangle; materials
+/// holds one material index per triangle, or a single index for the whole mesh.
+struct TriangleMesh {
+    std::vector<Vec3> positions;
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint32_t> materials{0};
+};
+
+/// Everything a scene is made of, as plain data.
+struct SceneDesc {
+    std::vector<Material> materials;
+    std::vector<HairCurves> curves;
+    std::vector<TriangleMesh> meshes;
+    std::vector<SunLight> suns;
+    std::vector<PointLight> point_lights;
+    std::vector<AreaLight> area_lights;
+    WorldLight world;
+    CameraDesc camera;
+};
+
+/// What the build did and what it costs.
+struct SceneStats {
+    std::size_t curves = 0;           ///< curves kept
+    std::size_t curve_segments = 0;   ///< Embree segments (points − 1 per curve)
+    std::size_t curve_points = 0;     ///< points of the kept curves
+    std::size_t skipped_curves = 0;   ///< zero-length or zero-radius curves left out
+    std::size_t triangles = 0;        ///< triangles kept
+    std::size_t skipped_triangles = 0;///< degenerate triangles left out
+    std::size_t emissive_triangles = 0;
+    std::size_t lamps = 0;            ///< lights sampled (suns, points, areas, world)
+    std::vector<std::string> warnings;///< one line per kind of skipped item
+    std::size_t scene_bytes = 0;      ///< hairis' own copies (curve and mesh buffers, lights)
+    std::size_t embree_peak_bytes = 0;///< Embree's peak allocation during the build
+    std::size_t embree_bytes = 0;     ///< Embree's allocation after the build
+    /// Estimated peak memory of the scene: own buffers + Embree's peak.
+    std::size_t estimated_peak_bytes = 0;
+    double build_seconds = 0;
+};
+
+/// A primitive of the scene: Embree geometry id and primitive index. For a hit the index is
+/// the segment or triangle; for a ray's self-intersection skip it is the triangle or, for hair,
+/// the curve (all of its segments are skipped).
+struct PrimRef {
+    static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    std::uint32_t geometry = kNone;
+    std::uint32_t primitive = kNone;
+};
+
+/// The closest hit of a ray.
+struct Hit {
+    float t = 0;
+    PrimRef prim;
+    float u = 0, v = 0;  ///< Embree's hit coordinates (curve parameter for curves)
+};
+
+/// What shading needs at a hit point.
+struct SurfacePoint {
+    Vec3 position;
+    /// Unit geometric normal: the face normal (not flipped) for triangles; for curves the
+    /// outward tube normal normalize(P − P_curve(u)) (Cycles' thick-curve Ng).
+    Vec3 normal;
+    /// Unit curve tangent normalize(dP/du) (zero for triangles).
+    Vec3 tangent;
+    std::uint32_t material = 0;
+    bool is_curve = false;
+    /// True for a mesh triangle whose emission is in the light set (MIS applies to it).
+    bool is_light = false;
+    /// The segment or triangle hit.
+    PrimRef prim;
+    /// What rays leaving this point must not hit: the triangle, or the whole curve.
+    PrimRef self;
+    /// Triangles: a bound on the position's rounding error; rays leave from
+    /// spawn_point(dir), pushed this far off the plane towards dir, so that they cannot hit
+    /// the triangles that share an edge with this one at t ≈ 0 (skipping the primitive
+    /// itself, as Cycles does, only handles the triangle hit). 0 for curves, whose rays leave
+    /// from the hit point itself (Cycles' self-primitive test and backface culling).
+    float offset = 0;
+
+    /// Where a ray in direction dir leaves this point from.
+    Vec3 spawn_point(Vec3 dir) const {
+        return offset == 0.0f ? position
+                              : position + normal * (dot(normal, dir) >= 0.0f ? offset : -offset);
+    }
+};
+
+/// A built, immutable scene. Thread-safe for tracing. Move-only.
+class Scene {
+  public:
+    /// Validates `desc`, builds the lights and Embree's BVH. Takes the buffers by value: move
+    /// them in to avoid copies.
+    static Expected<Scene> build(SceneDesc desc);
+
+    Scene(Scene &&) noexcept;
+    Scene &operator=(Scene &&) noexcept;
+    Scene(const Scene &) = delete;
+    Scene &operator=(const Scene &) = delete;
+    ~Scene();
+
+    const Camera &camera() const;
+    const LightSet &lights() const;
+    const std::vector<Material> &materials() const;
+    const SceneStats &stats() const;
+
+    /// The closest hit with t in (tmin, tmax), ignoring `skip` (SurfacePoint::self of the
+    /// point the ray starts on) and the inside of curve tubes. dir must be unit length.
+    std::optional<Hit> intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                 PrimRef skip = {}) const;
+    /// True when anything blocks the segment (tmin, tmax), ignoring skip_a and skip_b (as in
+    /// intersect()). Hair is opaque to shadow rays, as in Cycles.
+    bool occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip_a = {},
+                  PrimRef skip_b = {}) const;
+    /// Shading data of a hit of the ray (origin, dir).
+    SurfacePoint surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const;
+
+    /// The Catmull-Rom centre line of a curve segment at u ∈ [0, 1] (for tests): position
+    /// (and radius in `radius`), and dP/du in `derivative` when not null.
+    Vec3 curve_point(PrimRef segment, float u, Vec3 *derivative = nullptr,
+                     float *radius = nullptr) const;
+
+  private:
+    struct Impl;
+    explicit Scene(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hairis

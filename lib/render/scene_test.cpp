@@ -1,0 +1,293 @@
+#include "render/scene.h"
+
+#include <gtest/gtest.h>
+
+#include "fiber/chiang.h"
+#include "sampling/uniform_sampler.h"
+
+#include <cmath>
+#include <string>
+
+#include "chi2.h"
+
+namespace hairis {
+namespace {
+
+CameraDesc small_camera() {
+    CameraDesc c;
+    c.camera_to_world = Mat4::translation({0, 0, 5});
+    c.width = 4;
+    c.height = 4;
+    return c;
+}
+
+std::shared_ptr<const ChiangFiber> default_fiber() {
+    auto fiber = ChiangFiber::create(ChiangParams{});
+    EXPECT_TRUE(fiber.ok());
+    return std::make_shared<const ChiangFiber>(std::move(fiber).value());
+}
+
+HairMaterial hair_material() {
+    return HairMaterial{HairShading::create(default_fiber(), std::make_shared<const UniformSampler>()).value()};
+}
+
+// One straight hair along X at y = z = 0, radius 0.1, through 4 points.
+HairCurves straight_hair() {
+    HairCurves c;
+    c.points = {{-1.5f, 0, 0}, {-0.5f, 0, 0}, {0.5f, 0, 0}, {1.5f, 0, 0}};
+    c.radii = {0.1f, 0.1f, 0.1f, 0.1f};
+    c.first = {0, 4};
+    c.material = 0;
+    return c;
+}
+
+TriangleMesh quad(float z, std::uint32_t material) {
+    TriangleMesh m;
+    m.positions = {{-1, -1, z}, {1, -1, z}, {1, 1, z}, {-1, 1, z}};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    m.materials = {material};
+    return m;
+}
+
+Scene build_ok(SceneDesc desc) {
+    auto s = Scene::build(std::move(desc));
+    EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+    return std::move(s).value();
+}
+
+std::string build_error(SceneDesc desc) {
+    auto s = Scene::build(std::move(desc));
+    return s.ok() ? std::string("(built without error)") : s.error().message;
+}
+
+TEST(Scene, CurvesBecomeCatmullRomSegmentsThroughEveryPoint) {
+    SceneDesc d;
+    d.materials = {hair_material()};
+    HairCurves c;
+    c.points = {{0, 0, 0}, {1, 0.5f, 0}, {2, 0, 0.3f}, {3, 1, 0}, {0, 0, 2}, {0, 1, 2}};
+    c.radii = {0.1f, 0.2f, 0.15f, 0.05f, 0.3f, 0.3f};
+    c.first = {0, 4, 6};
+    d.curves = {c};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    const SceneStats &st = scene.stats();
+    EXPECT_EQ(st.curves, 2u);
+    EXPECT_EQ(st.curve_points, 6u);
+    EXPECT_EQ(st.curve_segments, 3u + 1u);  // n − 1 segments per curve
+    EXPECT_EQ(st.skipped_curves, 0u);
+    EXPECT_GT(st.embree_peak_bytes, 0u);
+    EXPECT_GE(st.estimated_peak_bytes, st.scene_bytes + st.embree_peak_bytes);
+    // With the end points duplicated, segment k runs from point k to point k + 1.
+    for (std::uint32_t k = 0; k < 3; ++k) {
+        float r0 = 0, r1 = 0;
+        const Vec3 a = scene.curve_point({0, k}, 0.0f, nullptr, &r0);
+        const Vec3 b = scene.curve_point({0, k}, 1.0f, nullptr, &r1);
+        EXPECT_NEAR(length(a - c.points[k]), 0.0f, 1e-6f) << k;
+        EXPECT_NEAR(length(b - c.points[k + 1]), 0.0f, 1e-6f) << k;
+        EXPECT_NEAR(r0, c.radii[k], 1e-6f);
+        EXPECT_NEAR(r1, c.radii[k + 1], 1e-6f);
+    }
+    // A two-point curve is a straight segment.
+    Vec3 derivative;
+    const Vec3 mid = scene.curve_point({0, 3}, 0.5f, &derivative);
+    EXPECT_NEAR(length(mid - Vec3{0, 0.5f, 2}), 0.0f, 1e-6f);
+    EXPECT_NEAR(length(safe_normalize(derivative) - Vec3{0, 1, 0}), 0.0f, 1e-6f);
+}
+
+TEST(Scene, RaysHitTheHairTubeWithCyclesShadingData) {
+    SceneDesc d;
+    d.materials = {hair_material()};
+    d.curves = {straight_hair()};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+
+    // Straight down onto the top of the tube.
+    auto hit = scene.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_NEAR(hit->t, 4.9f, 1e-3f);
+    SurfacePoint sp = scene.surface_point({0.3f, 0, 5}, {0, 0, -1}, *hit);
+    EXPECT_TRUE(sp.is_curve);
+    EXPECT_NEAR(sp.normal.z, 1.0f, 1e-3f);
+    EXPECT_NEAR(std::fabs(sp.tangent.x), 1.0f, 1e-5f);
+
+    // Off-centre by half the radius: the normal tilts; P − centre has length r.
+    hit = scene.intersect({0.3f, 0.05f, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_NEAR(hit->t, 5.0f - std::sqrt(0.01f - 0.0025f), 1e-3f);
+    sp = scene.surface_point({0.3f, 0.05f, 5}, {0, 0, -1}, *hit);
+    EXPECT_NEAR(sp.normal.y, 0.5f, 1e-2f);
+    EXPECT_NEAR(sp.normal.x, 0.0f, 1e-3f);
+
+    // A miss beside the tube.
+    EXPECT_FALSE(scene.intersect({0.3f, 0.2f, 5}, {0, 0, -1}, 0.0f, INFINITY).has_value());
+    // From inside the tube, the exit is a back face: culled, as in Cycles.
+    EXPECT_FALSE(scene.intersect({0.3f, 0, 0}, {0, 0, 1}, 0.0f, INFINITY).has_value());
+    // A ray leaving the surface into the fiber, skipping its own curve, does not hit it
+    // again (Cycles' self-intersection test); without the skip it would at t ≈ 0.
+    const auto top = scene.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(top.has_value());
+    const SurfacePoint top_sp = scene.surface_point({0.3f, 0, 5}, {0, 0, -1}, *top);
+    EXPECT_EQ(top_sp.self.geometry, top->prim.geometry);
+    EXPECT_EQ(top_sp.self.primitive, 0u);  // curve 0, although segment 1 was hit
+    EXPECT_EQ(top->prim.primitive, 1u);
+    const Vec3 inward = safe_normalize({0.2f, 0.1f, -1});
+    EXPECT_FALSE(scene.intersect(top_sp.position, inward, 0.0f, INFINITY, top_sp.self));
+    const auto unskipped =
+        scene.intersect(top_sp.position + Vec3{0, 0, 1e-4f}, inward, 0.0f, INFINITY);
+    ASSERT_TRUE(unskipped.has_value());
+    EXPECT_LT(unskipped->t, 1e-3f);
+    // Near a joint, the neighbouring segment of the same curve is skipped too.
+    const auto joint = scene.intersect({0.49f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(joint.has_value());
+    const SurfacePoint joint_sp = scene.surface_point({0.49f, 0, 5}, {0, 0, -1}, *joint);
+    EXPECT_FALSE(scene.intersect(joint_sp.position, safe_normalize({1, 0, -0.2f}), 0.0f,
+                                 INFINITY, joint_sp.self));
+    // Hair blocks shadow rays.
+    EXPECT_TRUE(scene.occluded({0.3f, 0, 5}, {0, 0, -1}, 0.0f, 10.0f));
+    EXPECT_FALSE(scene.occluded({0.3f, 0, 5}, {0, 0, -1}, 0.0f, 4.0f));
+}
+
+TEST(Scene, TrianglesAndSkips) {
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}, DiffuseMaterial{Rgb(0.0f), Rgb(2.0f)}};
+    d.meshes = {quad(0.0f, 0), quad(2.0f, 1)};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    EXPECT_EQ(scene.stats().triangles, 4u);
+    EXPECT_EQ(scene.stats().emissive_triangles, 2u);
+    EXPECT_EQ(scene.lights().emissive_triangle_count(), 2);
+
+    const auto hit = scene.intersect({0.2f, 0.3f, 1}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_NEAR(hit->t, 1.0f, 1e-5f);
+    const SurfacePoint sp = scene.surface_point({0.2f, 0.3f, 1}, {0, 0, -1}, *hit);
+    EXPECT_FALSE(sp.is_curve);
+    EXPECT_FALSE(sp.is_light);
+    EXPECT_EQ(sp.material, 0u);
+    EXPECT_NEAR(std::fabs(sp.normal.z), 1.0f, 1e-6f);
+    // The emitter above.
+    const auto up = scene.intersect({0.2f, 0.3f, 1}, {0, 0, 1}, 0.0f, INFINITY);
+    ASSERT_TRUE(up.has_value());
+    EXPECT_TRUE(scene.surface_point({0.2f, 0.3f, 1}, {0, 0, 1}, *up).is_light);
+    // Skipping the primitive a ray starts on.
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 0}, {0, 0, -1}, 0.0f, INFINITY, hit->prim));
+    EXPECT_TRUE(scene.occluded({0.2f, 0.3f, 1}, {0, 0, 1}, 0.0f, 5.0f));
+    EXPECT_FALSE(scene.occluded({0.2f, 0.3f, 1}, {0, 0, 1}, 0.0f, 5.0f, up->prim));
+}
+
+TEST(Scene, RaysEmbreeCannotTraceAreMissesAndBlockedShadows) {
+    // Embree asserts (and aborts) on origins or directions beyond ±1.8e18 and NaN t; such
+    // rays come from finite but huge inputs (fuzz_capi_params found a camera at ~1e30).
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}};
+    d.meshes = {quad(0.0f, 0)};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1e30f}, {0, 0, -1}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, 0, -1e30f}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, NAN, -1}, 0.0f, INFINITY));
+    EXPECT_FALSE(scene.intersect({0.2f, 0.3f, 1}, {0, 0, -1}, NAN, INFINITY));
+    EXPECT_TRUE(scene.occluded({0.2f, 0.3f, -1e30f}, {0, 0, 1}, 0.0f, 5.0f));
+    // Large but traceable rays are traced as before.
+    EXPECT_TRUE(scene.intersect({0.2f, 0.3f, 1e6f}, {0, 0, -1}, 0.0f, INFINITY));
+}
+
+TEST(Scene, DegenerateCurvesAreSkippedWithAWarning) {
+    SceneDesc d;
+    d.materials = {hair_material()};
+    HairCurves c = straight_hair();
+    // A second curve whose points all coincide, and a third of zero radius.
+    c.points.insert(c.points.end(), {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, {0, 0, 1}, {1, 0, 1}});
+    c.radii.insert(c.radii.end(), {0.1f, 0.1f, 0.1f, 0.0f, 0.0f});
+    c.first = {0, 4, 7, 9};
+    d.curves = {c};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    EXPECT_EQ(scene.stats().curves, 1u);
+    EXPECT_EQ(scene.stats().skipped_curves, 2u);
+    ASSERT_EQ(scene.stats().warnings.size(), 2u);
+    EXPECT_NE(scene.stats().warnings[0].find("zero length"), std::string::npos);
+    EXPECT_NE(scene.stats().warnings[1].find("zero radius"), std::string::npos);
+}
+
+TEST(Scene, InvalidScenesGiveClearErrors) {
+    auto base = [] {
+        SceneDesc d;
+        d.materials = {hair_material(), DiffuseMaterial{}};
+        d.curves = {straight_hair()};
+        d.camera = small_camera();
+        return d;
+    };
+    ASSERT_TRUE(Scene::build(base()).ok());
+
+    SceneDesc d = base();
+    d.curves[0].points[2].y = NAN;
+    std::string e = build_error(std::move(d));
+    EXPECT_NE(e.find("curve set 0, curve 0, point 2"), std::string::npos) << e;
+    EXPECT_NE(e.find("finite"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].points.push_back({2, 0, 0});
+    d.curves[0].radii.push_back(0.1f);
+    d.curves[0].first = {0, 4, 5};  // a second curve with one point
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("curve 1"), std::string::npos) << e;
+    EXPECT_NE(e.find("at least 2"), std::string::npos) << e;
+
+    d = base();
+    d.curves.clear();
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("no geometry"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].points = {{0, 0, 0}, {0, 0, 0}};
+    d.curves[0].radii = {0.1f, 0.1f};
+    d.curves[0].first = {0, 2};
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("no geometry"), std::string::npos) << e;
+    EXPECT_NE(e.find("skipped"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].radii[1] = -0.1f;
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("radius"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].radii.pop_back();
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("one radius per point"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].material = 7;
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("out of range"), std::string::npos) << e;
+
+    d = base();
+    d.meshes = {quad(0.0f, 0)};
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("meshes need a diffuse material"), std::string::npos) << e;
+
+    d = base();
+    d.meshes = {quad(0.0f, 1)};
+    d.meshes[0].indices[4] = 9;
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("vertex index out of range"), std::string::npos) << e;
+
+    d = base();
+    d.materials[0] = HairMaterial{HairShading::create(nullptr, std::make_shared<const UniformSampler>()).value()};
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("hair material has no fiber"), std::string::npos) << e;
+
+    d = base();
+    d.point_lights = {{Vec3{0, 0, 0}, Rgb(1.0f), NAN, 0.0f}};
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("point light 0: power"), std::string::npos) << e;
+
+    d = base();
+    d.camera.width = 0;
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("camera: width"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace hairis

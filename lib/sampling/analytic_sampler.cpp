@@ -1,0 +1,26 @@
+#include "sampling/analytic_sampler.h"
+
+namespace hairis {
+
+namespace {
+
+class AnalyticPoint final : public SamplerPoint {
+  public:
+    explicit AnalyticPoint(const ChiangPoint &fiber) : fiber_(&fiber) {}
+    std::optional<DirectionSample> sample(float u0, float u1, float u2) const override {
+        return fiber_->sample(u0, u1, u2);
+    }
+    float pdf(Vec3 wi) const override { return fiber_->pdf(wi); }
+
+  private:
+    const ChiangPoint *fiber_;
+};
+
+}  // namespace
+
+const SamplerPoint &AnalyticSampler::at(const FiberHit &, const FiberPoint *fiber, ScratchBuffer &scratch) const {
+    // model() is the Chiang fiber, so `fiber` is one of its ChiangPoints.
+    return scratch.make<AnalyticPoint>(static_cast<const ChiangPoint &>(*fiber));
+}
+
+}  // namespace hairis

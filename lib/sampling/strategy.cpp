@@ -1,0 +1,102 @@
+#include "sampling/strategy.h"
+
+#include <algorithm>
+
+#include "fiber/fiber_spec.h"
+#include "sampling/analytic_sampler.h"
+#include "sampling/mixture_sampler.h"
+#include "sampling/seed_samplers.h"
+#include "sampling/table_samplers.h"
+#include "sampling/uniform_sampler.h"
+
+namespace hairis {
+
+namespace {
+
+std::string join(const std::vector<int> &values) {
+    std::string out;
+    for (int v : values) out += (out.empty() ? "" : ", ") + std::to_string(v);
+    return out;
+}
+
+template <typename T>
+Expected<std::shared_ptr<const Sampler>> shared(Expected<T> made) {
+    if (!made) return made.error();
+    return std::shared_ptr<const Sampler>(std::make_shared<const T>(std::move(made).value()));
+}
+
+Expected<std::shared_ptr<const Sampler>> mixture(Expected<std::shared_ptr<const Sampler>> single,
+                                                 Expected<std::shared_ptr<const Sampler>> multiple, float w) {
+    if (!single) return single.error();
+    if (!multiple) return multiple.error();
+    return shared(MixtureSampler::create(std::move(single).value(), std::move(multiple).value(), w));
+}
+
+Error table_error(std::string message) { return Error{std::move(message), ErrorKind::InvalidTable}; }
+
+}  // namespace
+
+const char *strategy_name(StrategyKind kind) {
+    switch (kind) {
+        case StrategyKind::Uniform: return "uniform";
+        case StrategyKind::Analytic: return "analytic";
+        case StrategyKind::Gaussian: return "gaussian";
+        case StrategyKind::Table: return "table";
+    }
+    return "unknown";
+}
+
+Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
+    if (Status s = t.validate()) return Error{s->message, ErrorKind::InvalidTable};
+    Expected<DirectTable> direct = DirectTable::create(t.theta_r_nodes, t.theta_i_count, t.phi_count, t.direct);
+    if (!direct) return table_error("direct table: " + direct.error().message);
+    Expected<MultipleTable> multiple = MultipleTable::create(t.theta_r_nodes, t.n_h_values, t.theta_i_count, t.multiple);
+    if (!multiple) return table_error("multiple table: " + multiple.error().message);
+    return SamplingTables{std::make_shared<const DirectTable>(std::move(direct).value()),
+                          std::make_shared<const MultipleTable>(std::move(multiple).value()), t.model,
+                          canonical_parameters(t.parameters)};
+}
+
+Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &in) {
+    if (Status s = check::in_range("multiple_weight", in.multiple_weight, 0.0, 1.0)) return *s;
+    switch (kind) {
+        case StrategyKind::Uniform:
+            return std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>());
+        case StrategyKind::Analytic:
+            if (!in.chiang) return Error{"the analytic strategy needs a Chiang (Principled Hair) fiber"};
+            return std::shared_ptr<const Sampler>(std::make_shared<const AnalyticSampler>(in.chiang));
+        case StrategyKind::Gaussian:
+            return mixture(shared(SeedDirectSampler::create(in.seed)), shared(SeedMultipleSampler::create(in.seed, in.n_h)),
+                           in.multiple_weight);
+        case StrategyKind::Table: {
+            if (!in.tables || !in.tables->direct || !in.tables->multiple)
+                return table_error("the table strategy needs baked tables (none were given)");
+            const SamplingTables &t = *in.tables;
+            if (in.chiang) {
+                const std::string parameters = canonical_parameters(chiang_parameters(in.chiang->params()));
+                if (t.model != in.chiang->name() || t.parameters != parameters)
+                    return table_error("the tables were baked for " + t.model + " \"" + t.parameters + "\", not for " +
+                                       in.chiang->name() + " \"" + parameters + "\"; bake tables for this fiber");
+            }
+            if (t.multiple->strand_index(in.n_h) < 0)
+                return table_error("the tables hold n_h " + join(t.multiple->n_h_values()) + ", not n_h = " +
+                                   std::to_string(in.n_h));
+            Expected<std::shared_ptr<const Sampler>> single =
+                std::shared_ptr<const Sampler>(std::make_shared<const FarTableSampler>(t.direct));
+            if (in.chiang) {
+                std::shared_ptr<const NearFieldTable> near_field = in.near_field;
+                if (!near_field) {
+                    Expected<NearFieldTable> made = NearFieldTable::create(in.chiang);
+                    if (!made) return Error{"near-field table: " + made.error().message};
+                    near_field = std::make_shared<const NearFieldTable>(std::move(made).value());
+                }
+                single = std::shared_ptr<const Sampler>(std::make_shared<const NearFieldTableSampler>(near_field));
+            }
+            return mixture(std::move(single), shared(MultipleTableSampler::create(t.multiple, in.n_h)),
+                           in.multiple_weight);
+        }
+    }
+    return Error{"strategy must be uniform, analytic, gaussian or table"};
+}
+
+}  // namespace hairis

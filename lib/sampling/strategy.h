@@ -1,0 +1,79 @@
+// The strategy policy: which sampler draws ω_i for a hair material under each setting. This
+// is the one place that decides; the renderer, the C API and the studies all ask here.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/expected.h"
+#include "fiber/chiang.h"
+#include "fiber/seed_pdfs.h"
+#include "sampling/near_field_table.h"
+#include "sampling/sampler.h"
+#include "sampling/sampling_table.h"
+#include "sampling/table_set.h"
+
+namespace hairis {
+
+/// The strategies hairis offers (the add-on's `strategy` setting, the C API's `strategy`).
+enum class StrategyKind { Uniform = 0, Analytic = 1, Gaussian = 2, Table = 3 };
+
+/// "uniform", "analytic", "gaussian" or "table".
+const char *strategy_name(StrategyKind kind);
+
+/// The baked tables of one fiber, ready to sample, and what they were baked for.
+struct SamplingTables {
+    std::shared_ptr<const DirectTable> direct;
+    std::shared_ptr<const MultipleTable> multiple;
+    std::string model;       ///< TableSet::model
+    std::string parameters;  ///< canonical_parameters(TableSet::parameters)
+
+    /// Builds the samplers' tables from a table set (validated here).
+    static Expected<SamplingTables> from(const TableSet &tables);
+};
+
+/// A strategy and its settings, as the add-on and the C API give them.
+struct SamplerOptions {
+    int strategy = int(StrategyKind::Table);  ///< a StrategyKind
+    /// Weight of the multiple-scattering part (TABLE, GAUSSIAN). 0: in a path tracer the
+    /// multiple-scattering part only adds variance (bench/results/mixture_weight.md).
+    float multiple_weight = 0.0f;
+    int n_h = 2;
+};
+
+/// The option names of SamplerOptions (core/options.h's field descriptions).
+template <typename Fields>
+void describe(Fields &f, SamplerOptions &o) {
+    f.choice("strategy", o.strategy, {"uniform", "analytic", "gaussian", "table"});
+    f.field("multiple_weight", o.multiple_weight, 0.0, 1.0);
+    f.field("n_h", o.n_h, 1, 1024);
+}
+
+/// What a strategy may need.
+struct StrategyInputs {
+    /// The material's fiber: ANALYTIC samples it; TABLE samples its near field from it.
+    std::shared_ptr<const ChiangFiber> chiang;
+    /// Baked tables (TABLE): they must have been baked for `chiang`'s parameters.
+    const SamplingTables *tables = nullptr;
+    /// The seed's PDFs (GAUSSIAN).
+    SeedPdfParams seed;
+    /// Weight of the multiple-scattering part (TABLE, GAUSSIAN), in [0, 1].
+    float multiple_weight = SamplerOptions{}.multiple_weight;
+    /// The multiple-scattering distribution's n_h (TABLE: one the tables hold; GAUSSIAN: 1, 2,
+    /// 4, 8 or 16).
+    int n_h = SamplerOptions{}.n_h;
+    /// A near-field table to share between samplers of one fiber (TABLE with a fiber).
+    std::shared_ptr<const NearFieldTable> near_field;
+};
+
+/// The sampler of `kind`:
+///   UNIFORM   the sphere;
+///   ANALYTIC  Chiang's lobe sampling (needs the fiber);
+///   GAUSSIAN  (1 − w)·seed direct + w·seed multiple(n_h);
+///   TABLE     (1 − w)·single + w·multiple table(n_h), single = the fiber's near-field table
+///             when a fiber is given, else the tables' far-field direct table.
+/// Errors name what is missing or out of range; tables baked for another fiber, or without
+/// n_h, are refused with ErrorKind::InvalidTable.
+Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &inputs);
+
+}  // namespace hairis

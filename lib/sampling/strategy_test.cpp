@@ -1,0 +1,158 @@
+// Every strategy the policy makes samples the density it reports: χ² at θ_r on table nodes,
+// between nodes and near grazing, for the far-field direct table, each n_h of the multiple
+// table, their mixture, the near-field mixture, the analytic sampler and the uniform one; and
+// the policy refuses what it cannot build, naming it.
+#include "sampling/strategy.h"
+
+#include <gtest/gtest.h>
+
+#include "chi2.h"
+#include "core/frame.h"
+#include "fiber/fiber_spec.h"
+#include "sampler_at.h"
+#include "sampling/mixture_sampler.h"
+#include "tables/bake.h"
+
+namespace hairis {
+namespace {
+
+using testing::Chi2Options;
+using testing::Sample3;
+using testing::SamplerAt;
+
+constexpr int kNodes = 15;  // nodes every 12° at ±6°, ±18°, ..., ±84°
+// θ_r (degrees): on a node, between nodes, and near grazing (on the last node, between the
+// last two, and past the last node where the outer slice is used).
+const double kThetaR[] = {-36.0, 0.0, 30.0, 84.0, -81.0, 87.5};
+// table (direct, 5 n_h, mixture, near-field mixture), analytic, uniform
+constexpr int kFamily = 6 * (1 + 5 + 1 + 1) + 6 + 6;
+
+struct Fixture {
+    std::shared_ptr<const ChiangFiber> fiber;
+    SamplingTables tables;
+};
+
+const Fixture &fixture() {
+    static const Fixture f = [] {
+        const FiberSpec spec = FiberSpec::preset("cycles-default").value();
+        auto chiang = ChiangFiber::create(to_chiang_params(spec.node).value()).value();
+        BakeOptions options;
+        options.theta_r_count = kNodes;
+        options.theta_i_count = 32;
+        options.phi_count = 32;
+        const TableSet set = bake_tables(chiang, spec.parameters().value(), options).value();
+        return Fixture{std::make_shared<const ChiangFiber>(chiang), SamplingTables::from(set).value()};
+    }();
+    return f;
+}
+
+StrategyInputs inputs(std::shared_ptr<const ChiangFiber> fiber, const SamplingTables *tables, float w, int n_h) {
+    StrategyInputs in;
+    in.chiang = std::move(fiber);
+    in.tables = tables;
+    in.multiple_weight = w;
+    in.n_h = n_h;
+    return in;
+}
+
+Vec3 view_at(double theta_r_deg) { return direction_of(float(radians(theta_r_deg)), -float(kHalfPi)); }
+
+void expect_exact(const Sampler &sampler, double theta_r_deg, float h, const std::string &what) {
+    const SamplerAt at(sampler, view_at(theta_r_deg), h);
+    Chi2Options options;
+    options.test_count = kFamily;
+    // The table densities are piecewise constant: split the quadrature at their cell edges.
+    for (int k = 0; k <= 32; ++k) {
+        options.theta_breaks.push_back(-kHalfPi + kPi * k / 32);
+        options.phi_breaks.push_back(-kPi + kTwoPi * k / 32);
+    }
+    // ... and at the near-field table's (linear inside each cell).
+    for (int k = 0; k <= NearFieldTableOptions{}.theta_i_cells; ++k)
+        options.theta_breaks.push_back(-kHalfPi + kPi * k / NearFieldTableOptions{}.theta_i_cells);
+    const auto r = testing::chi2_direction_test(
+        [&](Sample3 u) -> std::optional<Vec3> {
+            auto s = at.sample(u.u0, u.u1, u.u2);
+            return s ? std::optional<Vec3>(s->wi) : std::nullopt;
+        },
+        [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+    EXPECT_TRUE(r.passed) << what << " at theta_r " << theta_r_deg << ": " << r.message;
+    EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what << " at theta_r " << theta_r_deg;
+    EXPECT_EQ(r.failed_samples, 0) << what;
+}
+
+std::shared_ptr<const Sampler> made(StrategyKind kind, const StrategyInputs &in) {
+    Expected<std::shared_ptr<const Sampler>> s = make_sampler(kind, in);
+    EXPECT_TRUE(s.ok()) << s.error().message;
+    return s.value();
+}
+
+class TableStrategy : public ::testing::TestWithParam<double> {};
+
+TEST_P(TableStrategy, DirectTableIsExact) {
+    expect_exact(*made(StrategyKind::Table, inputs(nullptr, &fixture().tables, 0.0f, 2)), GetParam(), 0.0f, "direct table");
+}
+
+TEST_P(TableStrategy, EachMultipleTableIsExact) {
+    for (int n_h : {1, 2, 4, 8, 16})
+        expect_exact(*made(StrategyKind::Table, inputs(nullptr, &fixture().tables, 1.0f, n_h)), GetParam(), 0.0f,
+                     "multiple table n_h " + std::to_string(n_h));
+}
+
+TEST_P(TableStrategy, MixtureIsExact) {
+    expect_exact(*made(StrategyKind::Table, inputs(nullptr, &fixture().tables, 0.3f, 4)), GetParam(), 0.0f, "mixture");
+}
+
+TEST_P(TableStrategy, NearFieldMixtureIsExact) {
+    // With a Chiang fiber the table strategy follows the near field at h.
+    const auto s = made(StrategyKind::Table, inputs(fixture().fiber, &fixture().tables, 0.3f, 4));
+    EXPECT_EQ(s->model(), fixture().fiber.get());
+    expect_exact(*s, GetParam(), -0.45f, "near-field mixture");
+}
+
+TEST_P(TableStrategy, AnalyticIsExact) {
+    expect_exact(*made(StrategyKind::Analytic, inputs(fixture().fiber, nullptr, 0.0f, 2)), GetParam(), 0.35f, "analytic");
+}
+
+TEST_P(TableStrategy, UniformIsExact) {
+    expect_exact(*made(StrategyKind::Uniform, {}), GetParam(), 0.0f, "uniform");
+}
+
+INSTANTIATE_TEST_SUITE_P(ThetaR, TableStrategy, ::testing::ValuesIn(kThetaR));
+
+TEST(Strategy, MissingOrMismatchedInputsAreRefusedByName) {
+    auto a = make_sampler(StrategyKind::Analytic, {});
+    ASSERT_FALSE(a.ok());
+    EXPECT_NE(a.error().message.find("Chiang"), std::string::npos);
+    auto t = make_sampler(StrategyKind::Table, {});
+    ASSERT_FALSE(t.ok());
+    EXPECT_NE(t.error().message.find("baked tables"), std::string::npos);
+    EXPECT_EQ(t.error().kind, ErrorKind::InvalidTable);
+    auto n = make_sampler(StrategyKind::Table, inputs(nullptr, &fixture().tables, 0.5f, 3));
+    ASSERT_FALSE(n.ok());
+    EXPECT_NE(n.error().message.find("hold n_h 1, 2, 4, 8, 16, not n_h = 3"), std::string::npos) << n.error().message;
+    EXPECT_EQ(n.error().kind, ErrorKind::InvalidTable);
+    auto w = make_sampler(StrategyKind::Gaussian, inputs(nullptr, nullptr, 2.0f, 2));
+    EXPECT_FALSE(w.ok());
+    // Tables of another fiber are never used silently.
+    ChiangParams other = fixture().fiber->params();
+    other.roughness = 0.45f;
+    auto stale = make_sampler(StrategyKind::Table,
+                              inputs(std::make_shared<const ChiangFiber>(ChiangFiber::create(other).value()),
+                                     &fixture().tables, 0.0f, 2));
+    ASSERT_FALSE(stale.ok());
+    EXPECT_EQ(stale.error().kind, ErrorKind::InvalidTable);
+    EXPECT_NE(stale.error().message.find("roughness=0.449999988"), std::string::npos) << stale.error().message;
+    EXPECT_STREQ(strategy_name(StrategyKind::Table), "table");
+}
+
+TEST(Strategy, AHairShadingRefusesASamplerOfAnotherFiber) {
+    const auto s = made(StrategyKind::Analytic, inputs(fixture().fiber, nullptr, 0.0f, 2));
+    const auto other = std::make_shared<const ChiangFiber>(ChiangFiber::create({}).value());
+    EXPECT_TRUE(HairShading::create(fixture().fiber, s).ok());
+    EXPECT_FALSE(HairShading::create(other, s).ok());
+    EXPECT_FALSE(HairShading::create(nullptr, s).ok());
+    EXPECT_TRUE(HairShading::create(nullptr, made(StrategyKind::Uniform, {})).ok());
+}
+
+}  // namespace
+}  // namespace hairis

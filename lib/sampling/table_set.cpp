@@ -1,0 +1,69 @@
+#include "sampling/table_set.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/math.h"
+
+namespace hairis {
+
+namespace {
+
+Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+
+}  // namespace
+
+std::string canonical_parameters(const std::vector<std::pair<std::string, double>> &params) {
+    std::string out;
+    char value[64];
+    for (const auto &[name, v] : params) {
+        std::snprintf(value, sizeof value, "%.9g", v);
+        if (!out.empty()) out += ';';
+        out += name + "=" + value;
+    }
+    return out;
+}
+
+Status TableSet::validate() const {
+    if (model != "chiang2016" && model != "marschner2003")
+        return file_error("model must be \"chiang2016\" or \"marschner2003\" (got \"" + model + "\")");
+    if (source != "exact" && source != "gaussian")
+        return file_error("source must be \"exact\" or \"gaussian\" (got \"" + source + "\")");
+    if (Status s = first_error(resolution().validate(),
+                               check::count_in_range("n_h count", (long long)n_h_values.size(), 0,
+                                                     std::min(phi_count, kMaxStrandCounts))))
+        return file_error(s->message);
+    const long long cells = resolution().cells();
+    for (int r = 0; r < theta_r_count(); ++r) {
+        const float t = theta_r_nodes[r];
+        if (!std::isfinite(t) || std::fabs(t) > float(kHalfPi) + 1e-6f)
+            return file_error("theta_r node " + std::to_string(r) + " must be finite and in [-pi/2, pi/2]");
+        if (r > 0 && !(t > theta_r_nodes[r - 1]))
+            return file_error("theta_r nodes must be strictly increasing (node " + std::to_string(r) + ")");
+    }
+    for (size_t k = 0; k < n_h_values.size(); ++k) {
+        if (n_h_values[k] < 1 || n_h_values[k] > 1024)
+            return file_error("n_h values must be in [1, 1024] (got " + std::to_string(n_h_values[k]) + ")");
+        if (k > 0 && n_h_values[k] <= n_h_values[k - 1])
+            return file_error("n_h values must be strictly increasing");
+    }
+    if (direct.size() != size_t(cells))
+        return file_error("direct table holds " + std::to_string(direct.size()) + " values; the grid needs " +
+                          std::to_string(cells));
+    const size_t multiple_size = size_t(theta_r_count()) * n_h_values.size() * theta_i_count;
+    if (multiple.size() != multiple_size)
+        return file_error("multiple table holds " + std::to_string(multiple.size()) +
+                          " values; the grid needs " + std::to_string(multiple_size));
+    for (const std::vector<float> *v : {&direct, &multiple})
+        for (size_t n = 0; n < v->size(); ++n)
+            if (!std::isfinite((*v)[n]) || (*v)[n] < 0.0f)
+                return file_error(std::string(v == &direct ? "direct" : "multiple") + " table value " +
+                                  std::to_string(n) + " is negative, NaN or infinite");
+    for (const auto &[name, value] : parameters)
+        if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
+            return file_error("parameter \"" + name + "\" must have a plain name and a finite value");
+    return std::nullopt;
+}
+
+}  // namespace hairis

@@ -1,0 +1,43 @@
+// A baked table set as plain data: what a table file holds and what the samplers are built
+// from (table_file.h reads and writes it as EXR).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/expected.h"
+#include "sampling/table_limits.h"
+
+namespace hairis {
+
+/// Everything a table file holds, as plain data.
+struct TableSet {
+    std::string model;   ///< "chiang2016" or "marschner2003"
+    std::string source;  ///< "exact" (our distributions) or "gaussian" (the seed's PDFs)
+    std::vector<std::pair<std::string, double>> parameters;  ///< every model parameter
+    std::vector<float> theta_r_nodes;  ///< radians, strictly increasing, in [−π/2, π/2]
+    int theta_i_count = 0;             ///< θ_i cells over [−π/2, π/2]
+    int phi_count = 0;                 ///< φ cells over [−π, π]
+    std::vector<int> n_h_values;       ///< strands for the multiple tables, increasing
+    std::vector<float> direct;    ///< [r][i][j]: theta_r_count × theta_i_count × phi_count
+    std::vector<float> multiple;  ///< [r][k][i]: theta_r_count × n_h count × theta_i_count
+
+    int theta_r_count() const { return int(theta_r_nodes.size()); }
+    TableResolution resolution() const { return {theta_r_count(), theta_i_count, phi_count}; }
+    float direct_at(int r, int i, int j) const {
+        return direct[(size_t(r) * theta_i_count + i) * phi_count + j];
+    }
+    float multiple_at(int r, int k, int i) const {
+        return multiple[(size_t(r) * n_h_values.size() + k) * theta_i_count + i];
+    }
+
+    /// Checks sizes, ordering, ranges and values; names the first problem found.
+    Status validate() const;
+};
+
+/// "name=value;..." with values printed to 9 significant digits, in the order given.
+std::string canonical_parameters(const std::vector<std::pair<std::string, double>> &params);
+
+}  // namespace hairis

@@ -1,0 +1,59 @@
+// Baking: from a fiber model (or the seed's Gaussian PDFs) to the per-θ_r tables of a
+// TableSet, ready to write as EXR or to build samplers from.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/expected.h"
+#include "fiber/fiber.h"
+#include "fiber/seed_pdfs.h"
+#include "sampling/table_set.h"
+
+namespace hairis {
+
+/// What to bake and at which resolution.
+struct BakeOptions {
+    int theta_r_count = 31;    ///< θ_r nodes at the centres of equal cells of [−π/2, π/2]
+    int theta_i_count = 64;    ///< θ_i cells over [−π/2, π/2]
+    int phi_count = 64;        ///< φ cells over [−π, π]
+    int quadrature_points = 2; ///< Gauss–Legendre nodes per axis inside each cell
+    std::vector<int> n_h_values = {1, 2, 4, 8, 16};
+    std::string source = "exact";  ///< "exact" (the model's distributions) or "gaussian"
+    SeedPdfParams seed;            ///< the seed's PDFs, for source "gaussian"
+    int threads = 0;               ///< 0: all cores
+
+    /// Names the first option out of range.
+    Status validate() const;
+};
+
+/// The option names of BakeOptions (core/options.h's field descriptions).
+template <typename Fields>
+void describe(Fields &f, BakeOptions &o) {
+    f.field("theta_r", o.theta_r_count, 1, kMaxThetaRNodes);
+    f.field("theta_i", o.theta_i_count, 2, kMaxTableAxisCells);
+    f.field("phi", o.phi_count, 1, kMaxTableAxisCells);
+    f.field("n_h", o.n_h_values, 16, 1, 1024);
+    f.field("source", o.source);
+    f.field("quadrature_points", o.quadrature_points, 1, 16);
+    f.field("threads", o.threads, 0, 1024);
+}
+
+/// The θ_r nodes of a bake: centres of `count` equal cells of [−π/2, π/2]. The ends ±π/2
+/// (a view along the fiber) are singular for both models, so no node sits there; a θ_r past
+/// the outer nodes uses the outer node's slice.
+std::vector<float> theta_r_nodes(int count);
+
+/// Called with progress in [0, 1]; return false to cancel.
+using ProgressFn = std::function<bool(float)>;
+
+/// Bakes direct and multiple tables for `model` whose parameters are `parameters` (recorded
+/// in the metadata). Deterministic: the same inputs give the same numbers for any thread
+/// count. Returns an error naming the problem, or "cancelled".
+Expected<TableSet> bake_tables(const FiberModel &model,
+                               const std::vector<std::pair<std::string, double>> &parameters,
+                               const BakeOptions &options, const ProgressFn &progress = {});
+
+}  // namespace hairis

@@ -1,0 +1,378 @@
+#include "tables/table_file.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/hash.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "core/math.h"
+
+namespace hairis {
+
+namespace {
+
+using OIIO::TypeDesc;
+
+constexpr int kChannels = 4;
+
+std::string sha1_of(const std::vector<float> &pixels) {
+    OIIO::SHA1 sha(pixels.data(), pixels.size() * sizeof(float));
+    return sha.digest();
+}
+
+std::string join_ints(const std::vector<int> &values) {
+    std::string out;
+    for (size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + std::to_string(values[i]);
+    return out;
+}
+
+// OIIO 2.4.7's IOMemReader takes any seek and checks a read's end as size + offset in
+// unsigned arithmetic, so a "negative" offset (OpenEXR seeks wherever a damaged chunk table
+// points) wraps past the check and copies from before the buffer. This reader answers a read
+// outside the buffer with 0 bytes, which OpenEXR reports as a truncated file.
+class BoundedMemReader final : public OIIO::Filesystem::IOMemReader {
+public:
+    using IOMemReader::IOMemReader;
+    size_t read(void *buf, size_t size) override {
+        const size_t n = pread(buf, size, m_pos);
+        m_pos += int64_t(n);
+        return n;
+    }
+    size_t pread(void *buf, size_t size, int64_t offset) override {
+        const size_t total = m_buf.size();
+        if (offset < 0 || uint64_t(offset) >= total) return 0;
+        return IOMemReader::pread(buf, std::min(size, total - size_t(offset)), offset);
+    }
+};
+
+// Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
+int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
+
+std::vector<float> pixels_of(const TableSet &t) {
+    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const int bands = int(t.n_h_values.size());
+    std::vector<float> px(size_t(width) * height * kChannels);
+    for (int r = 0; r < t.theta_r_count(); ++r) {
+        for (int i = 0; i < t.theta_i_count; ++i) {
+            const size_t row = size_t(r) * t.theta_i_count + i;
+            for (int j = 0; j < width; ++j) {
+                float *p = &px[(row * width + j) * kChannels];
+                p[0] = t.direct_at(r, i, j);
+                p[1] = bands ? t.multiple_at(r, band_of_column(j, width, bands), i) : 0.0f;
+                p[2] = 0.0f;
+                p[3] = 1.0f;
+            }
+        }
+    }
+    return px;
+}
+
+Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+
+// The size OpenEXR reads for an attribute of a fixed-size type whatever its size field says
+// (0: a variable-size or unknown type, read as `size` bytes).
+int fixed_attribute_size(const std::string &type) {
+    static const std::pair<const char *, int> sizes[] = {
+        {"int", 4},    {"float", 4},     {"double", 8},     {"v2i", 8},        {"v2f", 8},
+        {"v2d", 16},   {"v3i", 12},      {"v3f", 12},       {"v3d", 24},       {"box2i", 16},
+        {"box2f", 16}, {"m33f", 36},     {"m33d", 72},      {"m44f", 64},      {"m44d", 128},
+        {"rational", 8}, {"timecode", 8}, {"keycode", 28},  {"chromaticities", 32},
+        {"tiledesc", 9}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},
+        {"deepImageState", 1}};
+    for (const auto &[name, bytes] : sizes)
+        if (type == name) return bytes;
+    return 0;
+}
+
+// A first look at the EXR header, before OpenEXR reads it: OpenEXR allocates what an
+// attribute's size field, a string vector's entry, a preview or the data window claims (a
+// string attribute of 1.7 GB in a 2 KB buffer, a window of 2^31 rows whose offset table it
+// allocates) before finding the data missing, and reads fixed-size types at their own size,
+// so that a wrong size field makes it read the rest of the header out of step. Table files
+// are single-part scanline images whose attributes are consistent, lie inside the buffer and
+// whose window fits the table limits; anything else is refused here (found by fuzzing).
+Status check_exr_header(const unsigned char *data, size_t size) {
+    auto read_int = [&](size_t at) {
+        int32_t v = 0;
+        for (int b = 3; b >= 0; --b) v = int32_t(uint32_t(v) << 8 | data[at + size_t(b)]);
+        return v;
+    };
+    if (size < 8 || data[0] != 0x76 || data[1] != 0x2f || data[2] != 0x31 || data[3] != 0x01)
+        return file_error("not a readable OpenEXR file (no OpenEXR magic number)");
+    const uint32_t flags = uint32_t(read_int(4)) & ~0xffu;
+    constexpr uint32_t kLongNames = 0x400, kNonImage = 0x800, kMultiPart = 0x1000;
+    if (flags & (kNonImage | kMultiPart))
+        return file_error("a multi-part or deep OpenEXR file is not a table file");
+    const size_t max_name = flags & kLongNames ? 255 : 31;
+    size_t at = 8;
+    auto read_name = [&](std::string &name) -> Status {
+        const void *end = std::memchr(data + at, 0, std::min(size - at, max_name + 1));
+        if (!end) return file_error("the OpenEXR header is truncated or corrupt (attribute name)");
+        name.assign(reinterpret_cast<const char *>(data + at), size_t(static_cast<const unsigned char *>(end) - (data + at)));
+        at += name.size() + 1;
+        return std::nullopt;
+    };
+    std::string name, type;
+    while (true) {
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(name)) return s;
+        if (name.empty()) break;  // the end of the header
+        if (at >= size) return file_error("the OpenEXR header is truncated");
+        if (Status s = read_name(type)) return s;
+        if (size - at < 4) return file_error("the OpenEXR header is truncated");
+        const int32_t length = read_int(at);
+        at += 4;
+        if (length < 0 || size_t(length) > size - at)
+            return file_error("OpenEXR attribute \"" + name + "\" claims " + std::to_string(length) +
+                              " bytes; the data holds " + std::to_string(size - at));
+        const int fixed = fixed_attribute_size(type);
+        if (fixed != 0 && length != fixed)
+            return file_error("OpenEXR attribute \"" + name + "\" of type " + type + " has size " +
+                              std::to_string(length) + " (a " + type + " has " + std::to_string(fixed) + ")");
+        if (type == "stringvector") {
+            for (size_t in = 0; in < size_t(length);) {
+                if (size_t(length) - in < 4) return file_error("OpenEXR attribute \"" + name + "\" is corrupt");
+                const int32_t entry = read_int(at + in);
+                in += 4;
+                if (entry < 0 || size_t(entry) > size_t(length) - in)
+                    return file_error("OpenEXR attribute \"" + name + "\" has an entry larger than itself");
+                in += size_t(entry);
+            }
+        }
+        if (type == "chlist") {
+            // Entries of a name and 16 bytes, up to an empty name that must end the attribute.
+            size_t in = 0;
+            while (true) {
+                const size_t left = size_t(length) - in;
+                const void *end = std::memchr(data + at + in, 0, std::min(left, max_name + 1));
+                if (!end) return file_error("OpenEXR attribute \"" + name + "\": a channel entry is corrupt");
+                const size_t name_size = size_t(static_cast<const unsigned char *>(end) - (data + at + in));
+                in += name_size + 1;
+                if (name_size == 0) break;
+                if (size_t(length) - in < 16)
+                    return file_error("OpenEXR attribute \"" + name + "\": a channel entry is truncated");
+                in += 16;
+            }
+            if (in != size_t(length))
+                return file_error("OpenEXR attribute \"" + name + "\": the channel list does not fill its size");
+        }
+        if (type == "preview") {
+            // width × height RGBA bytes after the two sizes (unsigned: no overflow).
+            const uint64_t width = length >= 8 ? uint32_t(read_int(at)) : 0;
+            const uint64_t height = length >= 8 ? uint32_t(read_int(at + 4)) : 0;
+            if (length < 8 || width * height != (uint64_t(length) - 8) / 4 || (length - 8) % 4 != 0)
+                return file_error("OpenEXR attribute \"" + name + "\": the preview's size does not match its data");
+        }
+        if (name == "dataWindow") {
+            if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
+            const long long width = (long long)read_int(at + 8) - read_int(at) + 1;
+            const long long height = (long long)read_int(at + 12) - read_int(at + 4) + 1;
+            if (width < 1 || height < 1 || width > kMaxTableAxisCells ||
+                height > (long long)kMaxThetaRNodes * kMaxTableAxisCells || width * height > kMaxTableCells)
+                return file_error("the image is " + std::to_string(width) + "x" + std::to_string(height) +
+                                  " pixels; a table has at most " + std::to_string(kMaxTableAxisCells) +
+                                  " columns and " + std::to_string(kMaxTableCells) + " pixels");
+        }
+        at += size_t(length);
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
+    if (Status s = t.validate()) return *s;
+    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const std::vector<float> px = pixels_of(t);
+
+    OIIO::ImageSpec spec(width, height, kChannels, TypeDesc::FLOAT);
+    spec.channelnames = {"R", "G", "B", "A"};
+    spec.alpha_channel = 3;
+    spec.attribute("compression", "zip");
+    // OpenImageIO stamps the current time unless told otherwise; a fixed stamp keeps the
+    // bytes a function of the tables alone (deterministic bakes).
+    spec.attribute("DateTime", "1970:01:01 00:00:00");
+    spec.attribute("hairis:format_version", kTableFormatVersion);
+    spec.attribute("hairis:model", t.model);
+    spec.attribute("hairis:source", t.source);
+    spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
+    spec.attribute("hairis:theta_r_count", t.theta_r_count());
+    spec.attribute("hairis:theta_i_count", t.theta_i_count);
+    spec.attribute("hairis:phi_count", t.phi_count);
+    spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
+                   t.theta_r_nodes.data());
+    spec.attribute("hairis:n_h_values", join_ints(t.n_h_values));
+    spec.attribute("hairis:pixel_sha1", sha1_of(px));
+
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("openexr");
+    if (!out) return file_error("OpenImageIO has no OpenEXR writer: " + OIIO::geterror());
+    if (!out->set_ioproxy(&proxy) || !out->open("tables.exr", spec) ||
+        !out->write_image(TypeDesc::FLOAT, px.data()) || !out->close())
+        return file_error("encoding the EXR failed: " + out->geterror());
+    return bytes;
+}
+
+Expected<TableSet> decode_table_exr(const void *data, size_t size) {
+    if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
+    if (Status s = check_exr_header(static_cast<const unsigned char *>(data), size)) return *s;
+    BoundedMemReader proxy(data, size);
+    auto in = OIIO::ImageInput::create("openexr");
+    if (!in) return file_error("OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
+    // OIIO 2.4 takes the in-memory proxy through the open() configuration.
+    OIIO::ImageSpec config, opened;
+    void *proxy_pointer = &proxy;
+    config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxy_pointer);
+    if (!in->open("tables.exr", opened, config)) {
+        std::string why = in->geterror();
+        return file_error("not a readable OpenEXR file" + (why.empty() ? std::string() : ": " + why));
+    }
+    const OIIO::ImageSpec &spec = in->spec();
+
+    const int version = spec.get_int_attribute("hairis:format_version", -1);
+    if (version == -1) return file_error("no hairis:format_version attribute: not a hairis table file");
+    if (version != kTableFormatVersion)
+        return file_error("format version " + std::to_string(version) + " is not supported (this build reads version " +
+                          std::to_string(kTableFormatVersion) + ")");
+    if (spec.nchannels != kChannels || spec.channelnames != std::vector<std::string>{"R", "G", "B", "A"})
+        return file_error("expected 4 channels R, G, B, A (got " + std::to_string(spec.nchannels) + ")");
+    if (spec.format != TypeDesc::FLOAT)
+        return file_error("pixels must be 32-bit float (got " + std::string(spec.format.c_str()) + ")");
+
+    TableSet t;
+    t.model = spec.get_string_attribute("hairis:model");
+    t.source = spec.get_string_attribute("hairis:source");
+    const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
+    t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
+    t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
+    // Checked before anything is allocated: the header alone can claim any size.
+    if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
+        return file_error(s->message);
+    if (spec.width != t.phi_count || spec.height != theta_r_count * t.theta_i_count || spec.depth != 1 ||
+        spec.x != 0 || spec.y != 0)
+        return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                          " but the metadata needs " + std::to_string(t.phi_count) + "x" +
+                          std::to_string(theta_r_count * t.theta_i_count));
+
+    const OIIO::ParamValue *nodes = spec.find_attribute("hairis:theta_r_nodes");
+    if (!nodes || nodes->type().basetype != TypeDesc::FLOAT || nodes->type().basevalues() * size_t(nodes->nvalues()) != size_t(theta_r_count))
+        return file_error("hairis:theta_r_nodes must hold " + std::to_string(theta_r_count) + " floats");
+    const float *node_values = static_cast<const float *>(nodes->data());
+    t.theta_r_nodes.assign(node_values, node_values + theta_r_count);
+
+    const std::string n_h_text = spec.get_string_attribute("hairis:n_h_values");
+    if (!n_h_text.empty()) {
+        std::stringstream in_text(n_h_text);
+        std::string item;
+        while (std::getline(in_text, item, ',')) {
+            char *end = nullptr;
+            const long v = std::strtol(item.c_str(), &end, 10);
+            if (item.empty() || *end != '\0' || v < 1 || v > 1024)
+                return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + n_h_text + "\")");
+            t.n_h_values.push_back(int(v));
+        }
+    }
+
+    const std::string parameters = spec.get_string_attribute("hairis:parameters");
+    std::stringstream param_text(parameters);
+    std::string item;
+    while (std::getline(param_text, item, ';')) {
+        const size_t eq = item.find('=');
+        char *end = nullptr;
+        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
+        t.parameters.emplace_back(item.substr(0, eq), v);
+    }
+
+    // Read in bands of rows, so memory grows with the data the file really holds: a small file
+    // whose header claims a large table fails at its first missing scanline instead of after
+    // allocating the whole table.
+    const size_t width = size_t(spec.width), height = size_t(spec.height);
+    constexpr size_t kBandRows = 64;
+    std::vector<float> px, band;
+    OIIO::SHA1 hash;
+    for (size_t y = 0; y < height; y += kBandRows) {
+        const size_t rows = std::min(kBandRows, height - y);
+        band.resize(rows * width * kChannels);
+        if (!in->read_scanlines(0, 0, int(y), int(y + rows), 0, 0, kChannels, TypeDesc::FLOAT, band.data()))
+            return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
+        hash.append(band.data(), band.size() * sizeof(float));
+        px.insert(px.end(), band.begin(), band.end());
+    }
+    in->close();
+
+    const std::string sha = spec.get_string_attribute("hairis:pixel_sha1");
+    if (sha != hash.digest())
+        return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
+
+    const int bands = int(t.n_h_values.size());
+    if (bands > t.phi_count) return file_error("more n_h values than phi columns");
+    t.direct.resize(size_t(theta_r_count) * t.theta_i_count * t.phi_count);
+    t.multiple.assign(size_t(theta_r_count) * bands * t.theta_i_count, 0.0f);
+    for (size_t row = 0; row < height; ++row) {
+        const int r = int(row / size_t(t.theta_i_count)), i = int(row % size_t(t.theta_i_count));
+        for (size_t j = 0; j < width; ++j) {
+            const float *p = &px[(row * width + j) * kChannels];
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3]))
+                return file_error("pixel (" + std::to_string(j) + ", " + std::to_string(row) + ") holds NaN or infinity");
+            t.direct[row * width + j] = p[0];
+            if (bands) {
+                const int k = band_of_column(int(j), t.phi_count, bands);
+                float &m = t.multiple[(size_t(r) * bands + k) * t.theta_i_count + i];
+                const bool band_start = j == 0 || band_of_column(int(j) - 1, t.phi_count, bands) != k;
+                if (band_start) m = p[1];
+                else if (p[1] != m)
+                    return file_error("G channel differs inside the n_h band at pixel (" + std::to_string(j) + ", " +
+                                      std::to_string(row) + ")");
+            }
+            if (p[2] != 0.0f || p[3] != 1.0f)
+                return file_error("B must be 0 and A must be 1 at pixel (" + std::to_string(j) + ", " +
+                                  std::to_string(row) + ")");
+        }
+    }
+    if (Status s = t.validate()) return *s;
+    return t;
+}
+
+Expected<TableSet> read_table_file(const std::string &path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return file_error("cannot open \"" + path + "\" for reading");
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    if (file.bad()) return file_error("cannot read \"" + path + "\"");
+    Expected<TableSet> t = decode_table_exr(bytes.data(), bytes.size());
+    if (!t) return Error{t.error().message + " (in \"" + path + "\")"};
+    return t;
+}
+
+Status write_table_file(const TableSet &tables, const std::string &path) {
+    Expected<std::vector<unsigned char>> bytes = encode_table_exr(tables);
+    if (!bytes) return bytes.error();
+    const std::string temp = path + ".tmp-hairis";
+    {
+        std::ofstream file(temp, std::ios::binary | std::ios::trunc);
+        if (!file) return file_error("cannot write \"" + temp + "\" (is the folder writable?)");
+        file.write(reinterpret_cast<const char *>(bytes.value().data()), std::streamsize(bytes.value().size()));
+        file.close();
+        if (!file) {
+            std::remove(temp.c_str());
+            return file_error("writing \"" + temp + "\" failed (disk full?)");
+        }
+    }
+    if (std::rename(temp.c_str(), path.c_str()) != 0) {
+        std::remove(temp.c_str());
+        return file_error("cannot rename \"" + temp + "\" to \"" + path + "\"");
+    }
+    return std::nullopt;
+}
+
+}  // namespace hairis
