@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "fiber_options.h"
 #include "tables/bake.h"
+#include "tables/table_file.h"
 
 namespace hairis::cli {
 

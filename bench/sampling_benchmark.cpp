@@ -29,16 +29,21 @@ struct Queries {
     }
 };
 
+// Per direction, as a path vertex pays it: prepare the BSDF at the hit, draw ω_i (f comes
+// with it) and evaluate the density there (what MIS against a light needs).
 void sample_and_pdf(benchmark::State &state, int which) {
     const auto samplers = all_samplers(setup());
-    const DirectionSampler &s = *samplers[size_t(which)].sampler;
+    const Strategy &s = *samplers[size_t(which)].sampler;
     state.SetLabel(samplers[size_t(which)].name);
     const Queries q(4096);
+    ScratchBuffer scratch;
     size_t k = 0;
     for (auto _ : state) {
-        const auto smp = s.sample(q.views[k], q.h[k], q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
-        float pdf = smp ? s.pdf(smp->wi, q.views[k], q.h[k]) : 0.0f;
-        benchmark::DoNotOptimize(pdf);
+        scratch.reset();
+        const HairBsdf bsdf = s.at(q.views[k], q.h[k], scratch);
+        const auto smp = bsdf.sample(q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
+        float value = smp ? smp->f.g + bsdf.pdf(smp->wi) : 0.0f;
+        benchmark::DoNotOptimize(value);
         k = (k + 1) & 4095;
     }
     state.SetItemsProcessed(state.iterations());

@@ -16,7 +16,8 @@
 #include <random>
 
 #include "render/scene.h"
-#include "sampling/strategies.h"
+#include "sampling/analytic_sampler.h"
+#include "sampling/hair_bsdf.h"
 
 namespace hairis::bench {
 namespace {
@@ -52,7 +53,7 @@ HairCurves synthetic_strands(std::size_t count, std::uint32_t seed = 1) {
 SceneDesc strand_scene(std::size_t count) {
     SceneDesc desc;
     auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(ChiangParams{}).value());
-    desc.materials.push_back(HairMaterial{fiber, std::make_shared<const AnalyticSampler>(fiber)});
+    desc.materials.push_back(HairMaterial{HairShading::create(fiber, std::make_shared<const AnalyticSampler>(fiber)).value()});
     desc.curves.push_back(synthetic_strands(count));
     desc.suns.push_back(SunLight{});
     desc.camera.camera_to_world = Mat4::translation({0, 0, 5});

@@ -27,6 +27,7 @@
 
 #include "fiber/dual_scattering.h"
 #include "core/frame.h"
+#include "sampling/analytic_sampler.h"
 #include "study_common.h"
 
 using namespace hairis;
@@ -71,7 +72,7 @@ double median(std::vector<double> v) {
 // relative variance.
 const float kOffsets[] = {-0.95f, -0.6f, -0.2f, 0.2f, 0.6f, 0.95f};
 
-double relative_variance(const DirectionSampler &sampler, Vec3 wo, long long count,
+double relative_variance(const bench::Strategy &sampler, Vec3 wo, long long count,
                          const std::function<double(Vec3, float)> &integrand) {
     std::mt19937_64 rng(1234);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -94,7 +95,7 @@ double relative_variance(const DirectionSampler &sampler, Vec3 wo, long long cou
 }
 
 // Nanoseconds per sample+pdf on one thread (the best of three passes over random queries).
-double time_per_sample(const DirectionSampler &sampler) {
+double time_per_sample(const bench::Strategy &sampler) {
     const int queries = 1 << 18;
     std::vector<Vec3> views(static_cast<size_t>(queries));
     std::vector<float> hs(static_cast<size_t>(queries)), us(3 * static_cast<size_t>(queries));
@@ -267,7 +268,7 @@ int main(int argc, char **argv) {
                 in.n_h = n_h;
                 const StrategyKind kinds[] = {StrategyKind::Uniform, StrategyKind::Analytic, StrategyKind::Gaussian, StrategyKind::Table};
                 if (kinds[which] == StrategyKind::Analytic) in.chiang = cycles_default.fiber;
-                const auto sampler = make_sampler(kinds[which], in).value();
+                const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(kinds[which], in).value(), cycles_default.fiber);
                 std::vector<double> v;
                 for (double t : kThetaR) {
                     const Vec3 wo = direction_of(float(radians(t)), -float(kHalfPi));
@@ -303,7 +304,7 @@ int main(int argc, char **argv) {
                 in.tables = &cycles_default.sampling;
                 in.multiple_weight = 0.0f;
                 in.near_field = table;
-                const auto sampler = make_sampler(StrategyKind::Table, in).value();
+                const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(StrategyKind::Table, in).value(), cycles_default.fiber);
                 std::vector<double> v;
                 // Between nodes as well as on them: θ_r shifted off the grid by 1.3°.
                 for (double t : kThetaR) {
@@ -340,7 +341,7 @@ int main(int argc, char **argv) {
             StrategyInputs in;
             in.tables = &sampling;
             in.multiple_weight = 0.0f;
-            const auto sampler = make_sampler(StrategyKind::Table, in).value();
+            const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(StrategyKind::Table, in).value(), cycles_default.fiber);
             std::vector<double> v;
             for (double t : kThetaR) {
                 const Vec3 wo = direction_of(float(radians(t + 1.3)), -float(kHalfPi));
@@ -378,9 +379,10 @@ int main(int argc, char **argv) {
             const auto chosen = std::make_shared<const NearFieldTable>(NearFieldTable::create(fiber).value());
             const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             const auto rows = std::make_shared<const NearFieldTable>(NearFieldTable::create(fiber, rows_only).value());
-            const AnalyticSampler analytic(fiber);
-            const NearFieldTableSampler chosen_sampler(chosen), rows_sampler(rows);
-            const DirectionSampler *samplers[] = {&analytic, &rows_sampler, &chosen_sampler};
+            const bench::Strategy analytic(std::make_shared<const AnalyticSampler>(fiber), fiber);
+            const bench::Strategy chosen_sampler(std::make_shared<const NearFieldTableSampler>(chosen), fiber);
+            const bench::Strategy rows_sampler(std::make_shared<const NearFieldTableSampler>(rows), fiber);
+            const bench::Strategy *samplers[] = {&analytic, &rows_sampler, &chosen_sampler};
             double med[3], mean[3];
             for (int k = 0; k < 3; ++k) {
                 std::vector<double> v;

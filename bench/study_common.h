@@ -9,7 +9,8 @@
 
 #include "tables/bake.h"
 #include "fiber/fiber_spec.h"
-#include "sampling/strategies.h"
+#include "sampling/hair_bsdf.h"
+#include "sampling/strategy.h"
 
 namespace hairis::bench {
 
@@ -29,11 +30,32 @@ inline StudySetup make_setup(const std::string &preset = "cycles-default", BakeO
     return s;
 }
 
+/// A strategy bound to its fiber, used as the renderer uses it: prepared at (ω_o, h), then
+/// sampled or evaluated (one scratch buffer per thread).
+class Strategy {
+  public:
+    Strategy(std::shared_ptr<const Sampler> sampler, std::shared_ptr<const ChiangFiber> fiber)
+        : shading_(HairShading::create(sampler->model() ? std::move(fiber) : nullptr, sampler).value()) {}
+    HairBsdf at(Vec3 wo, float h, ScratchBuffer &scratch) const { return shading_.at({wo, h}, scratch); }
+    std::optional<BsdfSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const {
+        return at(wo, h, scratch()).sample(u0, u1, u2);
+    }
+    float pdf(Vec3 wi, Vec3 wo, float h) const { return at(wo, h, scratch()).pdf(wi); }
+
+  private:
+    static ScratchBuffer &scratch() {
+        thread_local ScratchBuffer buffer;
+        buffer.reset();
+        return buffer;
+    }
+    HairShading shading_;
+};
+
 /// The strategies compared, with the label used in tables: the mixture weight w of the
 /// multiple-scattering part is 0 for the "direct" variants.
 struct NamedSampler {
     std::string name;
-    std::shared_ptr<const DirectionSampler> sampler;
+    std::shared_ptr<const Strategy> sampler;
 };
 
 inline std::vector<NamedSampler> all_samplers(const StudySetup &s, float mixture_weight = 0.25f, int n_h = 2) {
@@ -46,7 +68,7 @@ inline std::vector<NamedSampler> all_samplers(const StudySetup &s, float mixture
         in.multiple_weight = w;
         in.n_h = n_h;
         if (near) in.near_field = near_field;
-        return make_sampler(kind, in).value();
+        return std::make_shared<const Strategy>(make_sampler(kind, in).value(), s.fiber);
     };
     const std::string w = "w=" + std::to_string(mixture_weight).substr(0, 4);
     return {{"uniform", make(StrategyKind::Uniform, 0.0f, false)},

@@ -50,28 +50,20 @@ class ProgressReporter:
         return bool(self.engine.test_break())
 
 
-def camera_struct(camera):
-    """A ``native.Camera`` from :class:`export.CameraData`."""
-    struct = native.Camera()
-    struct.camera_to_world[:] = [float(v) for v in np.asarray(camera.camera_to_world).reshape(-1)]
-    struct.orthographic = 1 if camera.orthographic else 0
-    struct.frame[:] = [float(v) for v in np.asarray(camera.frame).reshape(-1)]
-    struct.width = int(camera.width)
-    struct.height = int(camera.height)
-    return struct
+def camera_options(camera):
+    """The C API's camera options from :class:`export.CameraData`."""
+    return {"matrix": np.asarray(camera.camera_to_world, dtype=np.float64).reshape(-1),
+            "orthographic": bool(camera.orthographic),
+            "frame": np.asarray(camera.frame, dtype=np.float64).reshape(-1),
+            "width": int(camera.width), "height": int(camera.height)}
 
 
-def render_settings(library, settings):
-    """A ``native.RenderSettings`` from ``scene.hairis``."""
-    struct = library.render_settings_defaults()
-    struct.samples = int(settings.samples)
-    struct.max_bounces = int(settings.max_bounces)
-    struct.strategy = native.STRATEGIES[settings.strategy]
-    struct.multiple_weight = float(settings.multiple_weight)
-    struct.n_h = int(settings.n_h)
-    struct.seed = int(settings.seed)
-    struct.threads = int(settings.threads)
-    return struct
+def render_settings(settings):
+    """The C API's render settings from ``scene.hairis``."""
+    return {"samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
+            "strategy": settings.strategy.lower(),
+            "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
+            "seed": int(settings.seed), "threads": int(settings.threads)}
 
 
 def build_native_scene(library, data, hair_tables):
@@ -85,9 +77,9 @@ def build_native_scene(library, data, hair_tables):
         indices = []
         for i, material in enumerate(data.materials):
             if material.kind == "HAIR":
-                node = tables.principled_struct(library, material.hair)
                 try:
-                    indices.append(scene.add_hair_material(node, hair_tables.get(i)))
+                    indices.append(scene.add_hair_material(material.hair.as_dict(),
+                                                           hair_tables.get(i)))
                 except native.HairisError as error:
                     raise RenderFailed("material %r: %s" % (material.name, error.message)) \
                         from error
@@ -108,7 +100,7 @@ def build_native_scene(library, data, hair_tables):
                 scene.add_area_light(light.matrix, light.shape, light.size_x, light.size_y,
                                      light.color, light.strength)
         scene.set_world(data.world_color, data.world_strength)
-        scene.set_camera(camera_struct(data.camera))
+        scene.set_camera(camera_options(data.camera))
     except BaseException:
         scene.close()
         raise
@@ -185,17 +177,17 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             with build_native_scene(library, data, hair_tables) as native_scene:
                 self.update_stats("", "Rendering %d samples (%s)"
                                   % (settings.samples, settings.strategy.lower()))
-                rgba, stats = native_scene.render(render_settings(library, settings),
+                rgba, stats = native_scene.render(render_settings(settings),
                                                   ProgressReporter(self))
         finally:
             for table in hair_tables.values():
                 table.close()
-        peak = stats.peak_memory_bytes / (1024.0 * 1024.0)
+        peak = int(stats["peak_memory_bytes"]) / (1024.0 * 1024.0)
         self.update_memory_stats(memory_used=peak, memory_peak=peak)
-        self.update_stats("", "Rendered in %.2f s" % stats.seconds)
-        if stats.dropped_samples:
+        self.update_stats("", "Rendered in %.2f s" % float(stats["seconds"]))
+        if int(stats["dropped_samples"]):
             self.report({"WARNING"}, "%d samples with NaN or infinite values were dropped"
-                        % stats.dropped_samples)
+                        % int(stats["dropped_samples"]))
         return rgba
 
     def _resolve_tables(self, library, data, settings):

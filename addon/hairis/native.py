@@ -1,25 +1,27 @@
-"""ctypes binding of the hairis C API (``lib/include/hairis/hairis.h``).
+"""ctypes binding of the hairis C API (``lib/include/hairis/hairis.h`` and ``hairis_render.h``).
 
-Every function and struct of the header is bound here with its exact signature and field
-layout. :func:`load_library` finds ``libhairis.so`` (the ``HAIRIS_LIBRARY`` environment
-variable, else ``lib/`` inside this package), checks ``hairis_api_version() == 1`` and
-returns a :class:`Library` whose methods raise :class:`HairisError` (carrying
-``hairis_last_error()``) on every failing call. Nothing here imports ``bpy``: the module can be
-used, and tested, outside Blender.
+Every function of the headers is declared in :data:`PROTOTYPES` (checked against the headers
+by ``tests/capi/capi_ctypes_test.py``). Parameter sets cross the C API as option strings
+"name=value;..." (:func:`options`), so there are no structs to mirror: a parameter the library
+adds is a name with a default. :func:`load_library` finds ``libhairis.so`` (the
+``HAIRIS_LIBRARY`` environment variable, else ``lib/`` inside this package), checks
+``hairis_api_version() == API_VERSION`` and returns a :class:`Library` whose methods raise
+:class:`HairisError` (carrying ``hairis_last_error()``) on every failing call. Nothing here
+imports ``bpy``: the module can be used, and tested, outside Blender.
 
 Handles (fibers, tables, samplers, scenes) are wrapped in small classes that release the C
 object on :meth:`close`, on leaving a ``with`` block, or when garbage collected.
 """
 
 import ctypes
+import math
 import os
 import sys
-from ctypes import POINTER, c_char_p, c_double, c_float, c_int, c_int32, c_size_t, c_uint32
-from ctypes import c_uint64, c_void_p
+from ctypes import POINTER, c_char_p, c_float, c_int, c_int32, c_size_t, c_uint32, c_void_p
 
 import numpy as np
 
-API_VERSION = 1
+API_VERSION = 2
 """The HAIRIS_API_VERSION this binding was written for."""
 
 LIBRARY_ENV = "HAIRIS_LIBRARY"
@@ -42,169 +44,14 @@ STATUS_NAMES = {
     ERROR_INTERNAL: "HAIRIS_ERROR_INTERNAL",
 }
 
-# hairis_strategy.
-STRATEGY_UNIFORM = 0
-STRATEGY_ANALYTIC = 1
-STRATEGY_GAUSSIAN = 2
-STRATEGY_TABLE = 3
-STRATEGIES = {
-    "UNIFORM": STRATEGY_UNIFORM,
-    "ANALYTIC": STRATEGY_ANALYTIC,
-    "GAUSSIAN": STRATEGY_GAUSSIAN,
-    "TABLE": STRATEGY_TABLE,
-}
+STRATEGIES = ("UNIFORM", "ANALYTIC", "GAUSSIAN", "TABLE")
+"""The add-on's strategy names; the C API spells them in lower case."""
 
-# hairis_parametrization.
-PARAM_ABSORPTION = 0
-PARAM_MELANIN = 1
-PARAM_COLOR = 2
+PARAMETRIZATIONS = ("ABSORPTION", "MELANIN", "COLOR")
+"""Blender's Principled Hair parametrizations; the C API spells them in lower case."""
 
-# hairis_area_shape.
-AREA_SQUARE = 0
-AREA_RECTANGLE = 1
-AREA_DISK = 2
-AREA_ELLIPSE = 3
-AREA_SHAPES = {
-    "SQUARE": AREA_SQUARE,
-    "RECTANGLE": AREA_RECTANGLE,
-    "DISK": AREA_DISK,
-    "ELLIPSE": AREA_ELLIPSE,
-}
-
-
-# ---- Structs ---------------------------------------------------------------------------------
-
-class PrincipledHair(ctypes.Structure):
-    """``hairis_principled_hair``: the inputs of Blender's Principled Hair BSDF node."""
-
-    _fields_ = [
-        ("parametrization", c_int),
-        ("color", c_float * 3),
-        ("melanin", c_float),
-        ("melanin_redness", c_float),
-        ("tint", c_float * 3),
-        ("absorption_coefficient", c_float * 3),
-        ("roughness", c_float),
-        ("radial_roughness", c_float),
-        ("coat", c_float),
-        ("ior", c_float),
-        ("offset", c_float),
-        ("random_color", c_float),
-        ("random_roughness", c_float),
-        ("random", c_float),
-    ]
-
-    def to_dict(self):
-        """The fields as a dict of Python numbers (arrays as tuples)."""
-        return {name: _field_value(getattr(self, name)) for name, _ in self._fields_}
-
-    def update(self, values):
-        """Sets the fields named in the mapping ``values`` (unknown names raise KeyError)."""
-        names = {name for name, _ in self._fields_}
-        for name, value in values.items():
-            if name not in names:
-                raise KeyError("hairis_principled_hair has no field %r" % name)
-            _set_field(self, name, value)
-        return self
-
-
-class MarschnerParams(ctypes.Structure):
-    """``hairis_marschner_params``: Marschner 2003 fiber parameters."""
-
-    _fields_ = [
-        ("eta", c_float),
-        ("sigma_a", c_float * 3),
-        ("alpha_r", c_float),
-        ("alpha_tt", c_float),
-        ("alpha_trt", c_float),
-        ("beta_r", c_float),
-        ("beta_tt", c_float),
-        ("beta_trt", c_float),
-        ("eccentricity", c_float),
-        ("glint_scale", c_float),
-        ("caustic_width", c_float),
-        ("caustic_fade", c_float),
-        ("caustic_intensity_limit", c_float),
-    ]
-
-    def to_dict(self):
-        """The fields as a dict of Python numbers (arrays as tuples)."""
-        return {name: _field_value(getattr(self, name)) for name, _ in self._fields_}
-
-
-class BakeOptions(ctypes.Structure):
-    """``hairis_bake_options``: resolution and content of a table bake."""
-
-    _fields_ = [
-        ("theta_r_count", c_int),
-        ("theta_i_count", c_int),
-        ("phi_count", c_int),
-        ("n_h_count", c_int),
-        ("n_h_values", c_int * 16),
-        ("source", c_int),
-        ("threads", c_int),
-    ]
-
-    def n_h_list(self):
-        """The n_h values in use, as a list."""
-        return list(self.n_h_values[:max(0, min(self.n_h_count, 16))])
-
-    def set_n_h_list(self, values):
-        """Sets ``n_h_values``/``n_h_count`` from an increasing sequence of at most 16 ints."""
-        values = [int(v) for v in values]
-        if len(values) > 16:
-            raise ValueError("at most 16 n_h values, got %d" % len(values))
-        self.n_h_count = len(values)
-        for i in range(16):
-            self.n_h_values[i] = values[i] if i < len(values) else 0
-
-
-class Camera(ctypes.Structure):
-    """``hairis_camera``: a camera as Blender describes it (row-major camera-to-world)."""
-
-    _fields_ = [
-        ("camera_to_world", c_float * 16),
-        ("orthographic", c_int),
-        ("frame", c_float * 12),
-        ("width", c_int),
-        ("height", c_int),
-    ]
-
-
-class RenderSettings(ctypes.Structure):
-    """``hairis_render_settings``: the add-on's ``scene.hairis``."""
-
-    _fields_ = [
-        ("samples", c_int),
-        ("max_bounces", c_int),
-        ("strategy", c_int),
-        ("multiple_weight", c_float),
-        ("n_h", c_int),
-        ("seed", c_uint64),
-        ("threads", c_int),
-    ]
-
-
-class RenderStats(ctypes.Structure):
-    """``hairis_render_stats``: what a render did."""
-
-    _fields_ = [
-        ("seconds", c_double),
-        ("camera_rays", c_uint64),
-        ("dropped_samples", c_uint64),
-        ("peak_memory_bytes", c_uint64),
-    ]
-
-
-STRUCTS = {
-    "hairis_principled_hair": PrincipledHair,
-    "hairis_marschner_params": MarschnerParams,
-    "hairis_bake_options": BakeOptions,
-    "hairis_camera": Camera,
-    "hairis_render_settings": RenderSettings,
-    "hairis_render_stats": RenderStats,
-}
-"""The C struct names and their ctypes mirrors."""
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+"""Blender's area light shapes; the C API spells them in lower case."""
 
 PROGRESS_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_float)
 """``hairis_progress_fn``: ``int (*)(void *user, float progress)``; non-zero cancels."""
@@ -212,55 +59,103 @@ PROGRESS_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_float)
 _F = POINTER(c_float)
 _VOID = None
 
-# name: (restype, argtypes). Keep in the header's order.
-SIGNATURES = {
-    # Library
+PROTOTYPES = {
+    # hairis.h: library
     "hairis_api_version": (c_int, []),
     "hairis_version_string": (c_char_p, []),
     "hairis_last_error": (c_char_p, []),
-    # Fibers
-    "hairis_principled_hair_defaults": (_VOID, [POINTER(PrincipledHair)]),
-    "hairis_marschner_defaults": (_VOID, [POINTER(MarschnerParams)]),
-    "hairis_fiber_create_principled": (c_void_p, [POINTER(PrincipledHair)]),
-    "hairis_fiber_create_marschner": (c_void_p, [POINTER(MarschnerParams)]),
+    "hairis_defaults": (c_char_p, [c_char_p]),
+    # fibers
+    "hairis_fiber_create": (c_void_p, [c_char_p]),
     "hairis_fiber_destroy": (_VOID, [c_void_p]),
     "hairis_fiber_model": (c_char_p, [c_void_p]),
     "hairis_fiber_parameters": (c_char_p, [c_void_p]),
     "hairis_fiber_eval": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F]),
-    # Tables
-    "hairis_bake_options_defaults": (_VOID, [POINTER(BakeOptions)]),
-    "hairis_tables_bake": (c_void_p, [c_void_p, POINTER(BakeOptions), PROGRESS_FN, c_void_p]),
+    # tables
+    "hairis_tables_bake": (c_void_p, [c_void_p, c_char_p, PROGRESS_FN, c_void_p]),
     "hairis_tables_write": (c_int, [c_void_p, c_char_p]),
     "hairis_tables_load_file": (c_void_p, [c_char_p]),
     "hairis_tables_load_memory": (c_void_p, [c_void_p, c_size_t]),
     "hairis_tables_destroy": (_VOID, [c_void_p]),
     "hairis_tables_model": (c_char_p, [c_void_p]),
     "hairis_tables_parameters": (c_char_p, [c_void_p]),
+    "hairis_tables_info": (c_char_p, [c_void_p]),
     "hairis_tables_match_fiber": (c_int, [c_void_p, c_void_p]),
-    # Sampling
-    "hairis_sampler_create": (c_void_p, [c_int, c_void_p, c_void_p, c_float, c_int]),
+    # sampling
+    "hairis_sampler_create": (c_void_p, [c_void_p, c_void_p, c_char_p]),
     "hairis_sampler_destroy": (_VOID, [c_void_p]),
     "hairis_sample": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F, _F]),
     "hairis_pdf": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F]),
-    # Scenes and rendering
+    # hairis_render.h
     "hairis_scene_create": (c_void_p, []),
     "hairis_scene_destroy": (_VOID, [c_void_p]),
-    "hairis_scene_add_hair_material": (c_int, [c_void_p, POINTER(PrincipledHair), c_void_p]),
-    "hairis_scene_add_diffuse_material": (c_int, [c_void_p, _F, _F]),
+    "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
+    "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32), c_size_t,
                                         _F, _F]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, _F, c_size_t, POINTER(c_uint32),
                                       POINTER(c_int32)]),
-    "hairis_scene_add_sun": (c_int, [c_void_p, _F, _F, c_float, c_float]),
-    "hairis_scene_add_point_light": (c_int, [c_void_p, _F, _F, c_float, c_float]),
-    "hairis_scene_add_area_light": (c_int, [c_void_p, _F, c_int, c_float, c_float, _F, c_float]),
-    "hairis_scene_set_world": (c_int, [c_void_p, _F, c_float]),
-    "hairis_scene_set_camera": (c_int, [c_void_p, POINTER(Camera)]),
-    "hairis_render_settings_defaults": (_VOID, [POINTER(RenderSettings)]),
-    "hairis_render": (c_int, [c_void_p, POINTER(RenderSettings), _F, PROGRESS_FN, c_void_p,
-                              POINTER(RenderStats)]),
+    "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
+    "hairis_render": (c_int, [c_void_p, c_char_p, _F, PROGRESS_FN, c_void_p]),
+    "hairis_last_render_stats": (c_char_p, []),
 }
-"""Every function of hairis.h: name → (restype, argtypes)."""
+"""Every function of the headers: name → (restype, argtypes)."""
+
+
+# ---- Option strings --------------------------------------------------------------------------
+
+def _value_text(value):
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        if not math.isfinite(value):
+            return repr(value)  # refused by the library, naming the option
+        return "%.9g" % value
+    if isinstance(value, str):
+        return value
+    return ",".join(_value_text(v) for v in np.asarray(value, dtype=np.float64).reshape(-1))
+
+
+def options(values):
+    """An option string "name=value;..." from a dict (numbers to 9 significant digits,
+    sequences comma-separated, booleans 0/1); a string is passed through."""
+    if values is None:
+        return ""
+    if isinstance(values, str):
+        return values
+    return ";".join("%s=%s" % (name, _value_text(value)) for name, value in values.items())
+
+
+def parse_options(text):
+    """A dict of strings from an option string."""
+    result = {}
+    for item in (text or "").split(";"):
+        if "=" in item:
+            name, value = item.split("=", 1)
+            result[name.strip()] = value.strip()
+    return result
+
+
+def principled_options(params):
+    """Fiber options of a Principled Hair node from a dict of ``export.HairParameters``'
+    fields (parametrization as an index into PARAMETRIZATIONS or a name, angles in radians)."""
+    values = dict(params)
+    out = {"model": "chiang"}
+    if "cycles" in values:
+        out["cycles"] = values.pop("cycles")
+    parametrization = values.pop("parametrization", "COLOR")
+    if not isinstance(parametrization, str):
+        parametrization = PARAMETRIZATIONS[int(parametrization)]
+    out["parametrization"] = parametrization.lower()
+    if "absorption_coefficient" in values:
+        values["absorption"] = values.pop("absorption_coefficient")
+    out.update(values)
+    return out
 
 
 # ---- Errors ----------------------------------------------------------------------------------
@@ -305,24 +200,6 @@ class LibraryUnavailable(HairisError):
 
 # ---- Helpers ---------------------------------------------------------------------------------
 
-def _field_value(value):
-    if isinstance(value, ctypes.Array):
-        return tuple(value)
-    return value
-
-
-def _set_field(struct, name, value):
-    current = getattr(struct, name)
-    if isinstance(current, ctypes.Array):
-        values = list(value)
-        if len(values) != len(current):
-            raise ValueError("field %s needs %d values, got %d" % (name, len(current), len(values)))
-        for i, v in enumerate(values):
-            current[i] = v
-    else:
-        setattr(struct, name, value)
-
-
 def _decode(value):
     if value is None:
         return ""
@@ -345,13 +222,6 @@ def _ptr(array, ctype):
     if array is None:
         return None
     return array.ctypes.data_as(POINTER(ctype))
-
-
-def _vec3(values, what):
-    array = np.ascontiguousarray(values, dtype=np.float32).reshape(-1)
-    if array.size != 3:
-        raise ValueError("%s needs 3 values, got %d" % (what, array.size))
-    return array
 
 
 def default_library_path():
@@ -420,7 +290,7 @@ class Library:
         except OSError as error:
             raise LibraryUnavailable(path, str(error)) from None
         missing = []
-        for name, (restype, argtypes) in SIGNATURES.items():
+        for name, (restype, argtypes) in PROTOTYPES.items():
             try:
                 function = getattr(self.raw, name)
             except AttributeError:
@@ -466,50 +336,39 @@ class Library:
 
     # -- defaults --
 
-    def principled_hair_defaults(self):
-        """The Principled Hair BSDF node's Blender 3.4 defaults."""
-        node = PrincipledHair()
-        self.raw.hairis_principled_hair_defaults(ctypes.byref(node))
-        return node
-
-    def marschner_defaults(self):
-        """The seed's Marschner defaults."""
-        params = MarschnerParams()
-        self.raw.hairis_marschner_defaults(ctypes.byref(params))
-        return params
-
-    def bake_options_defaults(self):
-        """The default table resolution."""
-        options = BakeOptions()
-        self.raw.hairis_bake_options_defaults(ctypes.byref(options))
-        return options
+    def defaults(self, kind):
+        """Every option of ``kind`` ("chiang", "bake", "render", "sun", ...) with its default,
+        as a dict of strings."""
+        text = self.raw.hairis_defaults(kind.encode())
+        if text is None:
+            raise self._error("hairis_defaults")
+        return parse_options(_decode(text))
 
     def render_settings_defaults(self):
-        """The default render settings."""
-        settings = RenderSettings()
-        self.raw.hairis_render_settings_defaults(ctypes.byref(settings))
-        return settings
+        """The default render settings (a dict of strings)."""
+        return self.defaults("render")
+
+    def bake_options_defaults(self):
+        """The default bake options (a dict of strings)."""
+        return self.defaults("bake")
 
     # -- objects --
 
-    def fiber_principled(self, node):
-        """A Chiang 2016 fiber from a :class:`PrincipledHair` (or a dict of its fields)."""
-        if not isinstance(node, PrincipledHair):
-            node = self.principled_hair_defaults().update(node)
-        pointer = self.raw.hairis_fiber_create_principled(ctypes.byref(node))
-        return Fiber(self, self._handle("hairis_fiber_create_principled", pointer))
+    def fiber(self, values):
+        """A fiber from fiber options (a dict or an option string; hairis.h)."""
+        pointer = self.raw.hairis_fiber_create(options(values).encode())
+        return Fiber(self, self._handle("hairis_fiber_create", pointer))
 
-    def fiber_marschner(self, params):
-        """A Marschner 2003 fiber from :class:`MarschnerParams`."""
-        pointer = self.raw.hairis_fiber_create_marschner(ctypes.byref(params))
-        return Fiber(self, self._handle("hairis_fiber_create_marschner", pointer))
+    def fiber_principled(self, params):
+        """A Chiang fiber from a Principled Hair node's values (see :func:`principled_options`)."""
+        return self.fiber(principled_options(params))
 
-    def bake_tables(self, fiber, options=None, progress=None):
-        """Bakes tables for ``fiber``; ``progress(p) -> bool`` may cancel (HairisCancelled)."""
-        if options is None:
-            options = self.bake_options_defaults()
+    def bake_tables(self, fiber, values=None, progress=None):
+        """Bakes tables for ``fiber`` with bake options (dict or string); ``progress(p) -> bool``
+        may cancel (HairisCancelled)."""
         adapter = _Progress(progress)
-        pointer = self.raw.hairis_tables_bake(fiber, ctypes.byref(options), adapter.function, None)
+        text = options(values).encode()
+        pointer = self.raw.hairis_tables_bake(fiber, text, adapter.function, None)
         if pointer:
             # A callback error after the last progress call must not be lost.
             if adapter.error is not None:
@@ -531,11 +390,10 @@ class Library:
         return Tables(self, self._handle("hairis_tables_load_memory", pointer))
 
     def sampler(self, strategy, fiber=None, tables=None, multiple_weight=0.0, n_h=2):
-        """A direction sampler; ``strategy`` is a name ('TABLE', ...) or a hairis_strategy."""
-        if isinstance(strategy, str):
-            strategy = STRATEGIES[strategy]
-        pointer = self.raw.hairis_sampler_create(int(strategy), fiber, tables,
-                                                 float(multiple_weight), int(n_h))
+        """A direction sampler; ``strategy`` is one of STRATEGIES."""
+        text = options({"strategy": str(strategy).lower(),
+                        "multiple_weight": float(multiple_weight), "n_h": int(n_h)})
+        pointer = self.raw.hairis_sampler_create(fiber, tables, text.encode())
         return Sampler(self, self._handle("hairis_sampler_create", pointer), fiber, tables)
 
     def scene(self):
@@ -632,6 +490,17 @@ class Tables(_Handle):
         """The fiber parameters the tables were baked for."""
         return _decode(self._library.raw.hairis_tables_parameters(self))
 
+    @property
+    def info(self):
+        """What the tables hold: source, theta_r, theta_i, phi, n_h (strings)."""
+        return parse_options(_decode(self._library.raw.hairis_tables_info(self)))
+
+    @property
+    def n_h_values(self):
+        """The strand counts of the multiple-scattering tables."""
+        text = self.info.get("n_h", "")
+        return [int(v) for v in text.split(",") if v]
+
     def matches(self, fiber):
         """True when the tables were baked for exactly this fiber's parameters."""
         return self._library.raw.hairis_tables_match_fiber(self, fiber) == 1
@@ -699,11 +568,17 @@ class Scene(_Handle):
         self.width = None
         self.height = None
 
-    def add_hair_material(self, node, tables=None):
-        """Adds a hair material from a :class:`PrincipledHair` (or a dict); returns its index."""
-        if not isinstance(node, PrincipledHair):
-            node = self._library.principled_hair_defaults().update(node)
-        index = self._library.raw.hairis_scene_add_hair_material(self, ctypes.byref(node), tables)
+    def add_hair_material(self, fiber, tables=None):
+        """Adds a hair material of ``fiber`` (a :class:`Fiber`, or Principled Hair values for
+        :meth:`Library.fiber_principled`) with its ``tables``; returns its index."""
+        owned = None
+        if not isinstance(fiber, Fiber):
+            fiber = owned = self._library.fiber_principled(fiber)
+        try:
+            index = self._library.raw.hairis_scene_add_hair_material(self, fiber, tables)
+        finally:
+            if owned is not None:
+                owned.close()
         if index < 0:
             raise self._library._error("hairis_scene_add_hair_material")
         if tables is not None:
@@ -712,12 +587,10 @@ class Scene(_Handle):
 
     def add_diffuse_material(self, albedo, emission=(0.0, 0.0, 0.0)):
         """Adds a Lambert material with an emission; returns its index."""
-        albedo = _vec3(albedo, "albedo")
-        emission = _vec3(emission, "emission")
-        index = self._library.raw.hairis_scene_add_diffuse_material(
-            self, _ptr(albedo, c_float), _ptr(emission, c_float))
+        text = options({"type": "diffuse", "color": albedo, "emission": emission})
+        index = self._library.raw.hairis_scene_add_surface_material(self, text.encode())
         if index < 0:
-            raise self._library._error("hairis_scene_add_diffuse_material")
+            raise self._library._error("hairis_scene_add_surface_material")
         return index
 
     def add_curves(self, material, first, positions, radii):
@@ -747,51 +620,44 @@ class Scene(_Handle):
             _ptr(indices, c_uint32), _ptr(materials, c_int32))
         self._library._status("hairis_scene_add_mesh", status)
 
+    def add_light(self, values):
+        """Adds a light from light options (hairis_render.h: type sun, point or area)."""
+        status = self._library.raw.hairis_scene_add_light(self, options(values).encode())
+        self._library._status("hairis_scene_add_light", status)
+
     def add_sun(self, direction, color, strength, angle):
         """A sun; ``direction`` points from the scene towards the sun."""
-        direction = _vec3(direction, "direction")
-        color = _vec3(color, "color")
-        status = self._library.raw.hairis_scene_add_sun(
-            self, _ptr(direction, c_float), _ptr(color, c_float), float(strength), float(angle))
-        self._library._status("hairis_scene_add_sun", status)
+        self.add_light({"type": "sun", "direction": direction, "color": color,
+                        "strength": float(strength), "angle": float(angle)})
 
     def add_point_light(self, position, color, power, radius):
         """A point light of ``power`` W and ``radius`` m."""
-        position = _vec3(position, "position")
-        color = _vec3(color, "color")
-        status = self._library.raw.hairis_scene_add_point_light(
-            self, _ptr(position, c_float), _ptr(color, c_float), float(power), float(radius))
-        self._library._status("hairis_scene_add_point_light", status)
+        self.add_light({"type": "point", "position": position, "color": color,
+                        "power": float(power), "radius": float(radius)})
 
     def add_area_light(self, light_to_world, shape, size_x, size_y, color, power):
-        """An area light: row-major 4×4 object matrix, shape (name or enum), sizes, power."""
-        matrix = np.ascontiguousarray(light_to_world, dtype=np.float32).reshape(-1)
-        if matrix.size != 16:
-            raise ValueError("light_to_world needs 16 values, got %d" % matrix.size)
-        if isinstance(shape, str):
-            shape = AREA_SHAPES[shape]
-        color = _vec3(color, "color")
-        status = self._library.raw.hairis_scene_add_area_light(
-            self, _ptr(matrix, c_float), int(shape), float(size_x), float(size_y),
-            _ptr(color, c_float), float(power))
-        self._library._status("hairis_scene_add_area_light", status)
+        """An area light: row-major 4×4 object matrix, shape (one of AREA_SHAPES), sizes, power."""
+        self.add_light({"type": "area", "matrix": light_to_world, "shape": str(shape).lower(),
+                        "size": float(size_x), "size_y": float(size_y), "color": color,
+                        "power": float(power)})
 
     def set_world(self, color, strength):
         """A constant background radiance colour·strength."""
-        color = _vec3(color, "color")
-        status = self._library.raw.hairis_scene_set_world(self, _ptr(color, c_float),
-                                                          float(strength))
+        text = options({"color": color, "strength": float(strength)})
+        status = self._library.raw.hairis_scene_set_world(self, text.encode())
         self._library._status("hairis_scene_set_world", status)
 
     def set_camera(self, camera):
-        """Sets the :class:`Camera` (which also fixes the output resolution)."""
-        status = self._library.raw.hairis_scene_set_camera(self, ctypes.byref(camera))
+        """Sets the camera from camera options (a dict: matrix, orthographic, frame, width,
+        height, clip_start, clip_end), which also fix the output resolution."""
+        status = self._library.raw.hairis_scene_set_camera(self, options(camera).encode())
         self._library._status("hairis_scene_set_camera", status)
-        self.width = int(camera.width)
-        self.height = int(camera.height)
+        self.width = int(camera["width"])
+        self.height = int(camera["height"])
 
     def render(self, settings, progress=None, out=None):
-        """Renders; returns (rgba (height, width, 4) bottom row first, :class:`RenderStats`).
+        """Renders with render settings (dict or string); returns (rgba (height, width, 4)
+        bottom row first, the stats as a dict of strings: seconds, camera_rays, ...).
 
         ``progress(p) -> bool`` is called with p in [0, 1]; returning True cancels, which
         raises :class:`HairisCancelled` whose ``rgba`` attribute holds the partial image.
@@ -804,10 +670,10 @@ class Scene(_Handle):
               or not out.flags.c_contiguous):
             raise ValueError("out must be a C-contiguous float32 (%d, %d, 4) array"
                              % (self.height, self.width))
-        stats = RenderStats()
         adapter = _Progress(progress)
-        status = self._library.raw.hairis_render(self, ctypes.byref(settings), _ptr(out, c_float),
-                                                 adapter.function, None, ctypes.byref(stats))
+        status = self._library.raw.hairis_render(self, options(settings).encode(),
+                                                 _ptr(out, c_float), adapter.function, None)
+        stats = parse_options(_decode(self._library.raw.hairis_last_render_stats()))
         if status != OK or adapter.error is not None:
             error = self._library._error("hairis_render", status if status != OK else None,
                                          adapter)

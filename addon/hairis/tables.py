@@ -40,8 +40,9 @@ class TableStatus:
 
 
 def principled_struct(library, params):
-    """A ``native.PrincipledHair`` from :class:`export.HairParameters`."""
-    return library.principled_hair_defaults().update(params.as_dict())
+    """The Principled Hair values of :class:`export.HairParameters` for
+    ``Library.fiber_principled`` (kept as a function for the callers that pass it around)."""
+    return params.as_dict()
 
 
 def material_parameters(material):
@@ -66,12 +67,11 @@ def hair_materials(materials=None):
 def bake_options(library, n_h=None, threads=0):
     """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``."""
     options = library.bake_options_defaults()
-    values = set(options.n_h_list()) | set(N_H_CHOICES)
+    values = {int(v) for v in options["n_h"].split(",")} | set(N_H_CHOICES)
     if n_h is not None:
         values.add(int(n_h))
-    values = sorted(v for v in values if v > 0)[:16]
-    options.set_n_h_list(values)
-    options.threads = int(threads)
+    options["n_h"] = ",".join(str(v) for v in sorted(v for v in values if v > 0)[:16])
+    options["threads"] = int(threads)
     return options
 
 
