@@ -18,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
-export = sys.modules["hairis.export"]
+export = helpers.module("export")
 
 # Node input name → hairis_principled_hair field, written out here on purpose (not imported).
 HAIR_FIELDS = {

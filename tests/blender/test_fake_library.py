@@ -25,10 +25,10 @@ if not ARGS.fake_library or not os.path.isfile(ARGS.fake_library):
     helpers.skip("the fake library was not built (no C compiler?)")
 helpers.use_library(ARGS.fake_library)
 os.environ.pop("HAIRIS_FAKE_NOISE", None)  # exact images here
-native = sys.modules["hairis.native"]
-engine = sys.modules["hairis.engine"]
-tables = sys.modules["hairis.tables"]
-export = sys.modules["hairis.export"]
+native = helpers.module("native")
+engine = helpers.module("engine")
+tables = helpers.module("tables")
+export = helpers.module("export")
 HEADER = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "lib",
                       "include", "hairis", "hairis.h")
 SUMMARY = os.path.join(ARGS.workdir, "summary.txt")
