@@ -10,10 +10,13 @@ what the running Blender has, never from socket indices), so the other modules r
   lists each input's names, newest first, and :func:`find_input` takes the first one present;
 - ``use_nodes`` of materials and worlds is deprecated from 5.0 (always on; reading it warns):
   :func:`uses_nodes`;
-- the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang).
+- the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang);
+- a render pass's ``rect.foreach_set``: (pixels, 4) rows in 3.4, a flat float buffer in 4.5+:
+  :func:`set_pass_pixels`.
 """
 
 import bpy
+import numpy as np
 
 MINIMUM_VERSION = (3, 4, 0)
 """The oldest Blender Hairis supports (bl_info's "blender")."""
@@ -89,3 +92,12 @@ def find_input(node, names):
 def hair_model(node):
     """The Principled Hair BSDF's model: 'CHIANG' before 4.0, else the node's ``model``."""
     return getattr(node, "model", "CHIANG")
+
+
+def set_pass_pixels(render_pass, rgba):
+    """Writes (height, width, 4) float pixels into a RenderPass (whichever layout it takes)."""
+    pixels = np.ascontiguousarray(rgba, np.float32)
+    try:
+        render_pass.rect.foreach_set(pixels.reshape(-1))
+    except (TypeError, ValueError):
+        render_pass.rect.foreach_set(pixels.reshape(-1, 4))

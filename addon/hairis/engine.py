@@ -148,8 +148,7 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                            % (type(error).__name__, error))
             if pixels is not None:
                 try:
-                    rect = result.layers[0].passes["Combined"].rect
-                    rect.foreach_set(np.ascontiguousarray(pixels, np.float32).reshape(-1, 4))
+                    compat.set_pass_pixels(result.layers[0].passes["Combined"], pixels)
                 except Exception as error:  # noqa: BLE001
                     self._fail("Hairis could not write the render result: %s" % error)
         finally:

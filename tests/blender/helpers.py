@@ -187,12 +187,24 @@ def make_bsdf_material(name, node_type):
     return material, bsdf
 
 
+def socket(node, name):
+    """The input called ``name`` (by name or identifier), available or not.
+
+    From Blender 4.0 ``node.inputs[name]`` skips sockets the node's settings hide (a hair
+    node's Color under the Melanin parametrization).
+    """
+    for candidate in node.inputs:
+        if candidate.name == name or candidate.identifier == name:
+            return candidate
+    raise KeyError("%s has no input %r in Blender %s" % (node.name, name, bpy.app.version_string))
+
+
 def make_hair_material(name, parametrization="MELANIN", **inputs):
     """A material whose output is fed by a Principled Hair BSDF with the given inputs."""
     material, hair = make_bsdf_material(name, "ShaderNodeBsdfHairPrincipled")
     hair.parametrization = parametrization
     for key, value in inputs.items():
-        hair.inputs[key].default_value = value
+        socket(hair, key).default_value = value
     return material
 
 
@@ -201,7 +213,7 @@ def make_surface_material(name, color=(0.6, 0.4, 0.3, 1.0)):
     material = bpy.data.materials.new(name)
     use_nodes(material)
     node = material.node_tree.nodes["Principled BSDF"]
-    node.inputs["Base Color"].default_value = color
+    socket(node, "Base Color").default_value = color
     return material
 
 
@@ -225,8 +237,8 @@ def make_world(scene, color=(0.05, 0.1, 0.2), strength=1.5):
     world = bpy.data.worlds.new("World")
     use_nodes(world)
     background = world.node_tree.nodes["Background"]
-    background.inputs["Color"].default_value = tuple(color) + (1.0,)
-    background.inputs["Strength"].default_value = strength
+    socket(background, "Color").default_value = tuple(color) + (1.0,)
+    socket(background, "Strength").default_value = strength
     scene.world = world
     return world
 
@@ -268,7 +280,8 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     settings.material = 2
     if children:
         settings.child_type = "INTERPOLATED"
-        settings.child_nbr = 1
+        # Display amount of children per parent: child_nbr, child_percent from 4.0.
+        setattr(settings, "child_percent" if VERSION >= (4, 0, 0) else "child_nbr", 1)
         settings.rendered_child_count = children
     else:
         settings.child_type = "NONE"
@@ -349,7 +362,7 @@ def make_test_scene(children=None, with_curves=True):
 def make_diffuse_material(name, color):
     """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
     material, diffuse = make_bsdf_material(name, "ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = color
+    socket(diffuse, "Color").default_value = color
     return material
 
 
