@@ -236,7 +236,8 @@ def test_unsupported_things_warn():
     hair = bpy.data.materials["Hair"]
     tree = hair.node_tree
     info = tree.nodes.new("ShaderNodeHairInfo")
-    tree.links.new(info.outputs["Random"], helpers.socket(tree.nodes["Principled Hair BSDF"], "Random"))
+    tree.links.new(info.outputs["Random"],
+                   helpers.socket(tree.nodes["Principled Hair BSDF"], "Random"))
     world_tree = scene.world.node_tree
     environment = world_tree.nodes.new("ShaderNodeTexEnvironment")
     world_tree.links.new(environment.outputs["Color"],
@@ -285,9 +286,9 @@ def test_hair_node_models_and_missing_sockets():
     # A socket whose display name changed but whose identifier did not.
     params, _warnings, error = export.read_hair_node(
         stub_hair_node(rename={"Coat": "Coating"}), "Renamed")
+    compat = helpers.module("compat")
     assert error == "material 'Renamed': the Principled Hair BSDF has no 'Coat' input in " \
-        "Blender %s; Hairis supports %s" % (helpers.module("compat").version_string(),
-                                          helpers.module("compat").SUPPORTED_TEXT), error
+        "Blender %s; Hairis supports %s" % (compat.version_string(), compat.SUPPORTED_TEXT), error
     node = stub_hair_node()
     node.inputs[7].name = "Coating"  # Coat: the identifier stays "Coat"
     params, _warnings, error = export.read_hair_node(node, "Identifier")
