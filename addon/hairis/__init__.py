@@ -5,9 +5,14 @@ through the hairis C library (``lib/libhairis.so`` inside this package, or the f
 the ``HAIRIS_LIBRARY`` environment variable). The add-on registers without the library; the
 preferences and every render then say why it could not be loaded.
 
-Modules: ``native`` (ctypes binding), ``properties`` (``scene.hairis``, ``material.hairis``),
-``export`` (depsgraph → numpy), ``tables`` (sampling tables), ``engine`` (the render engine),
-``operators`` (``hairis.bake_tables``), ``ui`` (panels), ``preferences``.
+It installs as a legacy add-on (``bl_info``, Blender 3.4+) and as an Extension
+(``blender_manifest.toml``, Blender 4.2+, where the package is ``bl_ext.<repository>.hairis``):
+every import is relative and no module assumes the package's name.
+
+Modules: ``compat`` (what differs between Blender versions), ``native`` (ctypes binding),
+``properties`` (``scene.hairis``, ``material.hairis``), ``export`` (depsgraph → numpy),
+``tables`` (sampling tables), ``engine`` (the render engine), ``operators``
+(``hairis.bake_tables``), ``ui`` (panels), ``preferences``.
 """
 
 bl_info = {

@@ -14,7 +14,7 @@ import traceback
 import bpy
 import numpy as np
 
-from . import export, native, tables
+from . import compat, export, native, tables
 
 DUMP_ENV = "HAIRIS_EXPORT_DUMP"
 """When set, each render writes its exported scene to this ``.npz`` path (debugging, tests)."""
@@ -116,6 +116,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
     bl_use_shading_nodes_custom = False
     bl_use_eevee_viewport = True
 
+    def __init__(self, *args, **kwargs):
+        # Blender 4.x+ passes arguments to RenderEngine subclasses; they must reach the base.
+        super().__init__(*args, **kwargs)
+
     def render(self, depsgraph):
         """Renders one view layer of ``depsgraph`` into the Combined pass."""
         width, height = self.resolution_x, self.resolution_y
@@ -136,8 +140,7 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                            % (type(error).__name__, error))
             if pixels is not None:
                 try:
-                    rect = result.layers[0].passes["Combined"].rect
-                    rect.foreach_set(np.ascontiguousarray(pixels, np.float32).reshape(-1, 4))
+                    compat.set_pass_pixels(result.layers[0].passes["Combined"], pixels)
                 except Exception as error:  # noqa: BLE001
                     self._fail("Hairis could not write the render result: %s" % error)
         finally:
@@ -152,6 +155,9 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         self.update_stats("", "Error: " + message)
 
     def _render(self, depsgraph, width, height):
+        problem = compat.version_problem()
+        if problem:
+            raise RenderFailed(problem)
         scene = depsgraph.scene
         settings = scene.hairis
         if scene.render.use_border:

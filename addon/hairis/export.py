@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
+from . import compat
+
 DEFAULT_CURVES_RADIUS = 0.005
 """Cycles' radius for Curves without a ``radius`` attribute."""
 
@@ -304,18 +306,12 @@ def output_node(node_tree):
 
 def _input(node, name):
     """The node input called ``name`` (by name or identifier), preferring enabled sockets."""
-    found = None
-    for socket in node.inputs:
-        if socket.name == name or socket.identifier == name:
-            if getattr(socket, "enabled", True):
-                return socket
-            found = found or socket
-    return found
+    return compat.find_input(node, (name,))
 
 
 def surface_node(material):
     """The shader node connected to the active material output's Surface, or None."""
-    if material is None or not material.use_nodes or material.node_tree is None:
+    if material is None or not compat.uses_nodes(material):
         return None
     output = output_node(material.node_tree)
     if output is None:
@@ -359,10 +355,14 @@ def read_hair_node(node, material_name="?"):
     4.x's ``model`` setting) is an error for this material.
     """
     warnings = []
-    model = getattr(node, "model", "CHIANG")
+    model = compat.hair_model(node)
+    if model == "HUANG":
+        return None, warnings, ("material %r: its Principled Hair BSDF uses the Huang model, which "
+                                "Hairis cannot render yet (Huang support is coming); set the "
+                                "node's model to Chiang to render it with Hairis" % material_name)
     if model != "CHIANG":
         return None, warnings, ("material %r: the Principled Hair BSDF model %r is not supported "
-                                "(hairis implements the Chiang model)" % (material_name, model))
+                                "(Hairis implements the Chiang model)" % (material_name, model))
     parametrization = getattr(node, "parametrization", None)
     if parametrization not in PARAMETRIZATIONS:
         return None, warnings, ("material %r: unknown Principled Hair parametrization %r"
@@ -371,8 +371,10 @@ def read_hair_node(node, material_name="?"):
     for field_name, input_name, components in HAIR_INPUTS:
         socket = _input(node, input_name)
         if socket is None:
-            return None, warnings, ("material %r: the Principled Hair BSDF has no %r input "
-                                    "(unsupported Blender version?)" % (material_name, input_name))
+            return None, warnings, ("material %r: the Principled Hair BSDF has no %r input in "
+                                    "Blender %s; Hairis supports %s"
+                                    % (material_name, input_name, compat.version_string(),
+                                       compat.SUPPORTED_TEXT))
         if socket.is_linked:
             warnings.append("material %r: input %r of the Principled Hair BSDF is linked; hairis "
                             "uses its unlinked value" % (material_name, input_name))
@@ -396,32 +398,40 @@ def read_surface_material(material):
     """A non-hair material as (albedo, emission, warnings): Principled/Diffuse/Emission."""
     warnings = []
     name = material.name
-    if not material.use_nodes or material.node_tree is None:
+    if not compat.uses_nodes(material):
         return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
     node = surface_node(material)
     if node is None:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), warnings  # Cycles: black surface
     kind = node.bl_idname
 
-    def value(socket_name, components=3, default=None):
-        socket = _input(node, socket_name)
+    def value(key, components=3, default=None):
+        names = compat.SURFACE_INPUTS[key]
+        socket = compat.find_input(node, names)
         if socket is None:
+            warnings.append("material %r: %s has no %s input in Blender %s; hairis uses %r"
+                            % (name, node.name, " or ".join(repr(n) for n in names),
+                               compat.version_string(), default))
             return default
         if socket.is_linked:
             warnings.append("material %r: input %r of %s is linked (textures are not supported); "
-                            "hairis uses its unlinked value" % (name, socket_name, node.name))
-        return _socket_value(socket, components)
+                            "hairis uses its unlinked value" % (name, socket.name, node.name))
+        try:
+            return _socket_value(socket, components)
+        except (TypeError, ValueError) as error:
+            warnings.append("material %r: %s; hairis uses %r" % (name, error, default))
+            return default
 
     if kind == "ShaderNodeBsdfPrincipled":
-        albedo = value("Base Color", 3, DEFAULT_ALBEDO)
-        emission = value("Emission", 3, (0.0, 0.0, 0.0))
-        strength = value("Emission Strength", 1, 1.0)
+        albedo = value("base_color", 3, DEFAULT_ALBEDO)
+        emission = value("emission_color", 3, (0.0, 0.0, 0.0))
+        strength = value("emission_strength", 1, 1.0)
         return albedo, tuple(e * strength for e in emission), warnings
     if kind == "ShaderNodeBsdfDiffuse":
-        return value("Color", 3, DEFAULT_ALBEDO), (0.0, 0.0, 0.0), warnings
+        return value("color", 3, DEFAULT_ALBEDO), (0.0, 0.0, 0.0), warnings
     if kind == "ShaderNodeEmission":
-        color = value("Color", 3, (1.0, 1.0, 1.0))
-        strength = value("Strength", 1, 1.0)
+        color = value("color", 3, (1.0, 1.0, 1.0))
+        strength = value("strength", 1, 1.0)
         return (0.0, 0.0, 0.0), tuple(c * strength for c in color), warnings
     warnings.append("material %r: %s is not supported on meshes; using its viewport colour as a "
                     "diffuse albedo" % (name, node.bl_label or kind))
@@ -526,7 +536,7 @@ class _Exporter:
                                        % obj.name)
                     else:
                         export_particle_hair(self, obj)
-            elif kind in {"VOLUME", "POINTCLOUD", "GPENCIL"}:
+            elif kind in {"VOLUME", "POINTCLOUD", "GPENCIL", "GREASEPENCIL"}:
                 self.data.warn("object %r: %s objects are not supported" % (obj.name, kind.lower()))
         return self.data
 
@@ -563,7 +573,7 @@ class _Exporter:
         world = self.scene.world
         if world is None:
             return
-        if not world.use_nodes or world.node_tree is None:
+        if not compat.uses_nodes(world):
             self.data.world_color = _rgb(world.color)
             self.data.world_strength = 1.0
             return
@@ -592,7 +602,7 @@ class _Exporter:
         """Sun, point and area lights; spot lights are reported and skipped."""
         light = obj.data
         color = _rgb(light.color)
-        if getattr(light, "use_nodes", False) and light.node_tree is not None:
+        if compat.uses_nodes(light):
             self.data.warn("light %r: light node trees are ignored" % obj.name)
         kind = light.type
         if kind == "SUN":

@@ -27,6 +27,9 @@ API_VERSION = 2
 LIBRARY_ENV = "HAIRIS_LIBRARY"
 """Environment variable naming the shared library to load instead of the bundled one."""
 
+DEEPBIND_ENV = "HAIRIS_DEEPBIND"
+"""Set to 0 to load the library without RTLD_DEEPBIND (see :func:`load_mode`)."""
+
 # Status codes.
 OK = 0
 ERROR_INVALID_ARGUMENT = 1
@@ -235,6 +238,33 @@ def default_library_path():
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib", name)
 
 
+def _sanitizer_loaded():
+    """True when an ASan/TSan runtime is in the process (they refuse RTLD_DEEPBIND)."""
+    try:
+        process = ctypes.CDLL(None)
+    except OSError:
+        return False
+    return any(hasattr(process, name) for name in ("__asan_init", "__tsan_init"))
+
+
+def load_mode():
+    """The dlopen flags for libhairis: RTLD_LOCAL, and RTLD_DEEPBIND on Linux.
+
+    Blender 4.x/5.x bundle their own Embree 4, OpenEXR and OpenImageIO; in the Blender
+    executable they are in the global symbol scope, which the dynamic linker searches before a
+    library's own dependencies, so Embree 3's same-named C functions (``rtc*``) that libhairis
+    calls would bind to Embree 4's. RTLD_DEEPBIND makes libhairis and the dependencies loaded
+    with it look in their own scope first. Not with a sanitizer runtime (which refuses it) or
+    with ``HAIRIS_DEEPBIND=0``.
+    """
+    mode = ctypes.DEFAULT_MODE
+    deepbind = getattr(os, "RTLD_DEEPBIND", 0)
+    if (deepbind and sys.platform.startswith("linux")
+            and os.environ.get(DEEPBIND_ENV, "1").strip() != "0" and not _sanitizer_loaded()):
+        mode |= deepbind
+    return mode
+
+
 def library_path():
     """The library to load: ``$HAIRIS_LIBRARY`` when set (and non-empty), else the bundled one."""
     override = os.environ.get(LIBRARY_ENV, "").strip()
@@ -285,8 +315,9 @@ class Library:
         self.path = path
         if not os.path.exists(path):
             raise LibraryUnavailable(path, "no such file")
+        self.mode = load_mode()
         try:
-            self.raw = ctypes.CDLL(path)
+            self.raw = ctypes.CDLL(path, mode=self.mode)
         except OSError as error:
             raise LibraryUnavailable(path, str(error)) from None
         missing = []

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import bpy
 from bpy.props import BoolProperty, StringProperty
 
-from . import native, tables
+from . import compat, native, tables
 
 
 @dataclass
@@ -111,6 +111,10 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         name="Force", description="Bake even when the tables are current", default=False)
 
     def _prepare(self, context):
+        problem = compat.version_problem()
+        if problem:
+            self.report({"ERROR"}, problem)
+            return None, None
         try:
             library = native.load_library()
         except native.LibraryUnavailable as error:

@@ -11,7 +11,7 @@ and users keep editing Cycles' nodes.
 
 import bpy
 
-from . import export, native, tables
+from . import compat, export, native, tables
 
 ENGINE = "HAIRIS"
 
@@ -48,8 +48,11 @@ def compatible_panels():
 
 def draw_node_input(layout, id_data, input_name):
     """Draws the node tree feeding ``input_name`` of the active output (as Cycles)."""
-    if not id_data.use_nodes:
-        layout.prop(id_data, "use_nodes", icon="NODETREE")
+    if not compat.uses_nodes(id_data):
+        if compat.running_version() < compat.NODES_ALWAYS_ON:
+            layout.prop(id_data, "use_nodes", icon="NODETREE")
+        else:
+            layout.label(text="No node tree")
         return False
     node_tree = id_data.node_tree
     output = export.output_node(node_tree)
@@ -69,8 +72,15 @@ def draw_node_input(layout, id_data, input_name):
 
 
 def draw_library_status(layout, status=None):
-    """One line on the native library: its version, or why it is unavailable."""
+    """One line on the native library: its version, or why it is unavailable (and a line on
+    an unsupported Blender version)."""
     status = status or native.library_status()
+    problem = compat.version_problem()
+    if problem:
+        column = layout.column(align=True)
+        column.alert = True
+        for number, line in enumerate(_wrap(problem, 70)):
+            column.label(text=line, icon="ERROR" if number == 0 else "BLANK1")
     if status.ok:
         layout.label(text=status.message, icon="CHECKMARK")
     else:
@@ -168,7 +178,7 @@ class HAIRIS_PT_context_material(HairisPanel, bpy.types.Panel):
     @classmethod
     def poll(cls, context):
         """Objects with materials, not grease pencil."""
-        if context.active_object and context.active_object.type == "GPENCIL":
+        if context.active_object and context.active_object.type in {"GPENCIL", "GREASEPENCIL"}:
             return False
         return (context.material or context.object) and engine_is_hairis(context)
 

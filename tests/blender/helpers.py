@@ -1,8 +1,13 @@
 """Shared code of the headless Blender tests (runs inside Blender's Python).
 
 Each test script calls :func:`setup` (parse the arguments run_test.py passes after ``--``,
-install the add-on zip into the temporary user scripts folder and enable it), builds scenes
-with the ``make_*`` helpers and runs its test functions with :func:`run`.
+install the add-on into the temporary user folders and enable it), builds scenes with the
+``make_*`` helpers and runs its test functions with :func:`run`, which ends with the result
+line run_test.py judges the test by.
+
+Runs in a Blender executable (``blender -b --python``) and in a bpy module's Python alike. The
+add-on is installed as a legacy add-on (package ``hairis``) or as an Extension (package
+``bl_ext.user_default.hairis``): tests reach its modules through :func:`module`.
 """
 
 import argparse
@@ -13,54 +18,110 @@ import time
 import traceback
 import types
 
-import addon_utils
-import bpy
+import bpy  # first: as a Python module, importing bpy puts addon_utils on sys.path
+import addon_utils  # noqa: I100
 import numpy as np
 from mathutils import Euler, Vector
 
 SKIP = 77
-MODULE = "hairis"
+RESULT_PREFIX = "hairis-test-result: "
+"""run_test.py judges a test by the last line starting with this (not only by exit codes)."""
+LEGACY_MODULE = "hairis"
+EXTENSION_REPOSITORY = "user_default"
+EXTENSION_MODULE = "bl_ext.%s.hairis" % EXTENSION_REPOSITORY
+MODULE = LEGACY_MODULE
+"""The installed add-on's package name (set by :func:`install_addon`)."""
+VERSION = tuple(bpy.app.version)
 
 
 def parse_args():
-    """The arguments after ``--``: zip, fake_library, workdir."""
+    """The arguments after ``--``: zip, install (legacy/extension), fake_library, workdir."""
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     parser = argparse.ArgumentParser()
     parser.add_argument("--zip", required=True)
+    parser.add_argument("--install", choices=("legacy", "extension"), default="legacy")
     parser.add_argument("--fake-library", default="")
     parser.add_argument("--workdir", required=True)
+    parser.add_argument("--expect-version", default="")
     return parser.parse_args(argv)
+
+
+def result(outcome):
+    """Prints the result line run_test.py reads (PASSED, FAILED or SKIPPED)."""
+    print(RESULT_PREFIX + outcome, flush=True)
 
 
 def skip(message):
     """Ends the test as skipped (exit code 77, CTest's SKIP_RETURN_CODE)."""
     print("SKIP: " + message, flush=True)
-    sys.stdout.flush()
+    result("SKIPPED")
     sys.exit(SKIP)
 
 
-def install_addon(zip_path):
-    """Installs the zip into BLENDER_USER_SCRIPTS and enables it; returns the package."""
+def install_legacy(zip_path):
+    """Installs the bl_info zip into BLENDER_USER_SCRIPTS/addons and enables it."""
     user_scripts = os.environ.get("BLENDER_USER_SCRIPTS")
     assert user_scripts, "BLENDER_USER_SCRIPTS must point to a temporary folder"
+    done = bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    assert done == {"FINISHED"}, done
+    done = bpy.ops.preferences.addon_enable(module=LEGACY_MODULE)
+    assert done == {"FINISHED"}, done
+    return LEGACY_MODULE, os.path.join(user_scripts, "addons", LEGACY_MODULE)
+
+
+def install_extension(zip_path):
+    """Installs the Extension zip into the user_default repository and enables it (4.2+)."""
+    if VERSION < (4, 2, 0):
+        skip("Extensions need Blender 4.2 or newer (this is %s)" % bpy.app.version_string)
+    repositories = {repo.module: repo for repo in bpy.context.preferences.extensions.repos}
+    assert EXTENSION_REPOSITORY in repositories, sorted(repositories)
+    done = bpy.ops.extensions.package_install_files(
+        filepath=zip_path, repo=EXTENSION_REPOSITORY, enable_on_install=True)
+    assert done == {"FINISHED"}, done
+    folder = repositories[EXTENSION_REPOSITORY].directory
+    return EXTENSION_MODULE, os.path.join(folder, "hairis")
+
+
+def install_addon(zip_path, how="legacy"):
+    """Installs the zip (``how``: 'legacy' or 'extension') and enables it; returns the package.
+
+    The package must come from the temporary folder it was installed into (not from any
+    other copy on the machine).
+    """
+    global MODULE
     assert os.path.isfile(zip_path), "add-on zip %s does not exist" % zip_path
-    result = bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
-    assert result == {"FINISHED"}, result
-    result = bpy.ops.preferences.addon_enable(module=MODULE)
-    assert result == {"FINISHED"}, result
-    loaded, enabled = addon_utils.check(MODULE)
-    assert loaded and enabled, "the add-on did not enable"
-    package = sys.modules[MODULE]
+    name, expected = (install_extension if how == "extension" else install_legacy)(zip_path)
+    MODULE = name
+    loaded, enabled = addon_utils.check(name)
+    assert loaded and enabled, "the add-on %s did not enable" % name
+    package = sys.modules[name]
     installed = os.path.realpath(os.path.dirname(package.__file__))
-    expected = os.path.realpath(os.path.join(user_scripts, "addons", MODULE))
-    assert installed == expected, "add-on loaded from %s, not %s" % (installed, expected)
+    assert installed == os.path.realpath(expected), \
+        "add-on loaded from %s, not %s" % (installed, expected)
+    print("helpers: Blender %s, add-on %s installed as %s from %s"
+          % (bpy.app.version_string, name, how, installed), flush=True)
     return package
+
+
+def module(name):
+    """The add-on's submodule ``name`` ('native', 'engine', ...) as installed."""
+    return sys.modules["%s.%s" % (MODULE, name)]
 
 
 def setup():
     """Parses arguments, installs and enables the add-on; returns (args, package)."""
     args = parse_args()
-    package = install_addon(args.zip)
+    try:
+        if args.expect_version:
+            running = "%d.%d" % VERSION[:2]
+            assert running == args.expect_version, \
+                "this test is for Blender %s, but this is Blender %s" \
+                % (args.expect_version, bpy.app.version_string)
+        package = install_addon(args.zip, args.install)
+    except Exception:  # noqa: BLE001 - the result line must still come
+        traceback.print_exc()
+        result("FAILED")
+        sys.exit(1)
     return args, package
 
 
@@ -91,6 +152,7 @@ def run(tests):
         else:
             print("PASS %s (%.2f s)" % (test.__name__, time.monotonic() - start), flush=True)
     print("%d passed, %d failed" % (len(tests) - len(failed), len(failed)), flush=True)
+    result("FAILED" if failed else "PASSED")
     # Exit explicitly: Blender exits 1 after any render that reported an error, even one a
     # test provoked and caught.
     sys.exit(1 if failed else 0)
@@ -104,10 +166,17 @@ def reset():
     return bpy.context.scene
 
 
+def use_nodes(idblock):
+    """Gives a material or world its node tree (5.0+: always there; use_nodes is deprecated)."""
+    if VERSION < (5, 0, 0):
+        idblock.use_nodes = True
+    assert idblock.node_tree is not None, idblock.name
+
+
 def make_bsdf_material(name, node_type):
     """A material whose output is fed by one new ``node_type`` BSDF; returns (material, node)."""
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    use_nodes(material)
     tree = material.node_tree
     for node in list(tree.nodes):
         if node.type != "OUTPUT_MATERIAL":
@@ -118,21 +187,33 @@ def make_bsdf_material(name, node_type):
     return material, bsdf
 
 
+def socket(node, name):
+    """The input called ``name`` (by name or identifier), available or not.
+
+    From Blender 4.0 ``node.inputs[name]`` skips sockets the node's settings hide (a hair
+    node's Color under the Melanin parametrization).
+    """
+    for candidate in node.inputs:
+        if candidate.name == name or candidate.identifier == name:
+            return candidate
+    raise KeyError("%s has no input %r in Blender %s" % (node.name, name, bpy.app.version_string))
+
+
 def make_hair_material(name, parametrization="MELANIN", **inputs):
     """A material whose output is fed by a Principled Hair BSDF with the given inputs."""
     material, hair = make_bsdf_material(name, "ShaderNodeBsdfHairPrincipled")
     hair.parametrization = parametrization
     for key, value in inputs.items():
-        hair.inputs[key].default_value = value
+        socket(hair, key).default_value = value
     return material
 
 
 def make_surface_material(name, color=(0.6, 0.4, 0.3, 1.0)):
     """A Principled BSDF material with a base colour."""
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    use_nodes(material)
     node = material.node_tree.nodes["Principled BSDF"]
-    node.inputs["Base Color"].default_value = color
+    socket(node, "Base Color").default_value = color
     return material
 
 
@@ -154,10 +235,10 @@ def make_camera(scene, location=(0.0, -6.0, 1.0), rotation=(math.radians(90), 0.
 def make_world(scene, color=(0.05, 0.1, 0.2), strength=1.5):
     """A world whose Background node has ``color``·``strength``."""
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    use_nodes(world)
     background = world.node_tree.nodes["Background"]
-    background.inputs["Color"].default_value = tuple(color) + (1.0,)
-    background.inputs["Strength"].default_value = strength
+    socket(background, "Color").default_value = tuple(color) + (1.0,)
+    socket(background, "Strength").default_value = strength
     scene.world = world
     return world
 
@@ -199,7 +280,8 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     settings.material = 2
     if children:
         settings.child_type = "INTERPOLATED"
-        settings.child_nbr = 1
+        # Display amount of children per parent: child_nbr, child_percent from 4.0.
+        setattr(settings, "child_percent" if VERSION >= (4, 0, 0) else "child_nbr", 1)
         settings.rendered_child_count = children
     else:
         settings.child_type = "NONE"
@@ -280,7 +362,7 @@ def make_test_scene(children=None, with_curves=True):
 def make_diffuse_material(name, color):
     """A Diffuse BSDF material (Lambertian, as Hairis shades meshes)."""
     material, diffuse = make_bsdf_material(name, "ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = color
+    socket(diffuse, "Color").default_value = color
     return material
 
 

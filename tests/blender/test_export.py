@@ -18,7 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
-export = sys.modules["hairis.export"]
+export = helpers.module("export")
 
 # Node input name → hairis_principled_hair field, written out here on purpose (not imported).
 HAIR_FIELDS = {
@@ -45,7 +45,7 @@ def check_hair_material(material_data, material):
     params = material_data.hair
     assert params.parametrization == PARAMETRIZATION[node.parametrization]
     for name, field in HAIR_FIELDS.items():
-        expected = node.inputs[name].default_value
+        expected = helpers.socket(node, name).default_value
         actual = getattr(params, field)
         if isinstance(actual, tuple):
             np.testing.assert_allclose(actual, tuple(expected)[:3], rtol=0, atol=1e-7,
@@ -236,11 +236,12 @@ def test_unsupported_things_warn():
     hair = bpy.data.materials["Hair"]
     tree = hair.node_tree
     info = tree.nodes.new("ShaderNodeHairInfo")
-    tree.links.new(info.outputs["Random"], tree.nodes["Principled Hair BSDF"].inputs["Random"])
+    tree.links.new(info.outputs["Random"],
+                   helpers.socket(tree.nodes["Principled Hair BSDF"], "Random"))
     world_tree = scene.world.node_tree
     environment = world_tree.nodes.new("ShaderNodeTexEnvironment")
     world_tree.links.new(environment.outputs["Color"],
-                         world_tree.nodes["Background"].inputs["Color"])
+                         helpers.socket(world_tree.nodes["Background"], "Color"))
     skin = bpy.data.materials["Skin"]
     glass = skin.node_tree.nodes.new("ShaderNodeBsdfGlass")
     output = skin.node_tree.nodes["Material Output"]
@@ -250,10 +251,74 @@ def test_unsupported_things_warn():
     assert "'Random'" in text and "linked" in text, text
     assert "environment textures are not supported" in text, text
     assert "Glass BSDF is not supported" in text, text
-    # Blender 4.x's Huang model: refused with a message naming it.
-    stub = types.SimpleNamespace(model="HUANG", parametrization="COLOR", inputs=[])
-    params, _warnings, error = export.read_hair_node(stub, "Future")
-    assert params is None and "HUANG" in error, error
+
+
+class StubSocket:
+    """A node input with a name, an identifier and a value (for nodes no Blender makes)."""
+
+    def __init__(self, name, value, identifier=None):
+        self.name = name
+        self.identifier = identifier or name
+        self.default_value = value
+        self.is_linked = False
+        self.enabled = True
+
+
+def stub_hair_node(model="CHIANG", leave_out=(), rename=None):
+    """A stand-in Principled Hair BSDF with the node's inputs, some left out or renamed."""
+    rename = rename or {}
+    values = {"Color": (0.2, 0.3, 0.4, 1.0), "Tint": (1.0, 1.0, 1.0, 1.0),
+              "Absorption Coefficient": (0.2, 0.5, 1.3)}
+    inputs = [StubSocket(rename.get(name, name), values.get(name, 0.5), rename.get(name))
+              for name in HAIR_FIELDS if name not in leave_out]
+    return types.SimpleNamespace(model=model, parametrization="COLOR", inputs=inputs)
+
+
+def test_hair_node_models_and_missing_sockets():
+    """Huang is refused naming the material; a missing socket is named with the version; a
+    socket found by its identifier alone is read."""
+    params, _warnings, error = export.read_hair_node(stub_hair_node("HUANG"), "Future")
+    assert params is None and "'Future'" in error and "Huang support is coming" in error, error
+    params, _warnings, error = export.read_hair_node(stub_hair_node(leave_out=("Coat",)), "Old")
+    assert params is None, params
+    assert "'Old'" in error and "'Coat'" in error and bpy.app.version_string.split()[0] in error \
+        and "3.4 to 5.x" in error, error
+    # A socket whose display name changed but whose identifier did not.
+    params, _warnings, error = export.read_hair_node(
+        stub_hair_node(rename={"Coat": "Coating"}), "Renamed")
+    compat = helpers.module("compat")
+    assert error == "material 'Renamed': the Principled Hair BSDF has no 'Coat' input in " \
+        "Blender %s; Hairis supports %s" % (compat.version_string(), compat.SUPPORTED_TEXT), error
+    node = stub_hair_node()
+    node.inputs[7].name = "Coating"  # Coat: the identifier stays "Coat"
+    params, _warnings, error = export.read_hair_node(node, "Identifier")
+    assert error is None and params.coat == 0.5, (error, params)
+
+
+def test_huang_material_refused_at_render():
+    """Blender 4.0+: a new hair node is Chiang (RNA's default says Huang); a Huang material
+    fails F12 with a report naming it, a Chiang one exports."""
+    if helpers.VERSION < (4, 0, 0):
+        return  # Blender 3.4 has no model setting (read_hair_node's stub test covers it)
+    helpers.make_test_scene(with_curves=False)
+    node = bpy.data.materials["Hair"].node_tree.nodes["Principled Hair BSDF"]
+    assert node.model == "CHIANG", node.model
+    assert node.bl_rna.properties["model"].default == "HUANG"
+    export.export_context()
+    node.model = "HUANG"
+    try:
+        export.export_context()
+    except export.ExportError as error:
+        assert "'Hair'" in str(error) and "Huang support is coming" in str(error), error
+    else:
+        raise AssertionError("a Huang material must be refused")
+    try:
+        bpy.ops.render.render()
+    except RuntimeError as error:
+        assert "'Hair'" in str(error) and "Huang support is coming" in str(error), error
+        assert "Traceback" not in str(error), error
+    else:
+        raise AssertionError("F12 with a Huang material must fail with a report")
 
 
 def test_disabled_modifier_and_strands():
@@ -319,6 +384,8 @@ helpers.run([
     test_camera_orthographic_and_scale,
     test_mesh,
     test_unsupported_things_warn,
+    test_hair_node_models_and_missing_sockets,
+    test_huang_material_refused_at_render,
     test_disabled_modifier_and_strands,
     test_no_camera,
     test_render_mode_export_through_engine,

@@ -25,10 +25,10 @@ if not ARGS.fake_library or not os.path.isfile(ARGS.fake_library):
     helpers.skip("the fake library was not built (no C compiler?)")
 helpers.use_library(ARGS.fake_library)
 os.environ.pop("HAIRIS_FAKE_NOISE", None)  # exact images here
-native = sys.modules["hairis.native"]
-engine = sys.modules["hairis.engine"]
-tables = sys.modules["hairis.tables"]
-export = sys.modules["hairis.export"]
+native = helpers.module("native")
+engine = helpers.module("engine")
+tables = helpers.module("tables")
+export = helpers.module("export")
 HEADER = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, os.pardir, "lib",
                       "include", "hairis", "hairis.h")
 SUMMARY = os.path.join(ARGS.workdir, "summary.txt")
@@ -274,7 +274,7 @@ def test_bake_operator_saved_blend():
     assert os.path.getmtime(path) == before, "current tables must not be re-baked"
 
     hair = bpy.data.materials["Hair"]
-    hair.node_tree.nodes["Principled Hair BSDF"].inputs["Roughness"].default_value = 0.6
+    helpers.socket(hair.node_tree.nodes["Principled Hair BSDF"], "Roughness").default_value = 0.6
     assert tables.quick_state(lib, hair) == "STALE"
     expect_render_error(scene, "'Hair'", "baked for other hair parameters")
     assert bpy.ops.hairis.bake_tables(material="Hair") == {"FINISHED"}
@@ -303,11 +303,31 @@ def test_invalid_node_value_fails_cleanly():
     scene = helpers.make_test_scene(with_curves=False)
     scene.hairis.strategy = "UNIFORM"
     node = bpy.data.materials["Hair"].node_tree.nodes["Principled Hair BSDF"]
-    node.inputs["IOR"].default_value = 1.0
+    helpers.socket(node, "IOR").default_value = 1.0
     expect_render_error(scene, "IOR must be > 1")
-    node.inputs["IOR"].default_value = 1.55
+    helpers.socket(node, "IOR").default_value = 1.55
     pixels, _summary = render(scene)
     assert np.all(np.isfinite(pixels))
+
+
+def test_huang_material_refused_by_bake_and_render():
+    """Blender 4.0+: the bake operator and F12 refuse a Huang material with a report naming it
+    (the Chiang material beside it still bakes)."""
+    if helpers.VERSION < (4, 0, 0):
+        return  # no model setting before 4.0
+    scene = helpers.make_test_scene()
+    scene.hairis.auto_bake = True
+    bpy.data.materials["Curly"].node_tree.nodes["Principled Hair BSDF"].model = "HUANG"
+    for kwargs in ({}, {"material": "Curly"}):
+        try:
+            bpy.ops.hairis.bake_tables(**kwargs)  # an ERROR report raises in bpy.ops
+        except RuntimeError as error:
+            assert "'Curly'" in str(error) and "Huang support is coming" in str(error), error
+        else:
+            raise AssertionError("baking a Huang material must be refused")
+    assert bpy.data.materials["Hair"].hairis.table_image is not None, "Hair must still bake"
+    assert bpy.data.materials["Curly"].hairis.table_image is None
+    expect_render_error(scene, "'Curly'", "Huang support is coming")
 
 
 class StubEngine:
@@ -383,6 +403,7 @@ helpers.run([
     test_bake_operator_saved_blend,
     test_bake_operator_unsaved_blend_packs,
     test_invalid_node_value_fails_cleanly,
+    test_huang_material_refused_by_bake_and_render,
     test_cancel_returns_promptly,
     test_progress_reporter_rate_limit,
 ])

@@ -22,10 +22,10 @@ LIBRARY_PATH = OVERRIDE or helpers.bundled_library(PACKAGE)
 if not os.path.isfile(LIBRARY_PATH):
     helpers.skip("libhairis.so is not built yet (looked for %s)" % LIBRARY_PATH)
 helpers.use_library(OVERRIDE or None)
-native = sys.modules["hairis.native"]
-engine = sys.modules["hairis.engine"]
-export = sys.modules["hairis.export"]
-tables = sys.modules["hairis.tables"]
+native = helpers.module("native")
+engine = helpers.module("engine")
+export = helpers.module("export")
+tables = helpers.module("tables")
 STATUS = native.library_status()
 assert STATUS.ok, "the library exists but does not load: " + STATUS.message
 FAKE = STATUS.version.endswith("-fake")

@@ -1,0 +1,103 @@
+"""What differs between the Blender versions Hairis supports (3.4 to 5.x).
+
+Hairis reads Cycles' node trees; their sockets and some Python API names changed over those
+versions. Everything version-dependent is decided here, from ``bpy.app.version`` (and from
+what the running Blender has, never from socket indices), so the other modules read one name:
+
+- the supported versions: 3.4 and newer within the major versions Hairis knows (3, 4, 5);
+  :func:`version_problem` names the running version and the supported ones otherwise;
+- Principled BSDF inputs renamed in 4.0 (Emission → Emission Color, ...): :data:`SURFACE_INPUTS`
+  lists each input's names, newest first, and :func:`find_input` takes the first one present;
+- ``use_nodes`` of materials and worlds is deprecated from 5.0 (always on; reading it warns):
+  :func:`uses_nodes`;
+- the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang);
+- a render pass's ``rect.foreach_set``: (pixels, 4) rows in 3.4, a flat float buffer in 4.5+:
+  :func:`set_pass_pixels`.
+"""
+
+import bpy
+import numpy as np
+
+MINIMUM_VERSION = (3, 4, 0)
+"""The oldest Blender Hairis supports (bl_info's "blender")."""
+
+KNOWN_MAJOR_VERSIONS = (3, 4, 5)
+"""Major versions whose node and Python APIs Hairis was written and tested against."""
+
+SUPPORTED_TEXT = "Blender 3.4 to 5.x (tested: 3.4, 4.5 LTS, 5.0)"
+
+SURFACE_INPUTS = {
+    # key: the input's names, newest first (Blender 4.0 renamed Principled BSDF inputs).
+    "base_color": ("Base Color",),
+    "emission_color": ("Emission Color", "Emission"),
+    "emission_strength": ("Emission Strength",),
+    "color": ("Color",),
+    "strength": ("Strength",),
+}
+"""The surface-shader inputs Hairis reads, by every name they have had."""
+
+NODES_ALWAYS_ON = (5, 0, 0)
+"""From 5.0 materials and worlds always use nodes (``use_nodes`` is deprecated); lights not."""
+
+
+def running_version():
+    """``bpy.app.version`` as a tuple (a function, so tests can stand in another version)."""
+    return tuple(bpy.app.version)
+
+
+def version_string(version=None):
+    """'4.5.15' for (4, 5, 15)."""
+    return ".".join(str(part) for part in (version or running_version()))
+
+
+def version_problem(version=None):
+    """None when Hairis supports ``version`` (default: the running one), else why not."""
+    version = tuple(version or running_version())
+    if version < MINIMUM_VERSION:
+        return ("Hairis does not support Blender %s: it needs %s"
+                % (version_string(version), SUPPORTED_TEXT))
+    if version[0] not in KNOWN_MAJOR_VERSIONS:
+        return ("Hairis does not support Blender %s (a major version it does not know): it "
+                "supports %s" % (version_string(version), SUPPORTED_TEXT))
+    return None
+
+
+def uses_nodes(idblock):
+    """True when a material, world or light is shaded by its node tree."""
+    if idblock is None or getattr(idblock, "node_tree", None) is None:
+        return False
+    if running_version() >= NODES_ALWAYS_ON and isinstance(
+            idblock, (bpy.types.Material, bpy.types.World)):
+        return True
+    return bool(getattr(idblock, "use_nodes", False))
+
+
+def find_input(node, names):
+    """The first of ``names`` that ``node`` has as an input (by name or identifier), or None.
+
+    Enabled sockets win over disabled ones of the same name.
+    """
+    for name in names:
+        found = None
+        for socket in node.inputs:
+            if socket.name == name or socket.identifier == name:
+                if getattr(socket, "enabled", True):
+                    return socket
+                found = found or socket
+        if found is not None:
+            return found
+    return None
+
+
+def hair_model(node):
+    """The Principled Hair BSDF's model: 'CHIANG' before 4.0, else the node's ``model``."""
+    return getattr(node, "model", "CHIANG")
+
+
+def set_pass_pixels(render_pass, rgba):
+    """Writes (height, width, 4) float pixels into a RenderPass (whichever layout it takes)."""
+    pixels = np.ascontiguousarray(rgba, np.float32)
+    try:
+        render_pass.rect.foreach_set(pixels.reshape(-1))
+    except (TypeError, ValueError):
+        render_pass.rect.foreach_set(pixels.reshape(-1, 4))
