@@ -131,10 +131,7 @@ def blender_main():
         library = native.load_library()
         small = dataclasses.replace(data, camera=dataclasses.replace(
             data.camera, width=PROBE_RESOLUTION, height=PROBE_RESOLUTION))
-        struct = library.render_settings_defaults()
-        struct.samples = 1
-        struct.strategy = native.STRATEGIES["ANALYTIC"]
-        struct.threads = 0
+        struct = {"samples": 1, "strategy": "analytic", "threads": 0}
         start = time.monotonic()
         with engine.build_native_scene(library, small, {}) as native_scene:
             loaded = time.monotonic()

@@ -188,12 +188,12 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         finally:
             for table in hair_tables.values():
                 table.close()
-        peak = int(stats["peak_memory_bytes"]) / (1024.0 * 1024.0)
+        peak = stats.peak_memory_bytes / (1024.0 * 1024.0)
         self.update_memory_stats(memory_used=peak, memory_peak=peak)
-        self.update_stats("", "Rendered in %.2f s" % float(stats["seconds"]))
-        if int(stats["dropped_samples"]):
+        self.update_stats("", "Rendered in %.2f s" % stats.seconds)
+        if stats.dropped_samples:
             self.report({"WARNING"}, "%d samples with NaN or infinite values were dropped"
-                        % int(stats["dropped_samples"]))
+                        % stats.dropped_samples)
         return rgba
 
     def _resolve_tables(self, library, data, settings):

@@ -144,6 +144,24 @@ def parse_options(text):
     return result
 
 
+class RenderStats:
+    """What a render did (``hairis_last_render_stats``): one attribute per name, an int or a
+    float (seconds, camera_rays, rays, shadow_rays, dropped_samples, peak_memory_bytes, ...)."""
+
+    def __init__(self, text):
+        self.names = []
+        for name, value in parse_options(text).items():
+            try:
+                number = int(value)
+            except ValueError:
+                number = float(value)
+            setattr(self, name, number)
+            self.names.append(name)
+
+    def __repr__(self):
+        return "<RenderStats %s>" % ", ".join("%s=%r" % (n, getattr(self, n)) for n in self.names)
+
+
 def principled_options(params):
     """Fiber options of a Principled Hair node from a dict of ``export.HairParameters``'
     fields (parametrization as an index into PARAMETRIZATIONS or a name, angles in radians)."""
@@ -688,7 +706,7 @@ class Scene(_Handle):
 
     def render(self, settings, progress=None, out=None):
         """Renders with render settings (dict or string); returns (rgba (height, width, 4)
-        bottom row first, the stats as a dict of strings: seconds, camera_rays, ...).
+        bottom row first, :class:`RenderStats`).
 
         ``progress(p) -> bool`` is called with p in [0, 1]; returning True cancels, which
         raises :class:`HairisCancelled` whose ``rgba`` attribute holds the partial image.
@@ -704,7 +722,7 @@ class Scene(_Handle):
         adapter = _Progress(progress)
         status = self._library.raw.hairis_render(self, options(settings).encode(),
                                                  _ptr(out, c_float), adapter.function, None)
-        stats = parse_options(_decode(self._library.raw.hairis_last_render_stats()))
+        stats = RenderStats(_decode(self._library.raw.hairis_last_render_stats()))
         if status != OK or adapter.error is not None:
             error = self._library._error("hairis_render", status if status != OK else None,
                                          adapter)

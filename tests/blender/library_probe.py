@@ -62,7 +62,7 @@ def _scene(native, library, tables=None):
     """A small hair scene: a comb of 48 strands in front of the camera, a sun and a sky."""
     import numpy as np
     scene = library.scene()
-    material = scene.add_hair_material(library.principled_hair_defaults().update(FIBER), tables)
+    material = scene.add_hair_material(FIBER, tables)
     strands, keys = 48, 5
     points = np.zeros((strands, keys, 3), np.float32)
     points[:, :, 0] = np.linspace(-0.6, 0.6, strands)[:, None]
@@ -73,11 +73,9 @@ def _scene(native, library, tables=None):
                      np.full(strands * keys, 0.012, np.float32))
     scene.add_sun((0.3, -1.0, 0.5), (1.0, 0.95, 0.9), 3.0, 0.05)
     scene.set_world((0.2, 0.3, 0.4), 1.0)
-    camera = native.Camera()
-    camera.camera_to_world[:] = [1, 0, 0, 0, 0, 0, -1, -3, 0, 1, 0, 0, 0, 0, 0, 1]
-    camera.frame[:] = [0.5, 0.4, -1.5, 0.5, -0.4, -1.5, -0.5, -0.4, -1.5, -0.5, 0.4, -1.5]
-    camera.width, camera.height = 32, 24
-    scene.set_camera(camera)
+    scene.set_camera({"matrix": [1, 0, 0, 0, 0, 0, -1, -3, 0, 1, 0, 0, 0, 0, 0, 1],
+                      "frame": [0.5, 0.4, -1.5, 0.5, -0.4, -1.5, -0.5, -0.4, -1.5, -0.5, 0.4, -1.5],
+                      "width": 32, "height": 24})
     return scene
 
 
@@ -88,10 +86,7 @@ def probe(native, library_path, workdir):
     result = {"mode": library.mode}
     exr = os.path.join(workdir, "probe_%d.exr" % os.getpid())
     with library.fiber_principled(FIBER) as fiber:
-        options = library.bake_options_defaults()
-        options.theta_r_count, options.theta_i_count, options.phi_count = 9, 16, 16
-        options.set_n_h_list([1, 2])
-        options.threads = 2
+        options = {"theta_r": 9, "theta_i": 16, "phi": 16, "n_h": "1,2", "threads": 2}
         with library.bake_tables(fiber, options) as baked:
             baked.write(exr)
         with open(exr, "rb") as handle:
@@ -113,11 +108,7 @@ def probe(native, library_path, workdir):
         os.remove(exr + ".copy")
         with library.load_tables_memory(data) as tables:
             for strategy in ("ANALYTIC", "TABLE"):
-                settings = library.render_settings_defaults()
-                settings.samples = 8
-                settings.strategy = native.STRATEGIES[strategy]
-                settings.threads = 2
-                settings.seed = 5
+                settings = {"samples": 8, "strategy": strategy.lower(), "threads": 2, "seed": 5}
                 with _scene(native, library, tables if strategy == "TABLE" else None) as scene:
                     rgba, _stats = scene.render(settings)
                 result["render_" + strategy] = _digest(rgba)
