@@ -67,6 +67,30 @@ void chiang_near_field(benchmark::State &state) {
 }
 BENCHMARK(chiang_near_field);
 
+// The two halves of chiang_near_field: preparing the fiber at a hit, and f there.
+void chiang_prepare(benchmark::State &state) {
+    const Queries q(4096);
+    size_t k = 0;
+    for (auto _ : state) {
+        const ChiangPoint point = setup().fiber->at({q.views[k], q.h[k]});
+        benchmark::DoNotOptimize(point);
+        k = (k + 1) & 4095;
+    }
+}
+BENCHMARK(chiang_prepare);
+
+void chiang_f_prepared(benchmark::State &state) {
+    const Queries q(4096);
+    const ChiangPoint point = setup().fiber->at({q.views[7], q.h[7]});
+    size_t k = 0;
+    for (auto _ : state) {
+        Rgb f = point.f(direction_of(0.3f, 1.0f + q.u[k]));
+        benchmark::DoNotOptimize(f);
+        k = (k + 1) & 4095;
+    }
+}
+BENCHMARK(chiang_f_prepared);
+
 void chiang_far_field(benchmark::State &state) {
     const Queries q(4096);
     size_t k = 0;

@@ -35,7 +35,7 @@ inline StudySetup make_setup(const std::string &preset = "cycles-default", BakeO
 class Strategy {
   public:
     Strategy(std::shared_ptr<const Sampler> sampler, std::shared_ptr<const ChiangFiber> fiber)
-        : shading_(HairShading::create(sampler->model() ? std::move(fiber) : nullptr, sampler).value()) {}
+        : shading_(HairShading::create(std::move(fiber), sampler).value()) {}
     HairBsdf at(Vec3 wo, float h, ScratchBuffer &scratch) const { return shading_.at({wo, h}, scratch); }
     std::optional<BsdfSample> sample(Vec3 wo, float h, float u0, float u1, float u2) const {
         return at(wo, h, scratch()).sample(u0, u1, u2);

@@ -1,5 +1,6 @@
 #include "fiber/chiang.h"
 
+#include <boost/math/special_functions/bessel.hpp>
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
@@ -104,10 +105,18 @@ LongitudinalConstants longitudinal_constants(double v) {
     return c;
 }
 
+namespace {
+// Boost computes in double (its default promotes doubles to long double, ~2× slower).
+constexpr auto kDoublePolicy = boost::math::policies::policy<boost::math::policies::promote_double<false>>();
+}  // namespace
+
 double Cone::density(double sin_theta_i, double cos_theta_i) const {
-    const double log_value = c_->log_normalization - c_->kappa * sin_theta_i * axis_.sin +
-                             log_bessel_i0(c_->kappa * cos_theta_i * axis_.cos);
-    return std::exp(log_value);
+    const double log_prefactor = c_->log_normalization - c_->kappa * sin_theta_i * axis_.sin;
+    const double x = c_->kappa * cos_theta_i * axis_.cos;
+    // Boost's I0 directly while neither factor can overflow or underflow; log space beyond.
+    if (x < 600.0 && log_prefactor > -600.0 && log_prefactor < 600.0)
+        return std::exp(log_prefactor) * boost::math::cyl_bessel_i(0, x, kDoublePolicy);
+    return std::exp(log_prefactor + log_bessel_i0(x));
 }
 
 double Cone::sample(double u_cone, double u_about) const {

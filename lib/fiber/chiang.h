@@ -23,9 +23,9 @@
 // The sampler tilts θ_o (pbrt-v4's order): its pdf Σ_p w_p M_p(θ_i | θ_o + δ_p) N_p is exact
 // and, with 4.2's semantics, proportional to luminance(f) up to the lobe weights.
 //
-// Deviation from Cycles' floating-point code, on purpose: M_p is evaluated exactly (to double
-// precision) in log space, where Cycles' Bessel I0 approximation underestimates it by up to
-// ~2% where cos θ_i cos θ_o / v ≈ 12.
+// Deviation from Cycles' floating-point code, on purpose: M_p is evaluated to double precision
+// (Boost's I0, in log space where a factor would overflow), where Cycles' Bessel I0
+// approximation underestimates it by up to ~2% where cos θ_i cos θ_o / v ≈ 12.
 #pragma once
 
 #include <array>
@@ -100,7 +100,8 @@ double longitudinal_variance(double roughness);
 /// Cycles' azimuthal roughness mapping: β clamped to [0.001, 1], then
 /// s = sqrt(π/8)·(0.265β + 1.194β² + 5.372β²²).
 double logistic_scale(double radial_roughness);
-/// log I0(x) for x >= 0, to double precision.
+/// log I0(x) for x >= 0, to double precision (series, then the asymptotic expansion): for
+/// arguments where I0 itself overflows.
 double log_bessel_i0(double x);
 /// The constants of variance v > 0.
 LongitudinalConstants longitudinal_constants(double v);
