@@ -3,6 +3,8 @@
 // any number of ω_i (the light sample, the BSDF sample).
 #pragma once
 
+#include <cstdint>
+
 #include "core/math.h"
 #include "core/scratch.h"
 
@@ -12,6 +14,16 @@ namespace hairis {
 struct FiberHit {
     Vec3 wo;      ///< unit direction towards the viewer
     float h = 0;  ///< offset across the fiber, in [−1, 1] (frame.h)
+    /// The curve's normal attribute in the same frame (Huang: the ellipse's major axis after
+    /// removing its tangential part); zero when the curve has none. Chiang ignores it.
+    Vec3 normal{};
+    /// Cycles' pixel_coverage: half the pixel footprint in fiber radii for camera rays, 1 for
+    /// every other ray (Huang's near field iff the projected radius exceeds it). Chiang
+    /// ignores it.
+    float pixel_coverage = 1;
+    /// Seeds models whose f is a Monte Carlo estimate (Huang, like Cycles' per-shading-point
+    /// LCG); hashed with wo and h, so 0 is a valid seed. Chiang ignores it.
+    std::uint32_t seed = 0;
 };
 
 /// A sampled incident direction and the density it was drawn from.
