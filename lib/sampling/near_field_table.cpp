@@ -109,17 +109,22 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
             mass[size_t(row) * size_t(cells) + size_t(k)] = cell_mass(f, p, sin_o, peak, a, b);
         }
     });
+    // What the table file stores, rounded to float once here so that a loaded table is this one.
+    auto data = std::make_shared<NearFieldData>();
+    data->theta_o_nodes = nodes;
+    data->theta_i_cells = cells;
+    data->mass.assign(mass.begin(), mass.end());
     // M_p at the cell edges: the shape of the density inside each cell (linear in sin θ).
-    table.edge_.assign(size_t(rows) * size_t(cells + 1), 0.0f);
+    data->edge.assign(size_t(rows) * size_t(cells + 1), 0.0f);
     tbb::parallel_for(0, rows, [&](int row) {
         const int r = row / 4, p = row % 4;
         const double sin_o = std::sin(double(theta_o[size_t(r)]));
         for (int k = 0; k <= cells; ++k) {
             const double value = f.lobe_longitudinal(p, std::sin(-kHalfPi + kPi * k / cells), sin_o);
-            table.edge_[size_t(row) * size_t(cells + 1) + size_t(k)] = float(value);
+            data->edge[size_t(row) * size_t(cells + 1) + size_t(k)] = float(value);
         }
     });
-    table.integral_.assign(size_t(rows), 0.0);
+    data->integral.assign(size_t(rows), 0.0f);
     for (int row = 0; row < rows; ++row) {
         double sum = 0;
         for (int k = 0; k < cells; ++k) sum += mass[size_t(row) * size_t(cells) + size_t(k)];
@@ -129,10 +134,13 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
         if (!(sum >= 0.0) || !std::isfinite(sum))
             return Error{"NearFieldTable: lobe " + std::to_string(row % 4) + " at θ_o node " +
                          std::to_string(row / 4) + " has a non-finite mass (internal error)"};
-        table.integral_[size_t(row)] = sum;
+        data->integral[size_t(row)] = float(sum);
     }
+    data->cone.assign(size_t(rows), 0);
+    // The CDFs of the stored (float) masses, as from_data builds them; the probes below read them.
+    table.data_ = data;
     Expected<DiscreteCdfs> cdfs = DiscreteCdfs::create(rows, cells, [&](int row, double *w) {
-        std::copy_n(mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
+        std::copy_n(data->mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
     });
     if (!cdfs) return cdfs.error();
     table.cdfs_ = std::move(cdfs).value();
@@ -166,7 +174,6 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
         }
         d[size_t(i)] = sum;
     });
-    table.cone_.assign(size_t(rows), 0);
     for (int r = 0; r < nodes; ++r) {
         for (int p = 0; p < 4; ++p) {
             Divergences sum;
@@ -178,9 +185,60 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
             const LobeSampling m = options.lobe_sampling[size_t(p)];
             const int adjacent = (r > 0) + (r < intervals);
             const bool closer = probe[size_t(p)] && sum.table > kGoodEnough * adjacent && sum.cone < sum.table;
-            table.cone_[size_t(r) * 4 + size_t(p)] = m == LobeSampling::Cone || (m == LobeSampling::Auto && closer);
+            data->cone[size_t(r) * 4 + size_t(p)] = m == LobeSampling::Cone || (m == LobeSampling::Auto && closer);
         }
     }
+    return table;
+}
+
+Status NearFieldData::validate() const {
+    const std::string what = "near-field table: ";
+    if (Status s = first_error(check::count_in_range("theta_o nodes", theta_o_nodes, 2, kMaxThetaRNodes),
+                               check::count_in_range("theta_i cells", theta_i_cells, 4, kMaxTableAxisCells)))
+        return Error{what + s->message, ErrorKind::InvalidTable};
+    const size_t r = size_t(rows()), k = size_t(theta_i_cells);
+    if (mass.size() != r * k || edge.size() != r * (k + 1) || integral.size() != r || cone.size() != r)
+        return Error{what + "holds " + std::to_string(mass.size()) + " masses, " + std::to_string(edge.size()) +
+                         " edges, " + std::to_string(integral.size()) + " integrals and " + std::to_string(cone.size()) +
+                         " cone flags; " + std::to_string(theta_o_nodes) + " nodes of " + std::to_string(theta_i_cells) +
+                         " cells need " + std::to_string(r * k) + ", " + std::to_string(r * (k + 1)) + ", " +
+                         std::to_string(r) + " and " + std::to_string(r),
+                     ErrorKind::InvalidTable};
+    for (const std::vector<float> *values : {&mass, &edge, &integral})
+        for (size_t i = 0; i < values->size(); ++i)
+            if (!((*values)[i] >= 0.0f) || !std::isfinite((*values)[i]))
+                return Error{what + (values == &mass ? "mass " : values == &edge ? "edge value " : "integral ") +
+                                 std::to_string(i) + " must be finite and >= 0",
+                             ErrorKind::InvalidTable};
+    for (size_t i = 0; i < cone.size(); ++i)
+        if (cone[i] > 1) return Error{what + "cone flag " + std::to_string(i) + " must be 0 or 1", ErrorKind::InvalidTable};
+    return std::nullopt;
+}
+
+Expected<NearFieldTable> NearFieldTable::from_data(std::shared_ptr<const ChiangFiber> fiber,
+                                                   std::shared_ptr<const NearFieldData> data) {
+    if (!fiber) return Error{"NearFieldTable: the fiber must not be null"};
+    if (!data) return Error{"NearFieldTable: no data"};
+    if (Status s = data->validate()) return *s;
+    NearFieldTable table;
+    table.fiber_ = std::move(fiber);
+    const int nodes = data->theta_o_nodes, cells = data->theta_i_cells;
+    std::vector<float> theta_o(static_cast<size_t>(nodes));
+    for (int r = 0; r < nodes; ++r) theta_o[size_t(r)] = float(-kHalfPi + kPi * r / (nodes - 1));
+    theta_o.front() = -float(kHalfPi);
+    theta_o.back() = float(kHalfPi);
+    Expected<ThetaRNodes> made_nodes = ThetaRNodes::create(theta_o);
+    if (!made_nodes) return made_nodes.error();
+    table.nodes_ = std::move(made_nodes).value();
+    Expected<LongitudinalCells> made_cells = LongitudinalCells::create(cells);
+    if (!made_cells) return made_cells.error();
+    table.cells_ = std::move(made_cells).value();
+    Expected<DiscreteCdfs> cdfs = DiscreteCdfs::create(data->rows(), cells, [&](int row, double *w) {
+        std::copy_n(data->mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
+    });
+    if (!cdfs) return Error{"near-field table: " + cdfs.error().message, ErrorKind::InvalidTable};
+    table.cdfs_ = std::move(cdfs).value();
+    table.data_ = std::move(data);
     return table;
 }
 
@@ -227,7 +285,8 @@ NearFieldTable::Divergences NearFieldTable::divergences(int r, int p, float t_no
 size_t NearFieldTable::memory_bytes() const {
     const size_t rows = size_t(cdfs_.count()), cells = size_t(cdfs_.size());
     // CDF floats plus a guide of at least as many 16-bit entries, and the integrals.
-    return rows * (2 * (cells + 1) * sizeof(float) + cells * 2) + integral_.size() * sizeof(double);
+    return rows * (2 * (cells + 1) * sizeof(float) + cells * 2) +
+           data_->mass.size() * sizeof(float) + data_->edge.size() * sizeof(float) + rows * (sizeof(float) + 1);
 }
 
 namespace {
@@ -262,7 +321,7 @@ NearFieldTable::Prepared NearFieldTable::prepare(const ChiangPoint &fiber) const
     for (int p = 0; p < 4; ++p) a[p] = double(luminance(fiber.attenuation(p)));
     for (int side = 0; side < 2; ++side) {
         const int r = std::min(q.blend.lower + side, nodes_.count() - 1);
-        const double *integral = &integral_[size_t(r) * 4];
+        const float *integral = &data_->integral[size_t(r) * 4];
         double w[4], total = 0;
         for (int p = 0; p < 4; ++p) total += (w[p] = a[p] * integral[p]);
         for (int p = 0; p < 4; ++p) q.weight[side][p] = float(total > 0 ? w[p] / total : (p == 0 ? 1.0 : 0.0));
@@ -291,7 +350,7 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
         for (int p = 0; p < 4; ++p) {
             if (!(q.weight[side][p] > 0.0f)) continue;
             double m = 0;
-            if (cone_[size_t(r) * 4 + size_t(p)]) {
+            if (data_->cone[size_t(r) * 4 + size_t(p)]) {
                 if (longitudinal[p] < 0) longitudinal[p] = fiber.cone(p).density(double(wi.x), cos_from_sin(double(wi.x)));
                 m = longitudinal[p];
             } else {
@@ -331,7 +390,7 @@ std::optional<DirectionSample> NearFieldTable::sample(const Prepared &q, float u
     while (p > 0 && !(w[p] > 0.0f)) --p;  // rounding left u past the last positive lobe
 
     float sin_theta = 0, cos_theta = 1;
-    if (cone_[size_t(r) * 4 + size_t(p)]) {
+    if (data_->cone[size_t(r) * 4 + size_t(p)]) {
         // What is left of u inside the lobe's interval picks the cone's cosine; u1 the angle.
         const double u_cone = w[p] > 0.0f ? std::clamp(double(u) / double(w[p]), 0.0, 1.0) : 0.0;
         sin_theta = off_axis(float(fiber.cone(p).sample(u_cone, double(clamp_unit(u1)))));

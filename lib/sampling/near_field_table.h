@@ -66,13 +66,37 @@ struct NearFieldTableOptions {
                                                  LobeSampling::Auto, LobeSampling::Auto};
 };
 
+/// What a near-field table holds, as plain data (what a table file stores): per θ_o node r
+/// (equally spaced over [−π/2, π/2], ends included) and lobe p, row r·4 + p.
+struct NearFieldData {
+    int theta_o_nodes = 0;
+    int theta_i_cells = 0;
+    std::vector<float> mass;          ///< [row·cells + k]: ∫ over θ_i cell k of M_p cos θ_i (any scale per row)
+    std::vector<float> edge;          ///< [row·(cells + 1) + k]: M_p at the cells' edges (the shape inside a cell)
+    std::vector<float> integral;      ///< [row]: ∫ M_p cos θ_i dθ_i over the sphere (the lobe's weight factor)
+    std::vector<unsigned char> cone;  ///< [row]: 1 when the lobe draws θ_i from the fiber's cone
+
+    int rows() const { return 4 * theta_o_nodes; }
+    /// Counts in range ([2, kMaxThetaRNodes] nodes, [4, kMaxTableAxisCells] cells), sizes
+    /// consistent, values finite and >= 0, cone flags 0 or 1; names the first problem.
+    Status validate() const;
+};
+
 /// Per-θ_o, per-lobe inverse CDFs of Cycles' M_p·cos θ_i, and the near-field sampler on them.
 class NearFieldTable {
   public:
-    /// Tabulates the fiber's M_p; refuses node counts outside [2, kMaxThetaRNodes] and cell
-    /// counts outside [4, kMaxTableAxisCells].
+    /// Tabulates the fiber's M_p (what the baker stores); refuses node counts outside
+    /// [2, kMaxThetaRNodes] and cell counts outside [4, kMaxTableAxisCells].
     static Expected<NearFieldTable> create(std::shared_ptr<const ChiangFiber> fiber,
                                            const NearFieldTableOptions &options = {});
+    /// The table of `data` (baked for `fiber`'s parameters) for `fiber`: nothing is computed
+    /// from the fiber but the CDFs of the stored masses, so tables built and loaded sample
+    /// alike, bit for bit.
+    static Expected<NearFieldTable> from_data(std::shared_ptr<const ChiangFiber> fiber,
+                                              std::shared_ptr<const NearFieldData> data);
+    /// What the table holds.
+    const NearFieldData &data() const { return *data_; }
+    const std::shared_ptr<const NearFieldData> &shared_data() const { return data_; }
 
     /// What sample() and pdf() need at one hit, computed once from the fiber's point there:
     /// the θ_o nodes and their lobe weights.
@@ -97,9 +121,9 @@ class NearFieldTable {
     int theta_o_nodes() const { return nodes_.count(); }
     int theta_i_cells() const { return cells_.count(); }
     /// ∫ M_p(θ_i | θ_o node r)·cos θ_i dθ_i: 1 without a tilt, not exactly 1 with one.
-    double lobe_integral(int r, int p) const { return integral_[size_t(r) * 4 + size_t(p)]; }
+    double lobe_integral(int r, int p) const { return data_->integral[size_t(r) * 4 + size_t(p)]; }
     /// True when lobe p at θ_o node r draws θ_i from the fiber's cone sampler (see lobe_sampling).
-    bool uses_cone(int r, int p) const { return cone_[size_t(r) * 4 + size_t(p)] != 0; }
+    bool uses_cone(int r, int p) const { return data_->cone[size_t(r) * 4 + size_t(p)] != 0; }
     /// Bytes the tables hold (CDFs, guides, integrals).
     size_t memory_bytes() const;
 
@@ -111,14 +135,11 @@ class NearFieldTable {
     Divergences divergences(int r, int p, float t_node) const;
 
     std::shared_ptr<const ChiangFiber> fiber_;
+    std::shared_ptr<const NearFieldData> data_;
     ThetaRNodes nodes_;
     LongitudinalCells cells_;
-    const float *edge(int row) const { return edge_.data() + size_t(row) * size_t(cells_.count() + 1); }
-
-    DiscreteCdfs cdfs_;              // row r·4 + p: the cells' masses
-    std::vector<float> edge_;        // row r·4 + p: M_p at the cells' edges
-    std::vector<double> integral_;  // r·4 + p
-    std::vector<unsigned char> cone_;  // row r·4 + p: 1 when the lobe draws from the cone
+    DiscreteCdfs cdfs_;  // row r·4 + p: data_->mass
+    const float *edge(int row) const { return data_->edge.data() + size_t(row) * size_t(cells_.count() + 1); }
 };
 
 /// The near-field table as a sampler.

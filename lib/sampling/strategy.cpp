@@ -54,7 +54,7 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
     if (!multiple) return table_error("multiple table: " + multiple.error().message);
     return SamplingTables{std::make_shared<const DirectTable>(std::move(direct).value()),
                           std::make_shared<const MultipleTable>(std::move(multiple).value()), t.model,
-                          canonical_parameters(t.parameters)};
+                          canonical_parameters(t.parameters), t.near_field};
 }
 
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &in) {
@@ -86,8 +86,12 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
             if (in.chiang) {
                 std::shared_ptr<const NearFieldTable> near_field = in.near_field;
                 if (!near_field) {
-                    Expected<NearFieldTable> made = NearFieldTable::create(in.chiang);
-                    if (!made) return Error{"near-field table: " + made.error().message};
+                    // From the tables' data alone: nothing is tabulated from the fiber here.
+                    if (!t.near_field)
+                        return table_error("the tables have no near-field part (they were baked for the far field "
+                                           "only, or from the seed's Gaussians); bake exact tables for this fiber");
+                    Expected<NearFieldTable> made = NearFieldTable::from_data(in.chiang, t.near_field);
+                    if (!made) return table_error(made.error().message);
                     near_field = std::make_shared<const NearFieldTable>(std::move(made).value());
                 }
                 single = std::shared_ptr<const Sampler>(std::make_shared<const NearFieldTableSampler>(near_field));

@@ -27,6 +27,8 @@ struct SamplingTables {
     std::shared_ptr<const MultipleTable> multiple;
     std::string model;       ///< TableSet::model
     std::string parameters;  ///< canonical_parameters(TableSet::parameters)
+    /// The near-field part (Chiang), or null.
+    std::shared_ptr<const NearFieldData> near_field;
 
     /// Builds the samplers' tables from a table set (validated here).
     static Expected<SamplingTables> from(const TableSet &tables);
@@ -62,7 +64,8 @@ struct StrategyInputs {
     /// The multiple-scattering distribution's n_h (TABLE: one the tables hold; GAUSSIAN: 1, 2,
     /// 4, 8 or 16).
     int n_h = SamplerOptions{}.n_h;
-    /// A near-field table to share between samplers of one fiber (TABLE with a fiber).
+    /// A near-field table to use instead of the tables' near-field part (studies of other
+    /// resolutions; TABLE with a fiber).
     std::shared_ptr<const NearFieldTable> near_field;
 };
 
@@ -70,8 +73,8 @@ struct StrategyInputs {
 ///   UNIFORM   the sphere;
 ///   ANALYTIC  Chiang's lobe sampling (needs the fiber);
 ///   GAUSSIAN  (1 − w)·seed direct + w·seed multiple(n_h);
-///   TABLE     (1 − w)·single + w·multiple table(n_h), single = the fiber's near-field table
-///             when a fiber is given, else the tables' far-field direct table.
+///   TABLE     (1 − w)·single + w·multiple table(n_h), single = the tables' near-field part
+///             for the fiber when a fiber is given, else the tables' far-field direct table.
 /// Errors name what is missing or out of range; tables baked for another fiber, or without
 /// n_h, are refused with ErrorKind::InvalidTable.
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &inputs);

@@ -10,7 +10,7 @@ namespace hairis {
 
 namespace {
 
-Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+Error file_error(const std::string &what) { return Error{"hairis table: " + what, ErrorKind::InvalidTable}; }
 
 }  // namespace
 
@@ -60,6 +60,10 @@ Status TableSet::validate() const {
             if (!std::isfinite((*v)[n]) || (*v)[n] < 0.0f)
                 return file_error(std::string(v == &direct ? "direct" : "multiple") + " table value " +
                                   std::to_string(n) + " is negative, NaN or infinite");
+    if (near_field) {
+        if (model != "chiang2016") return file_error("a near-field part is only for chiang2016 tables (got " + model + ")");
+        if (Status s = near_field->validate()) return file_error(s->message);
+    }
     for (const auto &[name, value] : parameters)
         if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
             return file_error("parameter \"" + name + "\" must have a plain name and a finite value");

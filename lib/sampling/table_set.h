@@ -7,7 +7,10 @@
 #include <utility>
 #include <vector>
 
+#include <memory>
+
 #include "core/expected.h"
+#include "sampling/near_field_table.h"
 #include "sampling/table_limits.h"
 
 namespace hairis {
@@ -23,6 +26,9 @@ struct TableSet {
     std::vector<int> n_h_values;       ///< strands for the multiple tables, increasing
     std::vector<float> direct;    ///< [r][i][j]: theta_r_count × theta_i_count × phi_count
     std::vector<float> multiple;  ///< [r][k][i]: theta_r_count × n_h count × theta_i_count
+    /// Chiang's near-field tables (what TABLE samples single scattering from); null for other
+    /// models and for the seed's Gaussian source.
+    std::shared_ptr<const NearFieldData> near_field;
 
     int theta_r_count() const { return int(theta_r_nodes.size()); }
     TableResolution resolution() const { return {theta_r_count(), theta_i_count, phi_count}; }

@@ -7,7 +7,9 @@
 #include <memory>
 
 #include "fiber/distributions.h"
+#include "fiber/chiang.h"
 #include "fiber/dual_scattering.h"
+#include "sampling/near_field_table.h"
 
 namespace hairis {
 
@@ -129,6 +131,12 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
                 }
             });
         }
+    }
+    // Chiang's near field: what TABLE samples single scattering from (near_field_table.h).
+    if (const auto *chiang = dynamic_cast<const ChiangFiber *>(&model); chiang && options.source == "exact") {
+        Expected<NearFieldTable> near_field = NearFieldTable::create(std::make_shared<const ChiangFiber>(*chiang));
+        if (!near_field) return Error{"near-field table: " + near_field.error().message};
+        t.near_field = near_field.value().shared_data();
     }
     if (progress && !progress(1.0f)) return Error{"cancelled"};
     if (Status s = t.validate()) return Error{"baked tables are invalid (a bug): " + s->message};

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/math.h"
+#include "core/options.h"
 
 namespace hairis {
 
@@ -56,26 +57,58 @@ public:
 // Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
 int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
 
+// Where each part lies in the image (table_file.h): the far part's rows first, then the
+// near-field part's; the width is the widest part's, narrower rows padded with zeros.
+struct Layout {
+    int far_rows = 0, near_rows = 0, near_cols = 0;
+    long long width = 0, height = 0;
+    static Layout of(const TableSet &t) {
+        Layout l;
+        l.far_rows = t.theta_r_count() * t.theta_i_count;
+        if (t.near_field) {
+            l.near_rows = t.near_field->rows();
+            l.near_cols = t.near_field->theta_i_cells + 1;
+        }
+        l.width = std::max<long long>(t.phi_count, l.near_cols);
+        l.height = (long long)l.far_rows + l.near_rows;
+        return l;
+    }
+};
+
 std::vector<float> pixels_of(const TableSet &t) {
-    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const Layout l = Layout::of(t);
+    const size_t width = size_t(l.width);
     const int bands = int(t.n_h_values.size());
-    std::vector<float> px(size_t(width) * height * kChannels);
+    std::vector<float> px(width * size_t(l.height) * kChannels, 0.0f);
     for (int r = 0; r < t.theta_r_count(); ++r) {
         for (int i = 0; i < t.theta_i_count; ++i) {
             const size_t row = size_t(r) * t.theta_i_count + i;
-            for (int j = 0; j < width; ++j) {
-                float *p = &px[(row * width + j) * kChannels];
+            for (int j = 0; j < t.phi_count; ++j) {
+                float *p = &px[(row * width + size_t(j)) * kChannels];
                 p[0] = t.direct_at(r, i, j);
-                p[1] = bands ? t.multiple_at(r, band_of_column(j, width, bands), i) : 0.0f;
+                p[1] = bands ? t.multiple_at(r, band_of_column(j, t.phi_count, bands), i) : 0.0f;
                 p[2] = 0.0f;
                 p[3] = 1.0f;
             }
         }
     }
+    if (const NearFieldData *n = t.near_field.get()) {
+        const int cells = n->theta_i_cells;
+        for (int row = 0; row < n->rows(); ++row)
+            for (int k = 0; k <= cells; ++k) {
+                float *p = &px[((size_t(l.far_rows) + size_t(row)) * width + size_t(k)) * kChannels];
+                p[0] = k < cells ? n->mass[size_t(row) * size_t(cells) + size_t(k)] : 0.0f;
+                p[1] = n->edge[size_t(row) * size_t(cells + 1) + size_t(k)];
+                p[2] = n->integral[size_t(row)];
+                p[3] = float(n->cone[size_t(row)]);
+            }
+    }
     return px;
 }
 
-Error file_error(const std::string &what) { return Error{"hairis table: " + what}; }
+std::string pixel_name(long long x, long long y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
+
+Error file_error(const std::string &what) { return Error{"hairis table: " + what, ErrorKind::InvalidTable}; }
 
 // The size OpenEXR reads for an attribute of a fixed-size type whatever its size field says
 // (0: a variable-size or unknown type, read as `size` bytes).
@@ -175,8 +208,7 @@ Status check_exr_header(const unsigned char *data, size_t size) {
             if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
             const long long width = (long long)read_int(at + 8) - read_int(at) + 1;
             const long long height = (long long)read_int(at + 12) - read_int(at + 4) + 1;
-            if (width < 1 || height < 1 || width > kMaxTableAxisCells ||
-                height > (long long)kMaxThetaRNodes * kMaxTableAxisCells || width * height > kMaxTableCells)
+            if (width < 1 || height < 1 || width > kMaxTableAxisCells || width * height > kMaxTableCells)
                 return file_error("the image is " + std::to_string(width) + "x" + std::to_string(height) +
                                   " pixels; a table has at most " + std::to_string(kMaxTableAxisCells) +
                                   " columns and " + std::to_string(kMaxTableCells) + " pixels");
@@ -190,10 +222,10 @@ Status check_exr_header(const unsigned char *data, size_t size) {
 
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     if (Status s = t.validate()) return *s;
-    const int width = t.phi_count, height = t.theta_r_count() * t.theta_i_count;
+    const Layout layout = Layout::of(t);
     const std::vector<float> px = pixels_of(t);
 
-    OIIO::ImageSpec spec(width, height, kChannels, TypeDesc::FLOAT);
+    OIIO::ImageSpec spec(int(layout.width), int(layout.height), kChannels, TypeDesc::FLOAT);
     spec.channelnames = {"R", "G", "B", "A"};
     spec.alpha_channel = 3;
     spec.attribute("compression", "zip");
@@ -210,6 +242,14 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
                    t.theta_r_nodes.data());
     spec.attribute("hairis:n_h_values", join_ints(t.n_h_values));
+    std::string parts = "far";
+    if (t.near_field) {
+        parts += ",near";
+        spec.attribute("hairis:near", format_options({{"row", std::to_string(layout.far_rows)},
+                                                      {"theta_o", std::to_string(t.near_field->theta_o_nodes)},
+                                                      {"theta_i", std::to_string(t.near_field->theta_i_cells)}}));
+    }
+    spec.attribute("hairis:parts", parts);
     spec.attribute("hairis:pixel_sha1", sha1_of(px));
 
     std::vector<unsigned char> bytes;
@@ -240,6 +280,9 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
 
     const int version = spec.get_int_attribute("hairis:format_version", -1);
     if (version == -1) return file_error("no hairis:format_version attribute: not a hairis table file");
+    if (version == 1)
+        return file_error("format version 1 (baked by hairis 0.1) lacks what this build samples (the near-field "
+                          "tables); re-bake the tables (the Bake button, or hairis-bake bake)");
     if (version != kTableFormatVersion)
         return file_error("format version " + std::to_string(version) + " is not supported (this build reads version " +
                           std::to_string(kTableFormatVersion) + ")");
@@ -257,11 +300,29 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     // Checked before anything is allocated: the header alone can claim any size.
     if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
         return file_error(s->message);
-    if (spec.width != t.phi_count || spec.height != theta_r_count * t.theta_i_count || spec.depth != 1 ||
-        spec.x != 0 || spec.y != 0)
+    const std::string parts = spec.get_string_attribute("hairis:parts");
+    if (parts != "far" && parts != "far,near")
+        return file_error("hairis:parts must be \"far\" or \"far,near\" (got \"" + parts + "\")");
+    const long long far_rows = (long long)theta_r_count * t.theta_i_count;
+    NearFieldData near;
+    if (parts == "far,near") {
+        Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:near"), "hairis:near");
+        if (!reader) return file_error(reader.error().message);
+        int row = -1;
+        reader.value().field("row", row, 0, kMaxTableCells);
+        reader.value().field("theta_o", near.theta_o_nodes, 2, kMaxThetaRNodes);
+        reader.value().field("theta_i", near.theta_i_cells, 4, kMaxTableAxisCells);
+        if (Status e = reader.value().finish()) return file_error(e->message);
+        if (row != far_rows || near.theta_o_nodes == 0 || near.theta_i_cells == 0)
+            return file_error("hairis:near must give theta_o and theta_i and start at row " + std::to_string(far_rows) +
+                              ", after the far part");
+    }
+    const long long expected_width = std::max<long long>(t.phi_count, near.theta_i_cells ? near.theta_i_cells + 1 : 0);
+    const long long expected_height = far_rows + near.rows();
+    if (spec.width != expected_width || spec.height != expected_height || spec.depth != 1 || spec.x != 0 || spec.y != 0)
         return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                          " but the metadata needs " + std::to_string(t.phi_count) + "x" +
-                          std::to_string(theta_r_count * t.theta_i_count));
+                          " but the metadata needs " + std::to_string(expected_width) + "x" +
+                          std::to_string(expected_height));
 
     const OIIO::ParamValue *nodes = spec.find_attribute("hairis:theta_r_nodes");
     if (!nodes || nodes->type().basetype != TypeDesc::FLOAT || nodes->type().basevalues() * size_t(nodes->nvalues()) != size_t(theta_r_count))
@@ -317,28 +378,68 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
 
     const int bands = int(t.n_h_values.size());
     if (bands > t.phi_count) return file_error("more n_h values than phi columns");
+    auto pixel = [&](size_t row, size_t j) { return &px[(row * width + j) * kChannels]; };
+    for (size_t row = 0; row < height; ++row)
+        for (size_t j = 0; j < width; ++j) {
+            const float *p = pixel(row, j);
+            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3]))
+                return file_error(pixel_name((long long)j, (long long)row) + " holds NaN or infinity");
+        }
+    // The far part: R direct, G the n_h bands, B = 0, A = 1; zero padding beyond phi_count.
     t.direct.resize(size_t(theta_r_count) * t.theta_i_count * t.phi_count);
     t.multiple.assign(size_t(theta_r_count) * bands * t.theta_i_count, 0.0f);
-    for (size_t row = 0; row < height; ++row) {
+    for (size_t row = 0; row < size_t(far_rows); ++row) {
         const int r = int(row / size_t(t.theta_i_count)), i = int(row % size_t(t.theta_i_count));
         for (size_t j = 0; j < width; ++j) {
-            const float *p = &px[(row * width + j) * kChannels];
-            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3]))
-                return file_error("pixel (" + std::to_string(j) + ", " + std::to_string(row) + ") holds NaN or infinity");
-            t.direct[row * width + j] = p[0];
+            const float *p = pixel(row, j);
+            if (j >= size_t(t.phi_count)) {
+                if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
+                    return file_error(pixel_name((long long)j, (long long)row) + " lies outside every part and must be 0");
+                continue;
+            }
+            t.direct[row * size_t(t.phi_count) + j] = p[0];
             if (bands) {
                 const int k = band_of_column(int(j), t.phi_count, bands);
                 float &m = t.multiple[(size_t(r) * bands + k) * t.theta_i_count + i];
                 const bool band_start = j == 0 || band_of_column(int(j) - 1, t.phi_count, bands) != k;
                 if (band_start) m = p[1];
                 else if (p[1] != m)
-                    return file_error("G channel differs inside the n_h band at pixel (" + std::to_string(j) + ", " +
-                                      std::to_string(row) + ")");
+                    return file_error("G channel differs inside the n_h band at " + pixel_name((long long)j, (long long)row));
             }
             if (p[2] != 0.0f || p[3] != 1.0f)
-                return file_error("B must be 0 and A must be 1 at pixel (" + std::to_string(j) + ", " +
-                                  std::to_string(row) + ")");
+                return file_error("B must be 0 and A must be 1 at " + pixel_name((long long)j, (long long)row));
         }
+    }
+    // The near part: R cell mass, G M_p at the cell's lower edge, B the lobe integral and A the
+    // cone flag, both constant along the row; the last column holds only the upper edge.
+    if (near.theta_i_cells) {
+        const size_t cells = size_t(near.theta_i_cells), rows = size_t(near.rows());
+        near.mass.resize(rows * cells);
+        near.edge.resize(rows * (cells + 1));
+        near.integral.resize(rows);
+        near.cone.resize(rows);
+        for (size_t q = 0; q < rows; ++q) {
+            const size_t row = size_t(far_rows) + q;
+            near.integral[q] = pixel(row, 0)[2];
+            const float cone = pixel(row, 0)[3];
+            if (cone != 0.0f && cone != 1.0f)
+                return file_error("A (the cone flag) must be 0 or 1 at " + pixel_name(0, (long long)row));
+            near.cone[q] = cone == 1.0f;
+            for (size_t k = 0; k < width; ++k) {
+                const float *p = pixel(row, k);
+                if (k > cells) {
+                    if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
+                        return file_error(pixel_name((long long)k, (long long)row) + " lies outside every part and must be 0");
+                    continue;
+                }
+                if (p[2] != near.integral[q] || p[3] != cone)
+                    return file_error("B and A must be constant along a near-field row at " + pixel_name((long long)k, (long long)row));
+                if (k < cells) near.mass[q * cells + k] = p[0];
+                else if (p[0] != 0.0f) return file_error("R must be 0 in the near part's last column at " + pixel_name((long long)k, (long long)row));
+                near.edge[q * (cells + 1) + k] = p[1];
+            }
+        }
+        t.near_field = std::make_shared<const NearFieldData>(std::move(near));
     }
     if (Status s = t.validate()) return *s;
     return t;

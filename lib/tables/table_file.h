@@ -1,19 +1,29 @@
-// Sampling tables on disk: 32-bit float OpenEXR textures with hairis metadata.
+// Sampling tables on disk: 32-bit float OpenEXR textures with hairis metadata, one image that
+// Blender loads, shows and packs like any other.
 //
-// Layout (one part, scanline, ZIP compression, channels R, G, B, A, all FLOAT):
-//   width  = phi_count, height = theta_r_count × theta_i_count.
-//   Row y = r·theta_i_count + i holds θ_r node r and θ_i cell i (θ_i ascending from −π/2);
-//   column j is φ cell j (φ ascending from −π).
-//   R  the direct-scattering density S_direct(θ_i, φ | θ_r) per steradian (cell average);
-//   G  the multiple-scattering density S_multiple(θ_i | θ_r, n_h) per steradian: the φ columns
-//      are cut into n_h_count equal bands, band k holds n_h_values[k] repeated over its
-//      columns (so Blender's image editor shows one vertical stripe per n_h);
-//   B  0;  A  1.
-// Metadata (EXR header attributes): hairis:format_version (int), hairis:model (string),
-// hairis:source ("exact" or "gaussian"), hairis:parameters (string "name=value;..."),
-// hairis:theta_r_count, hairis:theta_i_count, hairis:phi_count (int), hairis:theta_r_nodes
-// (float array, radians), hairis:n_h_values (int array), hairis:pixel_sha1 (hex SHA-1 of the
-// float pixel data in scanline order, RGBA interleaved, little-endian).
+// One part, scanline, ZIP, channels R, G, B, A, all FLOAT. The image stacks the table's parts
+// from the top row down, each padded with zeros to the widest (hairis:parts names them):
+//  far   rows y = r·theta_i_count + i for θ_r node r and θ_i cell i (θ_i ascending from −π/2),
+//        columns j < phi_count for φ cell j (φ = φ_i − φ_o ascending from −π):
+//        R  the direct-scattering density S_direct(θ_i, φ | θ_r) per steradian (cell average);
+//        G  the multiple-scattering density S_multiple(θ_i | θ_r, n_h) per steradian: the φ
+//           columns are cut into n_h_count equal bands, band k holds n_h_values[k] repeated
+//           (Blender's image editor shows one vertical stripe per n_h);
+//        B  0;  A  1.
+//  near  (Chiang) rows r·4 + p after the far part for θ_o node r (equally spaced over
+//        [−π/2, π/2], ends included) and lobe p (R, TT, TRT, TRRT+), columns k ≤ theta_i:
+//        R  the mass of θ_i cell k of the lobe's M_p·cos θ_i (0 in the last column);
+//        G  M_p at the lower edge of cell k (the last column: the upper edge of the last cell);
+//        B  the lobe's integral ∫ M_p cos θ_i dθ_i, along the whole row;
+//        A  1 when the lobe draws θ_i from the fiber's cone instead of the row, along the row.
+//        This is what the TABLE strategy samples single scattering from (near_field_table.h).
+// Metadata (EXR header attributes): hairis:format_version (2), hairis:model (string),
+// hairis:source ("exact" or "gaussian"), hairis:parameters ("name=value;..."),
+// hairis:theta_r_count, hairis:theta_i_count, hairis:phi_count (the far part), hairis:theta_r_nodes
+// (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far" or "far,near"),
+// hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:pixel_sha1 (hex SHA-1 of the float
+// pixels in scanline order, RGBA interleaved, little-endian). Every pixel outside the parts is 0.
+// Version 1 files (no near part) are refused with a message asking for a re-bake.
 #pragma once
 
 #include <cstddef>
@@ -27,7 +37,7 @@
 namespace hairis {
 
 /// The version this build writes and the only one it reads.
-inline constexpr int kTableFormatVersion = 1;
+inline constexpr int kTableFormatVersion = 2;
 
 /// Encodes a table set as EXR bytes. Refuses an invalid set.
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &tables);

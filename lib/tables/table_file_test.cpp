@@ -162,9 +162,16 @@ TEST(TableFile, RefusesCorruptBytes) {
 
 TEST(TableFile, RefusesWrongVersion) {
     const auto bytes = tamper(encode(small_tables()), [](OIIO::ImageSpec &spec, std::vector<float> &) {
-        spec.attribute("hairis:format_version", 2);
+        spec.attribute("hairis:format_version", 3);
     });
-    expect_refused(bytes, "format version 2 is not supported");
+    expect_refused(bytes, "format version 3 is not supported");
+}
+
+TEST(TableFile, RefusesVersionOneAskingForARebake) {
+    const auto bytes = tamper(encode(small_tables()), [](OIIO::ImageSpec &spec, std::vector<float> &) {
+        spec.attribute("hairis:format_version", 1);
+    });
+    expect_refused(bytes, "re-bake the tables");
 }
 
 TEST(TableFile, RefusesForeignExr) {
