@@ -187,6 +187,9 @@ void for_each_item(size_t n, const F &f) {
 
 /// The canonical "name=value;..." string of a fiber spec (what table metadata records).
 std::string spec_parameters(const FiberSpec &spec);
+/// What hairis_fiber_create starts from for a model (hairis_defaults lists it): the node's
+/// defaults for Chiang, the seed's blonde parameters for Marschner.
+FiberSpec default_fiber_spec(FiberKind kind);
 
 }  // namespace hairis::capi
 
