@@ -1154,7 +1154,7 @@ static void test_sampling(void)
         CHECK(s == NULL, "TABLE with tables of another fiber");
         CHECK_ERROR_MENTIONS("baked for");
         hairis_sampler_destroy(s);
-        /* The code says which: sample through a scene render (same policy) in test_render. */
+        /* (A handle call has no status: test_render checks the code, INVALID_TABLE.) */
         hairis_fiber_destroy(rougher);
     }
     CHECK(hairis_sampler_create(NULL, NULL, "strategy=gaussian;n_h=3") == NULL,
