@@ -14,7 +14,7 @@
 namespace {
 
 void sample_tables(const hairis_tables *tables) {
-    hairis_sampler *sampler = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, nullptr, tables, 0.25f, 1);
+    hairis_sampler *sampler = hairis_sampler_create(nullptr, tables, "strategy=table;multiple_weight=0.25;n_h=1");
     if (!sampler) {
         hairis::fuzz::check_last_error("hairis_sampler_create");
         return;

@@ -61,6 +61,10 @@ struct Refusal {
 
 /// Records an exception that is not a Refusal as an internal error of `function`.
 int report_exception(const char *function, std::exception_ptr error) noexcept;
+/// Records a refusal; one with HAIRIS_ERROR_INTERNAL is worded as report_exception words its
+/// errors ("<function>: internal error (please report): ..."), so that calls returning a
+/// handle, which have no status, still say that it is a bug.
+void report_refusal(const char *function, const Refusal &refusal) noexcept;
 
 /// Runs f() -> int (a status) at the boundary: clears the last error on HAIRIS_OK.
 template <typename F>
@@ -70,7 +74,7 @@ int guard_status(const char *function, F &&f) noexcept {
         if (code == HAIRIS_OK) clear_error();
         return code;
     } catch (const Refusal &r) {
-        set_error(r.message);
+        report_refusal(function, r);
         return r.code;
     } catch (...) {
         return report_exception(function, std::current_exception());
@@ -85,7 +89,7 @@ T *guard_handle(const char *function, F &&f) noexcept {
         clear_error();
         return handle;
     } catch (const Refusal &r) {
-        set_error(r.message);
+        report_refusal(function, r);
     } catch (...) {
         report_exception(function, std::current_exception());
     }
@@ -100,7 +104,7 @@ T guard_value(const char *function, T failure, F &&f) noexcept {
         clear_error();
         return value;
     } catch (const Refusal &r) {
-        set_error(r.message);
+        report_refusal(function, r);
     } catch (...) {
         report_exception(function, std::current_exception());
     }
@@ -114,7 +118,7 @@ void guard_void(const char *function, F &&f) noexcept {
         f();
         clear_error();
     } catch (const Refusal &r) {
-        set_error(r.message);
+        report_refusal(function, r);
     } catch (...) {
         report_exception(function, std::current_exception());
     }
@@ -187,6 +191,9 @@ void for_each_item(size_t n, const F &f) {
 
 /// The canonical "name=value;..." string of a fiber spec (what table metadata records).
 std::string spec_parameters(const FiberSpec &spec);
+/// What hairis_fiber_create starts from for a model (hairis_defaults lists it): the node's
+/// defaults for Chiang, the seed's blonde parameters for Marschner.
+FiberSpec default_fiber_spec(FiberKind kind);
 
 }  // namespace hairis::capi
 

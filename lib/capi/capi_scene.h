@@ -17,9 +17,13 @@
 
 namespace hairis {
 
-// Option names of the core's lights (found by describe()'s argument-dependent lookup).
-inline constexpr double kHugeOption = double(std::numeric_limits<float>::max());
+/// The bound of float options without a limit: the largest float as "%.9g" writes it. As a
+/// double it lies just above FLT_MAX, yet reads back as FLT_MAX, so a written default at the
+/// limit (the camera's clip_end) reads back.
+inline constexpr double kHugeOption = 3.40282347e+38;
+static_assert(float(kHugeOption) == std::numeric_limits<float>::max());
 
+// Option names of the core's lights (found by describe()'s argument-dependent lookup).
 /// "type=sun": direction towards the sun, W/m², angular diameter (radians).
 template <typename Fields>
 void describe(Fields &f, SunLight &o) {
@@ -49,7 +53,7 @@ void describe(Fields &f, WorldLight &o) {
 
 namespace hairis::capi {
 
-inline constexpr double kHuge = double(std::numeric_limits<float>::max());
+inline constexpr double kHuge = kHugeOption;
 
 /// A hair material as the C API keeps it until a render: its fiber and, optionally, tables
 /// (shared with the hairis_tables they came from). The sampler is made by hairis_render from
@@ -98,7 +102,7 @@ struct CameraOptions {
     float frame[12] = {0.5f, 0.5f, -1, 0.5f, -0.5f, -1, -0.5f, -0.5f, -1, -0.5f, 0.5f, -1};
     int width = 64, height = 64;
     float clip_start = 0.0f;
-    float clip_end = float(kHuge);  ///< the largest float: no far clip
+    float clip_end = std::numeric_limits<float>::max();  ///< the largest float: no far clip
 };
 template <typename Fields>
 void describe(Fields &f, CameraOptions &o) {

@@ -13,8 +13,8 @@ namespace {
 thread_local std::string t_defaults;
 
 std::string defaults_of(const std::string &kind) {
-    if (kind == "chiang") return FiberSpec{}.options();
-    if (kind == "marschner") return FiberSpec::preset("blonde").value().options();
+    if (kind == "chiang") return default_fiber_spec(FiberKind::Chiang).options();
+    if (kind == "marschner") return default_fiber_spec(FiberKind::Marschner).options();
     if (kind == "bake") return write_options(BakeOptions{});
     if (kind == "sampler") return write_options(SamplerOptions{});
     if (kind == "render") return write_options(RenderOptions{});

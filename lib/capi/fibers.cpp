@@ -1,7 +1,9 @@
 // C API: fibers. A hairis_fiber keeps the FiberSpec it was made from, so that its model name
 // and "name=value;..." parameters are exactly what fiber_spec.h gives the baker and what
 // table metadata records (hairis_tables_match_fiber compares those strings).
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "capi_internal.h"
 #include "fiber/marschner.h"
@@ -15,19 +17,51 @@ std::string spec_parameters(const FiberSpec &spec) {
     return canonical_parameters(p.value());
 }
 
-/// The spec of `options`: "model" first (it picks the keys), then every key through
-/// FiberSpec::set, which names what it refuses.
+FiberSpec default_fiber_spec(FiberKind kind) {
+    FiberSpec spec;
+    spec.kind = kind;
+    if (kind == FiberKind::Marschner) spec.marschner = MarschnerParams::blonde();
+    return spec;
+}
+
+namespace {
+
+// The names hairis_fiber_create reads for a model: those default_fiber_spec(kind).options()
+// lists (hairis_defaults), and offset_deg for Chiang.
+std::vector<std::string> fiber_option_names(FiberKind kind) {
+    std::vector<std::string> names;
+    Expected<OptionItems> items = parse_options(default_fiber_spec(kind).options(), "defaults");
+    if (!items) invalid(items.error().message);
+    for (const auto &item : items.value()) names.push_back(item.first);
+    if (kind == FiberKind::Chiang) names.push_back("offset_deg");
+    return names;
+}
+
+}  // namespace
+
+/// The spec of `options`: "model" first (it picks the names and the defaults), then every
+/// other name through FiberSpec::set, which names what it refuses. A name the model does not
+/// read (a Marschner name for Chiang, "preset") is refused, listing the model's names.
 FiberSpec fiber_spec_of(const char *options) {
     Expected<OptionItems> items = parse_options(options ? options : "", "fiber options");
     if (!items) invalid(items.error().message);
     FiberSpec spec;
     for (const auto &[key, value] : items.value())
         if (key == "model") ok_or_invalid(spec.set(key, value), "fiber options: ");
+    spec = default_fiber_spec(spec.kind);
+    const char *model = spec.kind == FiberKind::Marschner ? "marschner" : "chiang";
+    const std::vector<std::string> known = fiber_option_names(spec.kind);
+    bool offset = false, offset_deg = false;
     for (const auto &[key, value] : items.value()) {
-        if (key == "model" || key == "preset") {
-            if (key == "preset") invalid("fiber options: preset is not an option of the C API (use model and its keys)");
-            continue;
+        if (std::find(known.begin(), known.end(), key) == known.end()) {
+            std::string list;
+            for (const std::string &name : known) list += (list.empty() ? "" : ", ") + name;
+            invalid("fiber options: unknown option \"" + key + "\" for model=" + model + " (known: " + list + ")");
         }
+        offset = offset || key == "offset";
+        offset_deg = offset_deg || key == "offset_deg";
+        if (offset && offset_deg)
+            invalid("fiber options: offset (radians) and offset_deg (degrees) set the same angle: give one");
         if (Status s = spec.set(key, value)) invalid("fiber options: " + s->message);
     }
     return spec;

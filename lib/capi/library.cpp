@@ -64,6 +64,18 @@ int report_exception(const char *function, std::exception_ptr error) noexcept {
     return HAIRIS_ERROR_INTERNAL;
 }
 
+void report_refusal(const char *function, const Refusal &refusal) noexcept {
+    if (refusal.code != HAIRIS_ERROR_INTERNAL) {
+        set_error(refusal.message);
+        return;
+    }
+    try {
+        set_error(std::string(function) + ": internal error (please report): " + refusal.message);
+    } catch (...) {
+        set_error(refusal.message);
+    }
+}
+
 int code_of(ErrorKind kind) {
     switch (kind) {
         case ErrorKind::InvalidTable: return HAIRIS_ERROR_INVALID_TABLE;

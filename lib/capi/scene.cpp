@@ -2,6 +2,7 @@
 // camera). Every input is checked when it is added, so an error names the call and argument
 // that caused it; Scene::build (at render time) checks the whole again.
 #include <climits>
+#include <limits>
 #include <string>
 
 #include "capi_scene.h"
@@ -232,7 +233,7 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
         desc.width = c.width;
         desc.height = c.height;
         desc.clip_start = c.clip_start;
-        desc.clip_end = double(c.clip_end) >= kHuge ? INFINITY : c.clip_end;
+        desc.clip_end = c.clip_end >= std::numeric_limits<float>::max() ? INFINITY : c.clip_end;
         // Refused now rather than at render time; the messages start with "camera: ".
         Expected<Camera> checked = Camera::create(desc);
         if (!checked) invalid(checked.error().message);

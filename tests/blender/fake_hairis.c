@@ -1,20 +1,23 @@
 /* A stand-in for libhairis used by the Blender add-on tests.
  *
- * It implements every function of lib/include/hairis/hairis.h with trivial physics (the
- * render is the world radiance, the sampler is uniform), but with the real header's
- * conventions: thread-local last error, argument checks, progress callbacks that cancel,
- * table files that round-trip and match fibers by their parameter string. Compiled against the
- * real header, it also exports hairis_fake_sizeof/hairis_fake_offsetof so the tests can check
- * the ctypes mirrors of the structs field by field.
+ * It implements every function of lib/include/hairis/hairis.h and hairis_render.h (compiled
+ * against them, so the compiler checks the signatures) with trivial physics: the render is
+ * the world radiance (every camera ray misses), the sampler is uniform. It keeps the real
+ * API's conventions: thread-local last error, option strings "name=value;..." whose names are
+ * those of hairis_defaults (the same strings the real library lists; unknown and repeated
+ * names are refused, naming them and listing the known ones), argument checks, progress
+ * callbacks that cancel, table files that round-trip and match fibers by their parameter
+ * string, and TABLE renders refused with HAIRIS_ERROR_INVALID_TABLE naming the material.
  *
  * Test hooks (environment variables):
- *   HAIRIS_FAKE_API_VERSION   value returned by hairis_api_version (default 1)
+ *   HAIRIS_FAKE_API_VERSION   value returned by hairis_api_version (default HAIRIS_API_VERSION)
  *   HAIRIS_FAKE_ROW_DELAY_MS  sleep per rendered row (to test cancelling)
  *   HAIRIS_FAKE_SUMMARY       hairis_render appends a summary of the scene to this file
  *   HAIRIS_FAKE_NOISE         relative noise of the rendered pixels (default 0: exact)
  */
 #define _POSIX_C_SOURCE 200809L
 #include "hairis/hairis.h"
+#include "hairis/hairis_render.h"
 
 #include <errno.h>
 #include <math.h>
@@ -24,9 +27,9 @@
 #include <string.h>
 #include <time.h>
 
-#define FAKE_EXPORT HAIRIS_API
-
-static _Thread_local char last_error[1024];
+static _Thread_local char last_error[2048];
+static _Thread_local char defaults_text[1024];
+static _Thread_local char render_stats[512];
 
 static void clear_error(void) { last_error[0] = '\0'; }
 
@@ -53,134 +56,411 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* ---- Option strings ----------------------------------------------------------------------- */
+
+/* Each kind's names with their defaults, as the real library's hairis_defaults lists them. */
+static const char *const kinds[][2] = {
+    {"chiang", "model=chiang;cycles=3.4;parametrization=color;"
+               "color=0.0175129995,0.00576299988,0.00205900008;tint=1,1,1;"
+               "absorption=0.245530993,0.519999981,1.36500001;melanin=0.800000012;"
+               "melanin_redness=1;roughness=0.300000012;radial_roughness=0.300000012;coat=0;"
+               "ior=1.54999995;offset=0.0349065848;random_color=0;random_roughness=0;random=0"},
+    {"marschner", "model=marschner;sigma_a=0.150000006,0.200000003,0.300000012;eta=1.55;"
+                  "alpha_r_deg=-7.5;alpha_tt_deg=3.75;alpha_trt_deg=11.25;beta_r_deg=7.5;"
+                  "beta_tt_deg=3.725;beta_trt_deg=15;eccentricity=0.9;glint_scale=0.4;"
+                  "caustic_width_deg=1.5;caustic_fade=0.3;caustic_limit=0.5"},
+    {"bake", "theta_r=31;theta_i=64;phi=64;n_h=1,2,4,8,16;source=exact;quadrature_points=2;"
+             "threads=0"},
+    {"sampler", "strategy=table;multiple_weight=0;n_h=2"},
+    {"diffuse", "type=diffuse;color=0.800000012,0.800000012,0.800000012;emission=0,0,0"},
+    {"sun", "type=sun;direction=0,0,1;color=1,1,1;strength=1;angle=0"},
+    {"point", "type=point;position=0,0,0;color=1,1,1;power=10;radius=0"},
+    {"area", "type=area;matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;shape=square;size=1;size_y=1;"
+             "color=1,1,1;power=10"},
+    {"world", "color=0,0,0;strength=1"},
+    {"camera", "matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;orthographic=0;"
+               "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
+               "clip_start=0;clip_end=3.40282347e+38"},
+    {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_transmission_bounces=12;"
+               "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
+               "strategy=table;multiple_weight=0;n_h=2"},
+};
+enum { KIND_COUNT = sizeof kinds / sizeof kinds[0] };
+
+static const char *defaults_of(const char *kind)
+{
+    for (int k = 0; k < KIND_COUNT; ++k)
+        if (strcmp(kinds[k][0], kind) == 0) return kinds[k][1];
+    return NULL;
+}
+
+enum { MAX_ITEMS = 48, NAME_SIZE = 64, VALUE_SIZE = 512 };
+
+typedef struct option_item {
+    char name[NAME_SIZE];
+    char value[VALUE_SIZE];
+} option_item;
+
+/* An option string's items: its own (given) over the kind's defaults (known). */
+typedef struct options {
+    const char *what;
+    option_item known[MAX_ITEMS];
+    int known_count;
+    int given[MAX_ITEMS]; /* per known item: given in the string */
+} options;
+
+static void trim(char *s)
+{
+    size_t n = strlen(s), a = 0;
+    while (a < n && (s[a] == ' ' || s[a] == '\t' || s[a] == '\r' || s[a] == '\n')) ++a;
+    while (n > a && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r' || s[n - 1] == '\n'))
+        --n;
+    memmove(s, s + a, n - a);
+    s[n - a] = '\0';
+}
+
+/* Calls f(name, value) for each item of "name=value;..."; stops at an error (returned). */
+typedef int (*item_fn)(options *o, const char *name, const char *value);
+
+static int for_each_item(const char *text, options *o, item_fn f)
+{
+    const char *p = text ? text : "";
+    while (1) {
+        const char *end = strchr(p, ';');
+        const size_t length = end ? (size_t)(end - p) : strlen(p);
+        char item[NAME_SIZE + VALUE_SIZE + 2];
+        if (length >= sizeof item)
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: an item is too long for the fake",
+                        o->what);
+        memcpy(item, p, length);
+        item[length] = '\0';
+        trim(item);
+        if (item[0] != '\0') {
+            char *eq = strchr(item, '=');
+            if (!eq) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: \"%s\" is not name=value", o->what, item);
+            *eq = '\0';
+            char *name = item, *value = eq + 1;
+            trim(name);
+            trim(value);
+            if (name[0] == '\0')
+                return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: \"=%s\" has no name before '='",
+                            o->what, value);
+            const int status = f(o, name, value);
+            if (status != HAIRIS_OK) return status;
+        }
+        if (!end) return HAIRIS_OK;
+        p = end + 1;
+    }
+}
+
+static int add_known(options *o, const char *name, const char *value)
+{
+    if (o->known_count >= MAX_ITEMS) return fail(HAIRIS_ERROR_INTERNAL, "fake: too many names");
+    snprintf(o->known[o->known_count].name, NAME_SIZE, "%s", name);
+    snprintf(o->known[o->known_count].value, VALUE_SIZE, "%s", value);
+    o->given[o->known_count] = 0;
+    ++o->known_count;
+    return HAIRIS_OK;
+}
+
+static int set_given(options *o, const char *name, const char *value)
+{
+    for (int i = 0; i < o->known_count; ++i) {
+        if (strcmp(o->known[i].name, name) != 0) continue;
+        if (o->given[i])
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: %s is given twice", o->what, name);
+        o->given[i] = 1;
+        snprintf(o->known[i].value, VALUE_SIZE, "%s", value);
+        return HAIRIS_OK;
+    }
+    char list[1024] = "";
+    for (int i = 0; i < o->known_count; ++i) {
+        const size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s %s", i ? "," : "", o->known[i].name);
+    }
+    return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: unknown option \"%s\" (known:%s)", o->what, name,
+                list);
+}
+
+/* Reads `text` as options of `kind` (plus `extra`, a name with its default, or NULL). */
+static int read_options(const char *text, const char *kind, const char *what, const char *extra,
+                        options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->what = what;
+    int status = for_each_item(defaults_of(kind), o, add_known);
+    if (status == HAIRIS_OK && extra) {
+        char name[NAME_SIZE];
+        snprintf(name, sizeof name, "%s", extra);
+        char *eq = strchr(name, '=');
+        *eq = '\0';
+        status = add_known(o, name, eq + 1);
+    }
+    return status == HAIRIS_OK ? for_each_item(text, o, set_given) : status;
+}
+
+/* The value of the first item called `name` in "name=value;..." ("" when absent). */
+static void find_value(const char *text, const char *name, char *out, size_t size)
+{
+    out[0] = '\0';
+    const char *p = text ? text : "";
+    while (*p) {
+        const char *end = strchr(p, ';');
+        const size_t length = end ? (size_t)(end - p) : strlen(p);
+        char item[NAME_SIZE + VALUE_SIZE + 2];
+        snprintf(item, sizeof item, "%.*s", (int)(length < sizeof item ? length : sizeof item - 1), p);
+        char *eq = strchr(item, '=');
+        if (eq) {
+            *eq = '\0';
+            trim(item);
+            trim(eq + 1);
+            if (strcmp(item, name) == 0) {
+                snprintf(out, size, "%s", eq + 1);
+                return;
+            }
+        }
+        if (!end) return;
+        p = end + 1;
+    }
+}
+
+static const char *value_of(const options *o, const char *name)
+{
+    for (int i = 0; i < o->known_count; ++i)
+        if (strcmp(o->known[i].name, name) == 0) return o->known[i].value;
+    return "";
+}
+
+static int given(const options *o, const char *name)
+{
+    for (int i = 0; i < o->known_count; ++i)
+        if (strcmp(o->known[i].name, name) == 0) return o->given[i];
+    return 0;
+}
+
+/* `count` finite numbers separated by ','. */
+static int numbers(const options *o, const char *name, double *out, int count)
+{
+    const char *p = value_of(o, name);
+    for (int k = 0; k < count; ++k) {
+        char *end = NULL;
+        errno = 0;
+        out[k] = strtod(p, &end);
+        while (end && *end == ' ') ++end;
+        const char want = k + 1 < count ? ',' : '\0';
+        if (end == p || !end || *end != want || !isfinite(out[k]))
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: %s must be %d finite number%s (got \"%s\")",
+                        o->what, name, count, count > 1 ? "s separated by ','" : "",
+                        value_of(o, name));
+        p = end + (want ? 1 : 0);
+    }
+    return HAIRIS_OK;
+}
+
+static int number_in(const options *o, const char *name, double lo, double hi, double *out)
+{
+    if (numbers(o, name, out, 1) != HAIRIS_OK) return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (*out < lo || *out > hi)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: %s must be in [%g, %g] (got %s)", o->what,
+                    name, lo, hi, value_of(o, name));
+    return HAIRIS_OK;
+}
+
+static int integer_in(const options *o, const char *name, long long lo, long long hi, long long *out)
+{
+    const char *text = value_of(o, name);
+    char *end = NULL;
+    errno = 0;
+    *out = strtoll(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || *out < lo || *out > hi)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: %s must be an integer in [%lld, %lld] (got \"%s\")",
+                    o->what, name, lo, hi, text);
+    return HAIRIS_OK;
+}
+
+/* One of `count` words; *out receives its index. */
+static int word(const options *o, const char *name, const char *const *words, int count, int *out)
+{
+    const char *text = value_of(o, name);
+    char allowed[256] = "";
+    for (int k = 0; k < count; ++k) {
+        if (strcmp(text, words[k]) == 0) {
+            *out = k;
+            return HAIRIS_OK;
+        }
+        const size_t used = strlen(allowed);
+        snprintf(allowed + used, sizeof allowed - used, "%s%s", k ? ", " : "", words[k]);
+    }
+    return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s: %s must be one of %s (got \"%s\")", o->what, name,
+                allowed, text);
+}
+
 /* ---- Library ------------------------------------------------------------------------------ */
 
 int hairis_api_version(void)
 {
+    clear_error();
     const char *override = getenv("HAIRIS_FAKE_API_VERSION");
     return override ? atoi(override) : HAIRIS_API_VERSION;
 }
 
-const char *hairis_version_string(void) { return "0.0.0-fake"; }
+const char *hairis_version_string(void)
+{
+    clear_error();
+    return "0.0.0-fake";
+}
 
 const char *hairis_last_error(void) { return last_error; }
+
+const char *hairis_defaults(const char *kind)
+{
+    if (!kind) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "kind must not be NULL");
+        return NULL;
+    }
+    const char *d = defaults_of(kind);
+    if (!d) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+             "kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
+             "area, world, camera (got \"%s\")",
+             kind);
+        return NULL;
+    }
+    snprintf(defaults_text, sizeof defaults_text, "%s", d);
+    clear_error();
+    return defaults_text;
+}
 
 /* ---- Fibers ------------------------------------------------------------------------------- */
 
 struct hairis_fiber {
     char model[32];
-    char parameters[768];
+    char parameters[1024];
+    int chiang;
 };
 
-void hairis_principled_hair_defaults(hairis_principled_hair *node)
+/* Every number of a value printed as a float ("%.9g"), words as they are: equal inputs give
+ * equal parameter strings. */
+static void canonical_value(const char *value, char *out, size_t size)
 {
-    if (!node) return;
-    memset(node, 0, sizeof *node);
-    node->parametrization = HAIRIS_PARAM_COLOR;
-    node->color[0] = 0.017513f;
-    node->color[1] = 0.005763f;
-    node->color[2] = 0.002059f;
-    node->melanin = 0.8f;
-    node->melanin_redness = 1.0f;
-    node->tint[0] = node->tint[1] = node->tint[2] = 1.0f;
-    node->absorption_coefficient[0] = 0.245531f;
-    node->absorption_coefficient[1] = 0.52f;
-    node->absorption_coefficient[2] = 1.365f;
-    node->roughness = 0.3f;
-    node->radial_roughness = 0.3f;
-    node->coat = 0.0f;
-    node->ior = 1.55f;
-    node->offset = 0.034906585f;
+    out[0] = '\0';
+    const char *p = value;
+    while (1) {
+        char *end = NULL;
+        const double v = strtod(p, &end);
+        if (end == p || (*end != ',' && *end != '\0')) {
+            snprintf(out, size, "%s", value); /* not a list of numbers */
+            return;
+        }
+        const size_t used = strlen(out);
+        snprintf(out + used, size - used, "%s%.9g", used ? "," : "", (double)(float)v);
+        if (*end == '\0') return;
+        p = end + 1;
+    }
 }
 
-void hairis_marschner_defaults(hairis_marschner_params *p)
+hairis_fiber *hairis_fiber_create(const char *text)
 {
-    if (!p) return;
-    memset(p, 0, sizeof *p);
-    p->eta = 1.55f;
-    p->sigma_a[0] = 0.2f;
-    p->sigma_a[1] = 0.3f;
-    p->sigma_a[2] = 0.5f;
-    p->alpha_r = -0.1f;
-    p->alpha_tt = 0.05f;
-    p->alpha_trt = 0.15f;
-    p->beta_r = 0.1f;
-    p->beta_tt = 0.05f;
-    p->beta_trt = 0.2f;
-    p->eccentricity = 0.9f;
-    p->glint_scale = 1.0f;
-    p->caustic_width = 0.3f;
-    p->caustic_fade = 0.3f;
-    p->caustic_intensity_limit = 0.5f;
-}
-
-static int check_principled(const hairis_principled_hair *n)
-{
-    const float *values = &n->color[0];
-    size_t count = (sizeof *n - offsetof(hairis_principled_hair, color)) / sizeof(float);
-    for (size_t i = 0; i < count; ++i)
-        if (!isfinite(values[i]))
-            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "node value %zu is not finite", i);
-    if (n->parametrization < 0 || n->parametrization > 2)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-                    "parametrization %d is not 0 (absorption), 1 (melanin) or 2 (color)",
-                    n->parametrization);
-    if (!(n->ior > 1.0f))
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "IOR must be > 1, got %g", (double)n->ior);
-    if (n->roughness < 0.0f || n->roughness > 1.0f)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "Roughness must be in [0, 1], got %g",
-                    (double)n->roughness);
-    return HAIRIS_OK;
-}
-
-hairis_fiber *hairis_fiber_create_principled(const hairis_principled_hair *n)
-{
-    if (!n) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "node is NULL");
+    /* The model picks the names. */
+    char model_name[64];
+    find_value(text, "model", model_name, sizeof model_name);
+    const int marschner = strcmp(model_name, "marschner") == 0;
+    options o;
+    if (read_options(text, marschner ? "marschner" : "chiang", "fiber options",
+                     marschner ? NULL : "offset_deg=2", &o) != HAIRIS_OK)
+        return NULL;
+    const char *models[2] = {"chiang", "marschner"};
+    int model = 0;
+    if (word(&o, "model", models, 2, &model) != HAIRIS_OK) return NULL;
+    double v[3];
+    if (!marschner) {
+        const char *parametrizations[3] = {"absorption", "melanin", "color"};
+        int p = 0;
+        if (word(&o, "parametrization", parametrizations, 3, &p) != HAIRIS_OK) return NULL;
+        const char *vectors[3] = {"color", "tint", "absorption"};
+        for (int k = 0; k < 3; ++k)
+            if (numbers(&o, vectors[k], v, 3) != HAIRIS_OK) return NULL;
+        const char *scalars[] = {"cycles", "melanin", "melanin_redness", "roughness",
+                                 "radial_roughness", "coat", "ior", "offset", "offset_deg",
+                                 "random_color", "random_roughness", "random"};
+        for (size_t k = 0; k < sizeof scalars / sizeof scalars[0]; ++k)
+            if (numbers(&o, scalars[k], v, 1) != HAIRIS_OK) return NULL;
+        numbers(&o, "ior", v, 1);
+        if (!(v[0] > 1.0)) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: ior: IOR must be > 1, got %g", v[0]);
+            return NULL;
+        }
+        if (number_in(&o, "roughness", 0.0, 1.0, v) != HAIRIS_OK) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: roughness: Roughness must be in [0, 1], got %s",
+                 value_of(&o, "roughness"));
+            return NULL;
+        }
+        if (given(&o, "offset") && given(&o, "offset_deg")) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: offset and offset_deg set the same angle: give one");
+            return NULL;
+        }
+    } else {
+        if (numbers(&o, "sigma_a", v, 3) != HAIRIS_OK) return NULL;
+        for (int i = 0; i < o.known_count; ++i)
+            if (strcmp(o.known[i].name, "model") != 0 && strcmp(o.known[i].name, "sigma_a") != 0 &&
+                numbers(&o, o.known[i].name, v, 1) != HAIRIS_OK)
+                return NULL;
+        numbers(&o, "eta", v, 1);
+        if (!(v[0] > 1.0)) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: eta must be > 1, got %g", v[0]);
+            return NULL;
+        }
+    }
+    hairis_fiber *f = calloc(1, sizeof *f);
+    if (!f) {
+        fail(HAIRIS_ERROR_INTERNAL, "hairis_fiber_create: out of memory");
         return NULL;
     }
-    if (check_principled(n) != HAIRIS_OK) return NULL;
-    hairis_fiber *f = calloc(1, sizeof *f);
-    snprintf(f->model, sizeof f->model, "chiang2016");
-    snprintf(f->parameters, sizeof f->parameters,
-             "parametrization=%d;color=%.9g,%.9g,%.9g;melanin=%.9g;melanin_redness=%.9g;"
-             "tint=%.9g,%.9g,%.9g;absorption=%.9g,%.9g,%.9g;roughness=%.9g;"
-             "radial_roughness=%.9g;coat=%.9g;ior=%.9g;offset=%.9g;random_color=%.9g;"
-             "random_roughness=%.9g;random=%.9g",
-             n->parametrization, n->color[0], n->color[1], n->color[2], n->melanin,
-             n->melanin_redness, n->tint[0], n->tint[1], n->tint[2],
-             n->absorption_coefficient[0], n->absorption_coefficient[1],
-             n->absorption_coefficient[2], n->roughness, n->radial_roughness, n->coat, n->ior,
-             n->offset, n->random_color, n->random_roughness, n->random);
+    snprintf(f->model, sizeof f->model, "%s", marschner ? "marschner2003" : "chiang2016");
+    f->chiang = !marschner;
+    /* The parameters: every name but model (offset_deg as offset), canonical numbers. */
+    for (int i = 0; i < o.known_count; ++i) {
+        const char *name = o.known[i].name;
+        if (strcmp(name, "model") == 0 || strcmp(name, "offset_deg") == 0) continue;
+        char value[VALUE_SIZE];
+        if (strcmp(name, "offset") == 0 && given(&o, "offset_deg")) {
+            numbers(&o, "offset_deg", v, 1);
+            snprintf(value, sizeof value, "%.9g", (double)(float)(v[0] * 3.14159265358979 / 180.0));
+        } else {
+            canonical_value(o.known[i].value, value, sizeof value);
+        }
+        const size_t used = strlen(f->parameters);
+        snprintf(f->parameters + used, sizeof f->parameters - used, "%s%s=%s", used ? ";" : "", name,
+                 value);
+    }
     clear_error();
     return f;
 }
 
-hairis_fiber *hairis_fiber_create_marschner(const hairis_marschner_params *p)
+void hairis_fiber_destroy(hairis_fiber *fiber)
 {
-    if (!p) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "params is NULL");
-        return NULL;
-    }
-    if (!(p->eta > 1.0f)) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "eta must be > 1, got %g", (double)p->eta);
-        return NULL;
-    }
-    hairis_fiber *f = calloc(1, sizeof *f);
-    snprintf(f->model, sizeof f->model, "marschner2003");
-    snprintf(f->parameters, sizeof f->parameters, "eta=%.9g;sigma_a=%.9g,%.9g,%.9g", p->eta,
-             p->sigma_a[0], p->sigma_a[1], p->sigma_a[2]);
+    free(fiber);
     clear_error();
-    return f;
 }
 
-void hairis_fiber_destroy(hairis_fiber *fiber) { free(fiber); }
-
-const char *hairis_fiber_model(const hairis_fiber *fiber) { return fiber ? fiber->model : ""; }
+const char *hairis_fiber_model(const hairis_fiber *fiber)
+{
+    if (!fiber) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
+        return "";
+    }
+    clear_error();
+    return fiber->model;
+}
 
 const char *hairis_fiber_parameters(const hairis_fiber *fiber)
 {
-    return fiber ? fiber->parameters : "";
+    if (!fiber) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
+        return "";
+    }
+    clear_error();
+    return fiber->parameters;
 }
 
 int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, const float *wo,
@@ -188,10 +468,11 @@ int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, cons
 {
     if (!fiber || (n && (!wi || !wo || !rgb_out)))
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber, wi, wo and rgb_out must not be NULL");
+    if (h && !fiber->chiang)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "h must be NULL for a %s fiber", fiber->model);
     for (size_t i = 0; i < n; ++i) {
         float cos_theta = sqrtf(fmaxf(0.0f, 1.0f - wi[3 * i] * wi[3 * i]));
         float value = 0.1f * cos_theta * (h ? 1.0f - fabsf(h[i]) : 1.0f);
-        (void)wo;
         rgb_out[3 * i] = rgb_out[3 * i + 1] = rgb_out[3 * i + 2] = value;
     }
     clear_error();
@@ -202,48 +483,67 @@ int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, cons
 
 struct hairis_tables {
     char model[32];
-    char parameters[768];
+    char parameters[1024];
+    char info[256];
 };
 
 #define FAKE_MAGIC "HAIRISFAKE"
 
-void hairis_bake_options_defaults(hairis_bake_options *o)
-{
-    if (!o) return;
-    memset(o, 0, sizeof *o);
-    o->theta_r_count = 16;
-    o->theta_i_count = 16;
-    o->phi_count = 32;
-    o->n_h_count = 5;
-    for (int i = 0; i < 5; ++i) o->n_h_values[i] = 1 << i;
-}
-
-hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const hairis_bake_options *o,
+hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *text,
                                   hairis_progress_fn progress, void *user)
 {
-    if (!fiber || !o) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber and options must not be NULL");
+    if (!fiber) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
         return NULL;
     }
-    if (o->n_h_count < 1 || o->n_h_count > 16) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "n_h_count must be in [1, 16], got %d", o->n_h_count);
+    options o;
+    if (read_options(text, "bake", "bake options", NULL, &o) != HAIRIS_OK) return NULL;
+    long long theta_r, theta_i, phi, threads, points;
+    if (integer_in(&o, "theta_r", 1, 1024, &theta_r) != HAIRIS_OK ||
+        integer_in(&o, "theta_i", 2, 4096, &theta_i) != HAIRIS_OK ||
+        integer_in(&o, "phi", 1, 4096, &phi) != HAIRIS_OK ||
+        integer_in(&o, "threads", 0, 1024, &threads) != HAIRIS_OK ||
+        integer_in(&o, "quadrature_points", 1, 16, &points) != HAIRIS_OK)
         return NULL;
-    }
-    for (int i = 1; i < o->n_h_count; ++i)
-        if (o->n_h_values[i] <= o->n_h_values[i - 1]) {
-            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "n_h_values must increase");
+    const char *sources[2] = {"exact", "gaussian"};
+    int source = 0;
+    if (word(&o, "source", sources, 2, &source) != HAIRIS_OK) return NULL;
+    /* n_h: 1 to 16 increasing integers. */
+    int n_h_count = 0, previous = 0;
+    const char *p = value_of(&o, "n_h");
+    while (1) {
+        char *end = NULL;
+        const long value = strtol(p, &end, 10);
+        if (end == p || (*end != ',' && *end != '\0') || value < 1 || value > 1024 || n_h_count == 16) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "bake options: n_h must be 1 to 16 integers in [1, 1024] (got \"%s\")",
+                 value_of(&o, "n_h"));
             return NULL;
         }
+        if (n_h_count > 0 && value <= previous) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "bake options: n_h must be increasing (got \"%s\")", value_of(&o, "n_h"));
+            return NULL;
+        }
+        previous = (int)value;
+        ++n_h_count;
+        if (*end == '\0') break;
+        p = end + 1;
+    }
     for (int step = 0; step <= 20; ++step) {
         if (progress && progress(user, (float)step / 20.0f)) {
-            fail(HAIRIS_ERROR_CANCELLED, "bake cancelled");
+            fail(HAIRIS_ERROR_CANCELLED, "cancelled");
             return NULL;
         }
         sleep_ms(2);
     }
     hairis_tables *t = calloc(1, sizeof *t);
+    if (!t) {
+        fail(HAIRIS_ERROR_INTERNAL, "hairis_tables_bake: out of memory");
+        return NULL;
+    }
     memcpy(t->model, fiber->model, sizeof t->model);
     memcpy(t->parameters, fiber->parameters, sizeof t->parameters);
+    snprintf(t->info, sizeof t->info, "source=%s;theta_r=%lld;theta_i=%lld;phi=%lld;n_h=%s",
+             sources[source], theta_r, theta_i, phi, value_of(&o, "n_h"));
     clear_error();
     return t;
 }
@@ -255,7 +555,7 @@ int hairis_tables_write(const hairis_tables *t, const char *path)
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (!f) return fail(HAIRIS_ERROR_IO, "cannot write %s: %s", tmp, strerror(errno));
-    fprintf(f, "%s\n%s\n%s\n", FAKE_MAGIC, t->model, t->parameters);
+    fprintf(f, "%s\n%s\n%s\n%s\n", FAKE_MAGIC, t->model, t->parameters, t->info);
     fclose(f);
     if (rename(tmp, path) != 0) return fail(HAIRIS_ERROR_IO, "cannot rename to %s", path);
     clear_error();
@@ -264,22 +564,27 @@ int hairis_tables_write(const hairis_tables *t, const char *path)
 
 static hairis_tables *parse_tables(const char *text, size_t size, const char *what)
 {
-    char buffer[2048];
+    char buffer[4096];
     if (size >= sizeof buffer) size = sizeof buffer - 1;
     memcpy(buffer, text, size);
     buffer[size] = '\0';
     char *model = strchr(buffer, '\n');
     char *parameters = model ? strchr(model + 1, '\n') : NULL;
-    char *end = parameters ? strchr(parameters + 1, '\n') : NULL;
+    char *info = parameters ? strchr(parameters + 1, '\n') : NULL;
+    char *end = info ? strchr(info + 1, '\n') : NULL;
     if (strncmp(buffer, FAKE_MAGIC "\n", strlen(FAKE_MAGIC) + 1) != 0 || !end) {
         fail(HAIRIS_ERROR_INVALID_TABLE, "%s is not a hairis table file", what);
         return NULL;
     }
-    *parameters = '\0';
-    *end = '\0';
+    *parameters = *info = *end = '\0';
     hairis_tables *t = calloc(1, sizeof *t);
+    if (!t) {
+        fail(HAIRIS_ERROR_INTERNAL, "out of memory");
+        return NULL;
+    }
     snprintf(t->model, sizeof t->model, "%s", model + 1);
     snprintf(t->parameters, sizeof t->parameters, "%s", parameters + 1);
+    snprintf(t->info, sizeof t->info, "%s", info + 1);
     clear_error();
     return t;
 }
@@ -287,15 +592,15 @@ static hairis_tables *parse_tables(const char *text, size_t size, const char *wh
 hairis_tables *hairis_tables_load_file(const char *path)
 {
     if (!path) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "path is NULL");
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "path must not be NULL");
         return NULL;
     }
     FILE *f = fopen(path, "rb");
     if (!f) {
-        fail(HAIRIS_ERROR_IO, "cannot read %s: %s", path, strerror(errno));
+        fail(HAIRIS_ERROR_IO, "cannot open \"%s\" for reading: %s", path, strerror(errno));
         return NULL;
     }
-    char buffer[2048];
+    char buffer[4096];
     size_t size = fread(buffer, 1, sizeof buffer, f);
     fclose(f);
     return parse_tables(buffer, size, path);
@@ -304,17 +609,36 @@ hairis_tables *hairis_tables_load_file(const char *path)
 hairis_tables *hairis_tables_load_memory(const void *data, size_t size)
 {
     if (!data) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "data is NULL");
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "data must not be NULL");
         return NULL;
     }
     return parse_tables((const char *)data, size, "the buffer");
 }
 
-void hairis_tables_destroy(hairis_tables *tables) { free(tables); }
+void hairis_tables_destroy(hairis_tables *tables)
+{
+    free(tables);
+    clear_error();
+}
 
-const char *hairis_tables_model(const hairis_tables *t) { return t ? t->model : ""; }
+static const char *tables_string(const hairis_tables *t, const char *s)
+{
+    if (!t) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "tables must not be NULL");
+        return "";
+    }
+    clear_error();
+    return s;
+}
 
-const char *hairis_tables_parameters(const hairis_tables *t) { return t ? t->parameters : ""; }
+const char *hairis_tables_model(const hairis_tables *t) { return tables_string(t, t ? t->model : ""); }
+
+const char *hairis_tables_parameters(const hairis_tables *t)
+{
+    return tables_string(t, t ? t->parameters : "");
+}
+
+const char *hairis_tables_info(const hairis_tables *t) { return tables_string(t, t ? t->info : ""); }
 
 int hairis_tables_match_fiber(const hairis_tables *t, const hairis_fiber *f)
 {
@@ -332,37 +656,55 @@ struct hairis_sampler {
     int strategy;
 };
 
-hairis_sampler *hairis_sampler_create(hairis_strategy strategy, const hairis_fiber *fiber,
-                                      const hairis_tables *tables, float multiple_weight, int n_h)
+static const char *const strategies[4] = {"uniform", "analytic", "gaussian", "table"};
+
+/* strategy, multiple_weight and n_h of sampler or render options. */
+static int read_strategy(const options *o, int *strategy)
 {
-    if ((int)strategy < 0 || (int)strategy > 3) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "unknown strategy %d", (int)strategy);
+    double weight;
+    long long n_h;
+    if (word(o, "strategy", strategies, 4, strategy) != HAIRIS_OK ||
+        number_in(o, "multiple_weight", 0.0, 1.0, &weight) != HAIRIS_OK ||
+        integer_in(o, "n_h", 1, 1024, &n_h) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    return HAIRIS_OK;
+}
+
+hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, const hairis_tables *tables,
+                                      const char *text)
+{
+    options o;
+    int strategy = 0;
+    if (read_options(text, "sampler", "sampler options", NULL, &o) != HAIRIS_OK ||
+        read_strategy(&o, &strategy) != HAIRIS_OK)
+        return NULL;
+    if (strategy == 1 && !(fiber && fiber->chiang)) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must be a chiang2016 fiber for strategy=analytic");
         return NULL;
     }
-    if (strategy == HAIRIS_STRATEGY_ANALYTIC && !fiber) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "the ANALYTIC strategy needs a fiber");
+    if (strategy == 3 && !tables) {
+        fail(HAIRIS_ERROR_INVALID_TABLE, "tables must not be NULL: the TABLE strategy needs tables");
         return NULL;
     }
-    if (strategy == HAIRIS_STRATEGY_TABLE && !tables) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "the TABLE strategy needs tables");
-        return NULL;
-    }
-    if (!(multiple_weight >= 0.0f && multiple_weight <= 1.0f)) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "multiple_weight must be in [0, 1], got %g",
-             (double)multiple_weight);
-        return NULL;
-    }
-    if (n_h < 1) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "n_h must be >= 1, got %d", n_h);
+    if (strategy == 3 && fiber && fiber->chiang && !hairis_tables_match_fiber(tables, fiber)) {
+        fail(HAIRIS_ERROR_INVALID_TABLE, "sampler options: the tables were baked for other parameters");
         return NULL;
     }
     hairis_sampler *s = calloc(1, sizeof *s);
-    s->strategy = (int)strategy;
+    if (!s) {
+        fail(HAIRIS_ERROR_INTERNAL, "out of memory");
+        return NULL;
+    }
+    s->strategy = strategy;
     clear_error();
     return s;
 }
 
-void hairis_sampler_destroy(hairis_sampler *sampler) { free(sampler); }
+void hairis_sampler_destroy(hairis_sampler *sampler)
+{
+    free(sampler);
+    clear_error();
+}
 
 int hairis_sample(const hairis_sampler *s, size_t n, const float *wo, const float *h,
                   const float *u, float *wi_out, float *pdf_out)
@@ -370,6 +712,9 @@ int hairis_sample(const hairis_sampler *s, size_t n, const float *wo, const floa
     (void)h;
     if (!s || (n && (!wo || !u || !wi_out || !pdf_out)))
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "sampler, wo, u, wi_out, pdf_out: NULL");
+    for (size_t i = 0; i < 3 * n; ++i)
+        if (!(u[i] >= 0.0f && u[i] < 1.0f))
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "u[%zu] must be in [0, 1)", i);
     for (size_t i = 0; i < n; ++i) {
         float z = 1.0f - 2.0f * u[3 * i];
         float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
@@ -403,58 +748,70 @@ struct hairis_scene {
     int material_count;
     int material_is_hair[MAX_MATERIALS];
     int material_has_tables[MAX_MATERIALS];
-    char material_parameters[MAX_MATERIALS][768];
+    int material_tables_match[MAX_MATERIALS];
+    char material_parameters[MAX_MATERIALS][1024];
     size_t curve_sets, curve_count, curve_points;
     double radius_sum, position_sum[3];
     size_t mesh_count, vertex_count, triangle_count;
     int suns, points, areas;
     float world[3];
     int has_camera;
-    hairis_camera camera;
+    int width, height, orthographic;
 };
 
 hairis_scene *hairis_scene_create(void)
 {
-    clear_error();
-    return calloc(1, sizeof(hairis_scene));
+    hairis_scene *s = calloc(1, sizeof(hairis_scene));
+    if (!s) fail(HAIRIS_ERROR_INTERNAL, "out of memory");
+    else clear_error();
+    return s;
 }
 
-void hairis_scene_destroy(hairis_scene *scene) { free(scene); }
+void hairis_scene_destroy(hairis_scene *scene)
+{
+    free(scene);
+    clear_error();
+}
 
-int hairis_scene_add_hair_material(hairis_scene *s, const hairis_principled_hair *node,
+int hairis_scene_add_hair_material(hairis_scene *s, const hairis_fiber *fiber,
                                    const hairis_tables *tables)
 {
-    if (!s || !node) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and node must not be NULL");
+    if (!s || !fiber) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and fiber must not be NULL");
+        return -1;
+    }
+    if (!fiber->chiang) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must be a chiang2016 fiber, got %s", fiber->model);
         return -1;
     }
     if (s->material_count >= MAX_MATERIALS) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "too many materials");
         return -1;
     }
-    hairis_fiber *fiber = hairis_fiber_create_principled(node);
-    if (!fiber) return -1;
-    if (tables && !hairis_tables_match_fiber(tables, fiber)) {
-        hairis_fiber_destroy(fiber);
-        fail(HAIRIS_ERROR_INVALID_TABLE, "the tables were baked for other parameters");
-        return -1;
-    }
+    /* Whether the tables fit is hairis_render's question (TABLE only), as in the library. */
     int index = s->material_count++;
     s->material_is_hair[index] = 1;
     s->material_has_tables[index] = tables != NULL;
+    s->material_tables_match[index] = tables && hairis_tables_match_fiber(tables, fiber);
     memcpy(s->material_parameters[index], fiber->parameters, sizeof fiber->parameters);
-    hairis_fiber_destroy(fiber);
     clear_error();
     return index;
 }
 
-int hairis_scene_add_diffuse_material(hairis_scene *s, const float albedo[3],
-                                      const float emission[3])
+int hairis_scene_add_surface_material(hairis_scene *s, const char *text)
 {
-    if (!s || !albedo || !emission) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene, albedo and emission must not be NULL");
+    options o;
+    double v[3];
+    int type = 0;
+    const char *types[1] = {"diffuse"};
+    if (!s) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
         return -1;
     }
+    if (read_options(text, "diffuse", "surface material", NULL, &o) != HAIRIS_OK ||
+        word(&o, "type", types, 1, &type) != HAIRIS_OK || numbers(&o, "color", v, 3) != HAIRIS_OK ||
+        numbers(&o, "emission", v, 3) != HAIRIS_OK)
+        return -1;
     if (s->material_count >= MAX_MATERIALS) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "too many materials");
         return -1;
@@ -471,6 +828,8 @@ int hairis_scene_add_curves(hairis_scene *s, int material, size_t curve_count,
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument to hairis_scene_add_curves");
     if (material < 0 || material >= s->material_count)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "material %d does not exist", material);
+    if (curve_count > point_count / 2)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "curve_count needs 2 points per curve");
     if (first[0] != 0 || first[curve_count] != point_count)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                     "first[0] must be 0 and first[curve_count] = point_count (%zu), got %u, %u",
@@ -478,10 +837,11 @@ int hairis_scene_add_curves(hairis_scene *s, int material, size_t curve_count,
     for (size_t c = 0; c < curve_count; ++c)
         if (first[c + 1] < first[c] + 2)
             return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "curve %zu has fewer than 2 points", c);
-    for (size_t i = 0; i < point_count; ++i) {
+    for (size_t i = 0; i < point_count; ++i)
         if (!isfinite(positions[3 * i]) || !isfinite(positions[3 * i + 1]) ||
             !isfinite(positions[3 * i + 2]) || !(radii[i] >= 0.0f))
             return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "point %zu is not finite", i);
+    for (size_t i = 0; i < point_count; ++i) {
         s->radius_sum += radii[i];
         for (int k = 0; k < 3; ++k) s->position_sum[k] += positions[3 * i + k];
     }
@@ -506,6 +866,9 @@ int hairis_scene_add_mesh(hairis_scene *s, size_t vertex_count, const float *pos
         if (materials[t] < 0 || materials[t] >= s->material_count)
             return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "triangle %zu: material %d does not exist",
                         t, materials[t]);
+        if (s->material_is_hair[materials[t]])
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "materials[%zu] = %d is a hair material", t,
+                        materials[t]);
     }
     s->mesh_count++;
     s->vertex_count += vertex_count;
@@ -514,86 +877,143 @@ int hairis_scene_add_mesh(hairis_scene *s, size_t vertex_count, const float *pos
     return HAIRIS_OK;
 }
 
-int hairis_scene_add_sun(hairis_scene *s, const float direction[3], const float color[3],
-                         float strength, float angle)
+int hairis_scene_add_light(hairis_scene *s, const char *text)
 {
-    if (!s || !direction || !color) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument");
-    float length = sqrtf(direction[0] * direction[0] + direction[1] * direction[1] +
-                         direction[2] * direction[2]);
-    if (fabsf(length - 1.0f) > 1e-3f)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "sun direction must be a unit vector");
-    if (!(strength >= 0.0f) || !(angle >= 0.0f))
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "sun strength and angle must be >= 0");
-    s->suns++;
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    /* The type picks the names. */
+    char type[32];
+    find_value(text, "type", type, sizeof type);
+    const char *types[3] = {"sun", "point", "area"};
+    int kind = -1;
+    for (int k = 0; k < 3; ++k)
+        if (strcmp(type, types[k]) == 0) kind = k;
+    if (kind < 0)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "light: type must be given: sun, point or area (got \"%s\")",
+                    type);
+    options o;
+    double v[16];
+    if (read_options(text, types[kind], "light", NULL, &o) != HAIRIS_OK ||
+        numbers(&o, "color", v, 3) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (kind == 0) {
+        if (numbers(&o, "direction", v, 3) != HAIRIS_OK) return HAIRIS_ERROR_INVALID_ARGUMENT;
+        if (v[0] == 0 && v[1] == 0 && v[2] == 0)
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "light: direction must not be the zero vector");
+        if (number_in(&o, "strength", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "angle", 0, 3.14159, v) != HAIRIS_OK)
+            return HAIRIS_ERROR_INVALID_ARGUMENT;
+        s->suns++;
+    } else if (kind == 1) {
+        if (numbers(&o, "position", v, 3) != HAIRIS_OK ||
+            number_in(&o, "power", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "radius", 0, 3.4e38, v) != HAIRIS_OK)
+            return HAIRIS_ERROR_INVALID_ARGUMENT;
+        s->points++;
+    } else {
+        const char *shapes[4] = {"square", "rectangle", "disk", "ellipse"};
+        int shape = 0;
+        if (numbers(&o, "matrix", v, 16) != HAIRIS_OK ||
+            word(&o, "shape", shapes, 4, &shape) != HAIRIS_OK ||
+            number_in(&o, "size", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "size_y", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "power", 0, 3.4e38, v) != HAIRIS_OK)
+            return HAIRIS_ERROR_INVALID_ARGUMENT;
+        s->areas++;
+    }
     clear_error();
     return HAIRIS_OK;
 }
 
-int hairis_scene_add_point_light(hairis_scene *s, const float position[3], const float color[3],
-                                 float power, float radius)
+int hairis_scene_set_world(hairis_scene *s, const char *text)
 {
-    if (!s || !position || !color) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument");
-    if (!(power >= 0.0f) || !(radius >= 0.0f))
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "point power and radius must be >= 0");
-    s->points++;
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    options o;
+    double color[3], strength;
+    if (read_options(text, "world", "world", NULL, &o) != HAIRIS_OK ||
+        numbers(&o, "color", color, 3) != HAIRIS_OK ||
+        number_in(&o, "strength", 0, 3.4e38, &strength) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    for (int k = 0; k < 3; ++k) s->world[k] = (float)(color[k] * strength);
     clear_error();
     return HAIRIS_OK;
 }
 
-int hairis_scene_add_area_light(hairis_scene *s, const float light_to_world[16], int shape,
-                                float size_x, float size_y, const float color[3], float power)
+int hairis_scene_set_camera(hairis_scene *s, const char *text)
 {
-    if (!s || !light_to_world || !color) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL");
-    if (shape < HAIRIS_AREA_SQUARE || shape > HAIRIS_AREA_ELLIPSE)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "unknown area shape %d", shape);
-    if (!(size_x >= 0.0f) || !(size_y >= 0.0f) || !(power >= 0.0f))
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "area sizes and power must be >= 0");
-    s->areas++;
-    clear_error();
-    return HAIRIS_OK;
-}
-
-int hairis_scene_set_world(hairis_scene *s, const float color[3], float strength)
-{
-    if (!s || !color) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument");
-    for (int k = 0; k < 3; ++k) s->world[k] = color[k] * strength;
-    clear_error();
-    return HAIRIS_OK;
-}
-
-int hairis_scene_set_camera(hairis_scene *s, const hairis_camera *camera)
-{
-    if (!s || !camera) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument");
-    if (camera->width < 1 || camera->height < 1)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "camera resolution %dx%d is empty",
-                    camera->width, camera->height);
-    s->camera = *camera;
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    options o;
+    double v[16];
+    long long width, height;
+    const char *flags[4] = {"0", "1", "false", "true"};
+    int orthographic = 0;
+    if (read_options(text, "camera", "camera", NULL, &o) != HAIRIS_OK ||
+        numbers(&o, "matrix", v, 16) != HAIRIS_OK || numbers(&o, "frame", v, 12) != HAIRIS_OK ||
+        word(&o, "orthographic", flags, 4, &orthographic) != HAIRIS_OK ||
+        integer_in(&o, "width", 1, 65536, &width) != HAIRIS_OK ||
+        integer_in(&o, "height", 1, 65536, &height) != HAIRIS_OK ||
+        numbers(&o, "clip_start", v, 1) != HAIRIS_OK || numbers(&o, "clip_end", v + 1, 1) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (!(v[1] > v[0])) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "camera: clip_end must be greater than clip_start");
+    s->width = (int)width;
+    s->height = (int)height;
+    s->orthographic = orthographic % 2;
     s->has_camera = 1;
     clear_error();
     return HAIRIS_OK;
 }
 
-void hairis_render_settings_defaults(hairis_render_settings *settings)
+/* ---- Rendering ---------------------------------------------------------------------------- */
+
+typedef struct render_settings {
+    long long samples, max_bounces, max_diffuse_bounces, max_transmission_bounces, threads,
+        tile_size, rr_start_bounce, n_h;
+    unsigned long long seed;
+    int strategy, film_transparent;
+    double multiple_weight;
+} render_settings;
+
+static int read_render_settings(const char *text, render_settings *r)
 {
-    if (!settings) return;
-    memset(settings, 0, sizeof *settings);
-    settings->samples = 64;
-    settings->max_bounces = 12;
-    settings->strategy = HAIRIS_STRATEGY_TABLE;
-    settings->multiple_weight = 0.25f;
-    settings->n_h = 2;
+    options o;
+    const char *flags[4] = {"0", "1", "false", "true"};
+    if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
+        integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
+        integer_in(&o, "max_bounces", 0, 1024, &r->max_bounces) != HAIRIS_OK ||
+        integer_in(&o, "max_diffuse_bounces", 0, 1024, &r->max_diffuse_bounces) != HAIRIS_OK ||
+        integer_in(&o, "max_transmission_bounces", 0, 1024, &r->max_transmission_bounces) != HAIRIS_OK ||
+        integer_in(&o, "threads", 0, 1024, &r->threads) != HAIRIS_OK ||
+        integer_in(&o, "tile_size", 1, 4096, &r->tile_size) != HAIRIS_OK ||
+        integer_in(&o, "rr_start_bounce", 1, 1024, &r->rr_start_bounce) != HAIRIS_OK ||
+        word(&o, "film_transparent", flags, 4, &r->film_transparent) != HAIRIS_OK ||
+        read_strategy(&o, &r->strategy) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    r->film_transparent %= 2;
+    long long n_h;
+    integer_in(&o, "n_h", 1, 1024, &n_h);
+    r->n_h = n_h;
+    numbers(&o, "multiple_weight", &r->multiple_weight, 1);
+    char *end = NULL;
+    const char *seed = value_of(&o, "seed");
+    errno = 0;
+    r->seed = strtoull(seed, &end, 10);
+    if (end == seed || *end != '\0' || errno == ERANGE || seed[0] == '-')
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "render settings: seed must be an integer in [0, 2^64 - 1] (got \"%s\")",
+                    seed);
+    return HAIRIS_OK;
 }
 
-static void write_summary(const hairis_scene *s, const hairis_render_settings *r)
+static void write_summary(const hairis_scene *s, const render_settings *r)
 {
     const char *path = getenv("HAIRIS_FAKE_SUMMARY");
     if (!path || !*path) return;
     FILE *f = fopen(path, "a");
     if (!f) return;
-    fprintf(f, "samples=%d max_bounces=%d strategy=%d multiple_weight=%.6g n_h=%d seed=%llu "
-               "threads=%d\n",
-            r->samples, r->max_bounces, r->strategy, (double)r->multiple_weight, r->n_h,
-            (unsigned long long)r->seed, r->threads);
+    fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
+               "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
+               "tile_size=%lld film_transparent=%d\n",
+            r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
+            r->threads, r->max_diffuse_bounces, r->max_transmission_bounces, r->tile_size,
+            r->film_transparent);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,
@@ -602,8 +1022,7 @@ static void write_summary(const hairis_scene *s, const hairis_render_settings *r
                "world=%.6g,%.6g,%.6g\n",
             s->mesh_count, s->vertex_count, s->triangle_count, s->suns, s->points, s->areas,
             (double)s->world[0], (double)s->world[1], (double)s->world[2]);
-    fprintf(f, "camera=%dx%d orthographic=%d\n", s->camera.width, s->camera.height,
-            s->camera.orthographic);
+    fprintf(f, "camera=%dx%d orthographic=%d\n", s->width, s->height, s->orthographic);
     for (int i = 0; i < s->material_count; ++i)
         if (s->material_is_hair[i])
             fprintf(f, "hair %d tables=%d %s\n", i, s->material_has_tables[i],
@@ -611,26 +1030,37 @@ static void write_summary(const hairis_scene *s, const hairis_render_settings *r
     fclose(f);
 }
 
-int hairis_render(hairis_scene *s, const hairis_render_settings *r, float *rgba,
-                  hairis_progress_fn progress, void *user, hairis_render_stats *stats)
+static void set_stats(double seconds, unsigned long long camera_rays, long long threads,
+                      int cancelled)
 {
-    if (!s || !r || !rgba) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "NULL argument");
-    if (!s->has_camera) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "the scene has no camera");
-    if (r->samples < 1)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "samples must be >= 1, got %d", r->samples);
-    if (r->max_bounces < 0)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "max_bounces must be >= 0");
-    if (r->strategy < 0 || r->strategy > 3)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "unknown strategy %d", r->strategy);
-    if (!(r->multiple_weight >= 0.0f && r->multiple_weight <= 1.0f))
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "multiple_weight must be in [0, 1]");
-    if (r->n_h < 1) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "n_h must be >= 1");
-    if (r->strategy == HAIRIS_STRATEGY_TABLE)
-        for (int i = 0; i < s->material_count; ++i)
+    snprintf(render_stats, sizeof render_stats,
+             "seconds=%.17g;camera_rays=%llu;rays=%llu;shadow_rays=0;dropped_samples=0;"
+             "peak_memory_bytes=%zu;threads=%lld;cancelled=%d",
+             seconds, camera_rays, camera_rays, sizeof(hairis_scene), threads > 0 ? threads : 1,
+             cancelled);
+}
+
+int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_progress_fn progress,
+                  void *user)
+{
+    if (!s || !rgba) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and rgba must not be NULL");
+    render_settings r;
+    if (read_render_settings(settings, &r) != HAIRIS_OK) return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (!s->has_camera)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "scene has no camera: call hairis_scene_set_camera before hairis_render");
+    if (r.strategy == 3)
+        for (int i = 0; i < s->material_count; ++i) {
             if (s->material_is_hair[i] && !s->material_has_tables[i])
-                return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-                            "hair material %d has no tables (TABLE strategy)", i);
-    write_summary(s, r);
+                return fail(HAIRIS_ERROR_INVALID_TABLE,
+                            "material %d (hair): strategy=table needs sampling tables, but the "
+                            "material was added without tables",
+                            i);
+            if (s->material_is_hair[i] && !s->material_tables_match[i])
+                return fail(HAIRIS_ERROR_INVALID_TABLE,
+                            "material %d (hair): the tables were baked for other parameters", i);
+        }
+    write_summary(s, &r);
     double start = now_seconds();
     const char *delay_text = getenv("HAIRIS_FAKE_ROW_DELAY_MS");
     int delay = delay_text ? atoi(delay_text) : 0;
@@ -638,110 +1068,41 @@ int hairis_render(hairis_scene *s, const hairis_render_settings *r, float *rgba,
      * statistical tests can be dry-run on the fake. */
     const char *noise_text = getenv("HAIRIS_FAKE_NOISE");
     float noise = noise_text ? (float)atof(noise_text) : 0.0f;
-    int width = s->camera.width, height = s->camera.height;
+    int width = s->width, height = s->height;
     for (int y = 0; y < height; ++y) {
-        if (progress && progress(user, (float)y / (float)height))
+        if (progress && progress(user, (float)y / (float)height)) {
+            set_stats(now_seconds() - start, (unsigned long long)y * (unsigned long long)width *
+                                                 (unsigned long long)r.samples,
+                      r.threads, 1);
             return fail(HAIRIS_ERROR_CANCELLED, "render cancelled at row %d of %d", y, height);
+        }
         for (int x = 0; x < width; ++x) {
             float *p = rgba + 4 * ((size_t)y * (size_t)width + (size_t)x);
             float factor = 1.0f;
             if (noise > 0.0f) {
-                uint64_t h = r->seed * 0x9E3779B97F4A7C15ull + (uint64_t)y * 0xBF58476D1CE4E5B9ull +
+                uint64_t h = r.seed * 0x9E3779B97F4A7C15ull + (uint64_t)y * 0xBF58476D1CE4E5B9ull +
                              (uint64_t)x * 0x94D049BB133111EBull + 1u;
                 h ^= h >> 31;
                 h *= 0xD6E8FEB86659FD93ull;
                 h ^= h >> 32;
                 float u = (float)(h >> 40) / 16777216.0f;
-                factor += noise * (u - 0.5f) * 3.4641016f / sqrtf((float)r->samples);
+                factor += noise * (u - 0.5f) * 3.4641016f / sqrtf((float)r.samples);
             }
-            p[0] = s->world[0] * factor;
-            p[1] = s->world[1] * factor;
-            p[2] = s->world[2] * factor;
-            p[3] = 1.0f;
+            /* Every camera ray misses: a transparent film shows nothing. */
+            const float shown = r.film_transparent ? 0.0f : factor;
+            p[0] = s->world[0] * shown;
+            p[1] = s->world[1] * shown;
+            p[2] = s->world[2] * shown;
+            p[3] = r.film_transparent ? 0.0f : 1.0f;
         }
         sleep_ms(delay);
     }
     if (progress) progress(user, 1.0f);
-    if (stats) {
-        stats->seconds = now_seconds() - start;
-        stats->camera_rays = (uint64_t)width * (uint64_t)height * (uint64_t)r->samples;
-        stats->dropped_samples = 0;
-        stats->peak_memory_bytes = sizeof *s;
-    }
+    set_stats(now_seconds() - start,
+              (unsigned long long)width * (unsigned long long)height * (unsigned long long)r.samples,
+              r.threads, 0);
     clear_error();
     return HAIRIS_OK;
 }
 
-/* ---- Layout introspection for the tests --------------------------------------------------- */
-
-#define SIZE_OF(type)                                                                             \
-    if (strcmp(name, #type) == 0) return (long)sizeof(type)
-#define OFFSET_OF(type, member)                                                                   \
-    if (strcmp(name, #type) == 0 && strcmp(field, #member) == 0)                                  \
-        return (long)offsetof(type, member)
-
-FAKE_EXPORT long hairis_fake_sizeof(const char *name)
-{
-    SIZE_OF(hairis_principled_hair);
-    SIZE_OF(hairis_marschner_params);
-    SIZE_OF(hairis_bake_options);
-    SIZE_OF(hairis_camera);
-    SIZE_OF(hairis_render_settings);
-    SIZE_OF(hairis_render_stats);
-    return -1;
-}
-
-FAKE_EXPORT long hairis_fake_offsetof(const char *name, const char *field)
-{
-    OFFSET_OF(hairis_principled_hair, parametrization);
-    OFFSET_OF(hairis_principled_hair, color);
-    OFFSET_OF(hairis_principled_hair, melanin);
-    OFFSET_OF(hairis_principled_hair, melanin_redness);
-    OFFSET_OF(hairis_principled_hair, tint);
-    OFFSET_OF(hairis_principled_hair, absorption_coefficient);
-    OFFSET_OF(hairis_principled_hair, roughness);
-    OFFSET_OF(hairis_principled_hair, radial_roughness);
-    OFFSET_OF(hairis_principled_hair, coat);
-    OFFSET_OF(hairis_principled_hair, ior);
-    OFFSET_OF(hairis_principled_hair, offset);
-    OFFSET_OF(hairis_principled_hair, random_color);
-    OFFSET_OF(hairis_principled_hair, random_roughness);
-    OFFSET_OF(hairis_principled_hair, random);
-    OFFSET_OF(hairis_marschner_params, eta);
-    OFFSET_OF(hairis_marschner_params, sigma_a);
-    OFFSET_OF(hairis_marschner_params, alpha_r);
-    OFFSET_OF(hairis_marschner_params, alpha_tt);
-    OFFSET_OF(hairis_marschner_params, alpha_trt);
-    OFFSET_OF(hairis_marschner_params, beta_r);
-    OFFSET_OF(hairis_marschner_params, beta_tt);
-    OFFSET_OF(hairis_marschner_params, beta_trt);
-    OFFSET_OF(hairis_marschner_params, eccentricity);
-    OFFSET_OF(hairis_marschner_params, glint_scale);
-    OFFSET_OF(hairis_marschner_params, caustic_width);
-    OFFSET_OF(hairis_marschner_params, caustic_fade);
-    OFFSET_OF(hairis_marschner_params, caustic_intensity_limit);
-    OFFSET_OF(hairis_bake_options, theta_r_count);
-    OFFSET_OF(hairis_bake_options, theta_i_count);
-    OFFSET_OF(hairis_bake_options, phi_count);
-    OFFSET_OF(hairis_bake_options, n_h_count);
-    OFFSET_OF(hairis_bake_options, n_h_values);
-    OFFSET_OF(hairis_bake_options, source);
-    OFFSET_OF(hairis_bake_options, threads);
-    OFFSET_OF(hairis_camera, camera_to_world);
-    OFFSET_OF(hairis_camera, orthographic);
-    OFFSET_OF(hairis_camera, frame);
-    OFFSET_OF(hairis_camera, width);
-    OFFSET_OF(hairis_camera, height);
-    OFFSET_OF(hairis_render_settings, samples);
-    OFFSET_OF(hairis_render_settings, max_bounces);
-    OFFSET_OF(hairis_render_settings, strategy);
-    OFFSET_OF(hairis_render_settings, multiple_weight);
-    OFFSET_OF(hairis_render_settings, n_h);
-    OFFSET_OF(hairis_render_settings, seed);
-    OFFSET_OF(hairis_render_settings, threads);
-    OFFSET_OF(hairis_render_stats, seconds);
-    OFFSET_OF(hairis_render_stats, camera_rays);
-    OFFSET_OF(hairis_render_stats, dropped_samples);
-    OFFSET_OF(hairis_render_stats, peak_memory_bytes);
-    return -1;
-}
+const char *hairis_last_render_stats(void) { return render_stats; }

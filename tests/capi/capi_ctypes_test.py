@@ -2,14 +2,18 @@
 """Tests of the hairis C API through Python's ctypes, the way the Blender add-on loads it.
 
 Usage (CTest passes every option):
-    capi_ctypes_test.py --library libhairis.so [--layout-tool capi_test] [--header hairis.h]
-                        [--addon-native addon/hairis/native.py] [--version X.Y.Z]
+    capi_ctypes_test.py --library libhairis.so --header hairis.h --header hairis_render.h
+                        [--nm nm] [--addon-native addon/hairis/native.py] [--version X.Y.Z]
                         [unittest options]
 
-The struct mirrors below are declared here, independently of the add-on; TestLayout compares
-them (and the add-on's, when --addon-native is given) with the sizes and offsets the C
-compiler gives (``capi_test --layout``). Exits non-zero on a failure; 77 (skip) when numpy is
-missing.
+PROTOTYPES below declares, independently of the headers, the ctypes prototype of every C API
+function; the library is called through it. TestPrototypes parses the headers' HAIRIS_API
+prototypes (a small strict parser for their regular style, parse_prototypes) into ctypes
+types and fails, naming the function, when one is missing from a PROTOTYPES dict, extra in
+it, or declared otherwise; it checks this file's dict and, once it has one, the add-on's
+``PROTOTYPES`` in addon/hairis/native.py. It also checks that libhairis.so exports exactly
+the headers' functions (``nm -D --defined-only``). Exits non-zero on a failure; 77 (skip)
+when numpy is missing.
 """
 
 import argparse
@@ -22,8 +26,8 @@ import sys
 import tempfile
 import threading
 import unittest
-from ctypes import POINTER, c_char_p, c_double, c_float, c_int, c_int32, c_size_t, c_uint32
-from ctypes import c_uint64, c_void_p
+from ctypes import CFUNCTYPE, POINTER, c_char_p, c_double, c_float, c_int, c_int32, c_size_t
+from ctypes import c_uint32, c_uint64, c_void_p
 
 try:
     import numpy as np
@@ -39,156 +43,223 @@ ERROR_INVALID_TABLE = 3
 ERROR_CANCELLED = 4
 ERROR_INTERNAL = 5
 
-UNIFORM, ANALYTIC, GAUSSIAN, TABLE = 0, 1, 2, 3
-PARAM_ABSORPTION, PARAM_MELANIN, PARAM_COLOR = 0, 1, 2
+KINDS = ("chiang", "marschner", "bake", "sampler", "diffuse", "sun", "point", "area", "world",
+         "camera", "render")
 
+# ---- The prototypes, written here by hand ---------------------------------------------------
 
-# ---- Struct mirrors of hairis.h ------------------------------------------------------------
-
-class PrincipledHair(ctypes.Structure):
-    _fields_ = [
-        ("parametrization", c_int),
-        ("color", c_float * 3),
-        ("melanin", c_float),
-        ("melanin_redness", c_float),
-        ("tint", c_float * 3),
-        ("absorption_coefficient", c_float * 3),
-        ("roughness", c_float),
-        ("radial_roughness", c_float),
-        ("coat", c_float),
-        ("ior", c_float),
-        ("offset", c_float),
-        ("random_color", c_float),
-        ("random_roughness", c_float),
-        ("random", c_float),
-    ]
-
-
-class MarschnerParams(ctypes.Structure):
-    _fields_ = [
-        ("eta", c_float),
-        ("sigma_a", c_float * 3),
-        ("alpha_r", c_float),
-        ("alpha_tt", c_float),
-        ("alpha_trt", c_float),
-        ("beta_r", c_float),
-        ("beta_tt", c_float),
-        ("beta_trt", c_float),
-        ("eccentricity", c_float),
-        ("glint_scale", c_float),
-        ("caustic_width", c_float),
-        ("caustic_fade", c_float),
-        ("caustic_intensity_limit", c_float),
-    ]
-
-
-class BakeOptions(ctypes.Structure):
-    _fields_ = [
-        ("theta_r_count", c_int),
-        ("theta_i_count", c_int),
-        ("phi_count", c_int),
-        ("n_h_count", c_int),
-        ("n_h_values", c_int * 16),
-        ("source", c_int),
-        ("threads", c_int),
-    ]
-
-
-class Camera(ctypes.Structure):
-    _fields_ = [
-        ("camera_to_world", c_float * 16),
-        ("orthographic", c_int),
-        ("frame", c_float * 12),
-        ("width", c_int),
-        ("height", c_int),
-    ]
-
-
-class RenderSettings(ctypes.Structure):
-    _fields_ = [
-        ("samples", c_int),
-        ("max_bounces", c_int),
-        ("strategy", c_int),
-        ("multiple_weight", c_float),
-        ("n_h", c_int),
-        ("seed", c_uint64),
-        ("threads", c_int),
-    ]
-
-
-class RenderStats(ctypes.Structure):
-    _fields_ = [
-        ("seconds", c_double),
-        ("camera_rays", c_uint64),
-        ("dropped_samples", c_uint64),
-        ("peak_memory_bytes", c_uint64),
-    ]
-
-
-STRUCTS = {
-    "hairis_principled_hair": PrincipledHair,
-    "hairis_marschner_params": MarschnerParams,
-    "hairis_bake_options": BakeOptions,
-    "hairis_camera": Camera,
-    "hairis_render_settings": RenderSettings,
-    "hairis_render_stats": RenderStats,
-}
-
-PROGRESS_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_float)
+PROGRESS_FN = CFUNCTYPE(c_int, c_void_p, c_float)
 F = POINTER(c_float)
+U32 = POINTER(c_uint32)
+I32 = POINTER(c_int32)
 
-SIGNATURES = {
+PROTOTYPES = {
     "hairis_api_version": (c_int, []),
     "hairis_version_string": (c_char_p, []),
     "hairis_last_error": (c_char_p, []),
-    "hairis_principled_hair_defaults": (None, [POINTER(PrincipledHair)]),
-    "hairis_marschner_defaults": (None, [POINTER(MarschnerParams)]),
-    "hairis_fiber_create_principled": (c_void_p, [POINTER(PrincipledHair)]),
-    "hairis_fiber_create_marschner": (c_void_p, [POINTER(MarschnerParams)]),
+    "hairis_defaults": (c_char_p, [c_char_p]),
+    "hairis_fiber_create": (c_void_p, [c_char_p]),
     "hairis_fiber_destroy": (None, [c_void_p]),
     "hairis_fiber_model": (c_char_p, [c_void_p]),
     "hairis_fiber_parameters": (c_char_p, [c_void_p]),
     "hairis_fiber_eval": (c_int, [c_void_p, c_size_t, F, F, F, F]),
-    "hairis_bake_options_defaults": (None, [POINTER(BakeOptions)]),
-    "hairis_tables_bake": (c_void_p, [c_void_p, POINTER(BakeOptions), PROGRESS_FN, c_void_p]),
+    "hairis_tables_bake": (c_void_p, [c_void_p, c_char_p, PROGRESS_FN, c_void_p]),
     "hairis_tables_write": (c_int, [c_void_p, c_char_p]),
     "hairis_tables_load_file": (c_void_p, [c_char_p]),
     "hairis_tables_load_memory": (c_void_p, [c_void_p, c_size_t]),
     "hairis_tables_destroy": (None, [c_void_p]),
     "hairis_tables_model": (c_char_p, [c_void_p]),
     "hairis_tables_parameters": (c_char_p, [c_void_p]),
+    "hairis_tables_info": (c_char_p, [c_void_p]),
     "hairis_tables_match_fiber": (c_int, [c_void_p, c_void_p]),
-    "hairis_sampler_create": (c_void_p, [c_int, c_void_p, c_void_p, c_float, c_int]),
+    "hairis_sampler_create": (c_void_p, [c_void_p, c_void_p, c_char_p]),
     "hairis_sampler_destroy": (None, [c_void_p]),
     "hairis_sample": (c_int, [c_void_p, c_size_t, F, F, F, F, F]),
     "hairis_pdf": (c_int, [c_void_p, c_size_t, F, F, F, F]),
     "hairis_scene_create": (c_void_p, []),
     "hairis_scene_destroy": (None, [c_void_p]),
-    "hairis_scene_add_hair_material": (c_int, [c_void_p, POINTER(PrincipledHair), c_void_p]),
-    "hairis_scene_add_diffuse_material": (c_int, [c_void_p, F, F]),
-    "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32), c_size_t,
-                                        F, F]),
-    "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, POINTER(c_uint32),
-                                      POINTER(c_int32)]),
-    "hairis_scene_add_sun": (c_int, [c_void_p, F, F, c_float, c_float]),
-    "hairis_scene_add_point_light": (c_int, [c_void_p, F, F, c_float, c_float]),
-    "hairis_scene_add_area_light": (c_int, [c_void_p, F, c_int, c_float, c_float, F, c_float]),
-    "hairis_scene_set_world": (c_int, [c_void_p, F, c_float]),
-    "hairis_scene_set_camera": (c_int, [c_void_p, POINTER(Camera)]),
-    "hairis_render_settings_defaults": (None, [POINTER(RenderSettings)]),
-    "hairis_render": (c_int, [c_void_p, POINTER(RenderSettings), F, PROGRESS_FN, c_void_p,
-                              POINTER(RenderStats)]),
+    "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
+    "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F]),
+    "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
+    "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
+    "hairis_render": (c_int, [c_void_p, c_char_p, F, PROGRESS_FN, c_void_p]),
+    "hairis_last_render_stats": (c_char_p, []),
 }
+
+# ---- The headers' prototypes as ctypes types --------------------------------------------------
+
+# C scalar types and the ctypes type of each (pointers to them: POINTER of it).
+C_SCALARS = {
+    "int": c_int, "float": c_float, "double": c_double, "size_t": c_size_t,
+    "int32_t": c_int32, "uint32_t": c_uint32, "uint64_t": c_uint64,
+}
+
+
+class HeaderError(Exception):
+    """A declaration the parser does not understand (it is strict on purpose)."""
+
+
+def _strip(text):
+    """The header without comments and preprocessor lines."""
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+    text = re.sub(r"//[^\n]*", " ", text)
+    return "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
+
+
+def _parse_type(text, handles, callbacks, where):
+    """The ctypes type of a C type (`const` ignored): None for void."""
+    tokens = re.findall(r"\*|[A-Za-z_]\w*|\S", text)
+    if any(t != "*" and not re.match(r"[A-Za-z_]\w*$", t) for t in tokens):
+        raise HeaderError("%s: cannot read the type %r" % (where, text))
+    tokens = [t for t in tokens if t != "const"]
+    stars = tokens.count("*")
+    names = [t for t in tokens if t != "*"]
+    if len(names) != 1 or (stars and tokens[-stars:] != ["*"] * stars):
+        raise HeaderError("%s: cannot read the type %r" % (where, text))
+    base = names[0]
+    if stars > 1:
+        raise HeaderError("%s: pointer to pointer in %r" % (where, text))
+    if base == "void":
+        return c_void_p if stars else None
+    if base == "char":
+        if not stars:
+            raise HeaderError("%s: a char by value in %r" % (where, text))
+        return c_char_p
+    if base in handles:
+        if not stars:
+            raise HeaderError("%s: opaque %s by value" % (where, base))
+        return c_void_p
+    if base in callbacks:
+        if stars:
+            raise HeaderError("%s: pointer to a callback in %r" % (where, text))
+        return callbacks[base]
+    if base in C_SCALARS:
+        return POINTER(C_SCALARS[base]) if stars else C_SCALARS[base]
+    raise HeaderError("%s: unknown type %r" % (where, text))
+
+
+def _parse_parameters(text, handles, callbacks, where):
+    """The ctypes types of a parameter list "type name, ..." ("void": none)."""
+    text = text.strip()
+    if text == "void":
+        return []
+    if not text or "(" in text or "[" in text or "..." in text:
+        raise HeaderError("%s: cannot read the parameters %r" % (where, text))
+    types = []
+    for parameter in text.split(","):
+        match = re.match(r"^(.*?)\b([A-Za-z_]\w*)\s*$", parameter.strip(), re.S)
+        if not match or not match.group(1).strip():
+            raise HeaderError("%s: a parameter needs a type and a name: %r" % (where, parameter))
+        types.append(_parse_type(match.group(1), handles, callbacks, where))
+    return types
+
+
+def parse_prototypes(texts):
+    """{name: (restype, [argtypes])} of every HAIRIS_API function in the header texts."""
+    text = "\n".join(_strip(t) for t in texts)
+    handles = set(re.findall(r"typedef\s+struct\s+(hairis_\w+)\s+\1\s*;", text))
+    callbacks = {}
+    for ret, name, params in re.findall(
+            r"typedef\s+([^;()]+?)\s*\(\s*\*\s*(hairis_\w+)\s*\)\s*\(([^;()]*)\)\s*;", text):
+        where = "typedef " + name
+        restype = _parse_type(ret, handles, callbacks, where)
+        callbacks[name] = CFUNCTYPE(restype, *_parse_parameters(params, handles, callbacks, where))
+    prototypes = {}
+    for declaration in re.findall(r"\bHAIRIS_API\b([^;]*);", text):
+        declaration = " ".join(declaration.split())
+        match = re.match(r"^(.+?)\b(hairis_\w+)\s*\((.*)\)$", declaration)
+        if not match:
+            raise HeaderError("cannot read the declaration %r" % declaration)
+        ret, name, params = match.groups()
+        if name in prototypes:
+            raise HeaderError("%s is declared twice" % name)
+        prototypes[name] = (_parse_type(ret, handles, callbacks, name),
+                            _parse_parameters(params, handles, callbacks, name))
+    if not prototypes:
+        raise HeaderError("no HAIRIS_API declarations found")
+    return prototypes
+
+
+def same_type(a, b):
+    """Whether two ctypes types pass and return alike (callbacks by their prototype)."""
+    if a is None or b is None:
+        return a is b
+    if isinstance(a, type) and isinstance(b, type):
+        func_base = ctypes._CFuncPtr  # the base of CFUNCTYPE types
+        if issubclass(a, func_base) or issubclass(b, func_base):
+            return (issubclass(a, func_base) and issubclass(b, func_base) and
+                    a._flags_ == b._flags_ and same_type(a._restype_, b._restype_) and
+                    len(a._argtypes_) == len(b._argtypes_) and
+                    all(same_type(x, y) for x, y in zip(a._argtypes_, b._argtypes_)))
+        if issubclass(a, ctypes._Pointer) or issubclass(b, ctypes._Pointer):
+            return (issubclass(a, ctypes._Pointer) and issubclass(b, ctypes._Pointer) and
+                    same_type(a._type_, b._type_))
+    return a is b
+
+
+def type_name(t):
+    """A readable name of a ctypes type."""
+    if t is None:
+        return "None"
+    if isinstance(t, type) and issubclass(t, ctypes._CFuncPtr):
+        parts = (t._restype_,) + tuple(t._argtypes_)
+        return "CFUNCTYPE(%s)" % ", ".join(type_name(x) for x in parts)
+    if isinstance(t, type) and issubclass(t, ctypes._Pointer):
+        return "POINTER(%s)" % type_name(t._type_)
+    return getattr(t, "__name__", repr(t))
+
+
+def prototype_problems(expected, declared, who):
+    """What differs between the headers' prototypes and a PROTOTYPES dict, one line each."""
+    problems = []
+    for name in sorted(set(expected) - set(declared)):
+        problems.append("%s: %s is missing (the headers declare it)" % (who, name))
+    for name in sorted(set(declared) - set(expected)):
+        problems.append("%s: %s is not in the headers" % (who, name))
+    for name in sorted(set(expected) & set(declared)):
+        restype, argtypes = expected[name]
+        try:
+            got_restype, got_argtypes = declared[name]
+        except (TypeError, ValueError):
+            problems.append("%s: %s must be (restype, [argtypes])" % (who, name))
+            continue
+        if not same_type(restype, got_restype):
+            problems.append("%s: %s returns %s, the headers say %s" % (
+                who, name, type_name(got_restype), type_name(restype)))
+        got_argtypes = list(got_argtypes)
+        if len(got_argtypes) != len(argtypes):
+            problems.append("%s: %s takes %d arguments, the headers say %d" % (
+                who, name, len(got_argtypes), len(argtypes)))
+            continue
+        for i, (want, got) in enumerate(zip(argtypes, got_argtypes)):
+            if not same_type(want, got):
+                problems.append("%s: %s argument %d is %s, the headers say %s" % (
+                    who, name, i + 1, type_name(got), type_name(want)))
+    return problems
+
+
+def header_prototypes():
+    texts = []
+    for path in OPTIONS.header:
+        with open(path) as handle:
+            texts.append(handle.read())
+    return parse_prototypes(texts)
+
+
+# ---- The library -----------------------------------------------------------------------------
 
 _LIB = None
 
 
 def lib():
-    """The library, loaded once, with every signature declared."""
+    """The library, loaded once, with every prototype declared."""
     global _LIB
     if _LIB is None:
         raw = ctypes.CDLL(OPTIONS.library)
-        for name, (restype, argtypes) in SIGNATURES.items():
+        for name, (restype, argtypes) in PROTOTYPES.items():
             function = getattr(raw, name)
             function.restype = restype
             function.argtypes = argtypes
@@ -204,34 +275,22 @@ def ptr(array, ctype=c_float):
     return None if array is None else array.ctypes.data_as(POINTER(ctype))
 
 
-def vec(*values):
-    return (c_float * len(values))(*values)
+def items(options):
+    """{name: value} of "name=value;..."."""
+    return dict(item.split("=", 1) for item in options.split(";") if item)
 
 
-def node_defaults():
-    node = PrincipledHair()
-    lib().hairis_principled_hair_defaults(ctypes.byref(node))
-    return node
+def defaults(kind):
+    text = lib().hairis_defaults(kind.encode())
+    assert text is not None, last_error()
+    return text.decode()
 
 
-def make_fiber(**changes):
-    node = node_defaults()
-    for name, value in changes.items():
-        setattr(node, name, value)
-    return lib().hairis_fiber_create_principled(ctypes.byref(node))
+def make_fiber(options=""):
+    return lib().hairis_fiber_create(options.encode())
 
 
-def tiny_options():
-    options = BakeOptions()
-    lib().hairis_bake_options_defaults(ctypes.byref(options))
-    options.theta_r_count = 4
-    options.theta_i_count = 8
-    options.phi_count = 8
-    options.n_h_count = 2
-    options.n_h_values[0] = 1
-    options.n_h_values[1] = 2
-    options.threads = 2
-    return options
+TINY_BAKE = b"theta_r=4;theta_i=8;phi=8;n_h=1,2;threads=2"
 
 
 def unit_vectors(rng, n):
@@ -242,16 +301,15 @@ def unit_vectors(rng, n):
     return np.ascontiguousarray(v, dtype=np.float32)
 
 
-_BYTES = None  # EXR bytes of tables baked once for the default node
+_BYTES = None  # EXR bytes of tables baked once for the default fiber
 
 
 def default_table_bytes():
-    """Bakes tables for the default node once and returns the EXR file's bytes."""
+    """Bakes tables for the default fiber once and returns the EXR file's bytes."""
     global _BYTES
     if _BYTES is None:
         fiber = make_fiber()
-        tables = lib().hairis_tables_bake(fiber, ctypes.byref(tiny_options()), PROGRESS_FN(),
-                                          None)
+        tables = lib().hairis_tables_bake(fiber, TINY_BAKE, PROGRESS_FN(), None)
         assert tables, last_error()
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "default.exr")
@@ -270,72 +328,126 @@ def load_memory(data):
 
 # ---- Tests -----------------------------------------------------------------------------------
 
-class TestLayout(unittest.TestCase):
-    """The ctypes mirrors have the C compiler's sizes and offsets."""
+class TestPrototypes(unittest.TestCase):
+    """PROTOTYPES dicts against the headers; the library's exports against the headers."""
 
     @classmethod
     def setUpClass(cls):
-        if not OPTIONS.layout_tool:
-            raise unittest.SkipTest("no --layout-tool")
-        output = subprocess.run([OPTIONS.layout_tool, "--layout"], check=True,
-                                capture_output=True, text=True).stdout
-        cls.sizes, cls.offsets = {}, {}
-        for line in output.splitlines():
-            parts = line.split()
-            if parts[0] == "struct":
-                cls.sizes[parts[1]] = int(parts[2])
-            elif parts[0] == "field":
-                cls.offsets[(parts[1], parts[2])] = int(parts[3])
+        if not OPTIONS.header:
+            raise unittest.SkipTest("no --header")
+        cls.expected = header_prototypes()
 
-    def check_structs(self, structs, who):
-        self.assertEqual(set(structs), set(self.sizes), "%s: the set of structs" % who)
-        for name, struct in structs.items():
-            self.assertEqual(ctypes.sizeof(struct), self.sizes[name], "%s: sizeof %s" % (who, name))
-            fields = [field[0] for field in struct._fields_]
-            expected = sorted((f for (s, f) in self.offsets if s == name),
-                              key=lambda f: self.offsets[(name, f)])
-            self.assertEqual(fields, expected, "%s: fields of %s in order" % (who, name))
-            for field in fields:
-                self.assertEqual(getattr(struct, field).offset, self.offsets[(name, field)],
-                                 "%s: offset of %s.%s" % (who, name, field))
+    def test_this_files_prototypes_match_the_headers(self):
+        problems = prototype_problems(self.expected, PROTOTYPES, "capi_ctypes_test.py")
+        self.assertEqual(problems, [], "\n".join(problems))
 
-    def test_mirrors_here(self):
-        self.check_structs(STRUCTS, "this test")
+    def test_the_check_names_each_kind_of_difference(self):
+        """The comparison fails, naming the function, for every kind of mistake."""
+        def with_change(name, value):
+            changed = dict(PROTOTYPES)
+            if value is None:
+                del changed[name]
+            else:
+                changed[name] = value
+            return prototype_problems(self.expected, changed, "x")
 
-    def test_addon_mirrors(self):
+        self.assertEqual(with_change("hairis_pdf", None),
+                         ["x: hairis_pdf is missing (the headers declare it)"])
+        self.assertEqual(with_change("hairis_extra", (c_int, [])),
+                         ["x: hairis_extra is not in the headers"])
+        self.assertEqual(with_change("hairis_tables_info", (c_void_p, [c_void_p])),
+                         ["x: hairis_tables_info returns c_void_p, the headers say c_char_p"])
+        self.assertEqual(with_change("hairis_sample", (c_int, [c_void_p, c_size_t, F, F, F, F])),
+                         ["x: hairis_sample takes 6 arguments, the headers say 7"])
+        self.assertEqual(with_change("hairis_scene_add_mesh",
+                                     (c_int, [c_void_p, c_size_t, F, c_size_t, U32, U32])),
+                         ["x: hairis_scene_add_mesh argument 6 is POINTER(c_uint), "
+                          "the headers say POINTER(c_int)"])
+        # A callback with another prototype, and a C function pointer where a callback goes.
+        wrong_callback = CFUNCTYPE(c_int, c_void_p, c_double)
+        problems = with_change("hairis_render", (c_int, [c_void_p, c_char_p, F, wrong_callback,
+                                                         c_void_p]))
+        self.assertEqual(len(problems), 1)
+        self.assertIn("hairis_render argument 4", problems[0])
+        self.assertEqual(with_change("hairis_render",
+                                     (c_int, [c_void_p, c_char_p, F, c_void_p, c_void_p])),
+                         ["x: hairis_render argument 4 is c_void_p, "
+                          "the headers say CFUNCTYPE(c_int, c_void_p, c_float)"])
+
+    def test_the_parser_reads_our_style_and_refuses_the_rest(self):
+        header = """
+            /* comment with HAIRIS_API inside; */
+            #define HAIRIS_API __attribute__((visibility("default")))
+            typedef struct hairis_thing hairis_thing;
+            typedef int (*hairis_cb)(void *user, float progress);
+            HAIRIS_API const char *hairis_name(const hairis_thing *thing);
+            HAIRIS_API int hairis_fill(hairis_thing *t, size_t n,
+                                       const uint32_t *first, hairis_cb cb, void *user);
+            HAIRIS_API void hairis_none(void);
+        """
+        parsed = parse_prototypes([header])
+        self.assertEqual(set(parsed), {"hairis_name", "hairis_fill", "hairis_none"})
+        self.assertIs(parsed["hairis_name"][0], c_char_p)
+        self.assertEqual(parsed["hairis_none"], (None, []))
+        restype, argtypes = parsed["hairis_fill"]
+        self.assertIs(restype, c_int)
+        self.assertEqual(argtypes[:3], [c_void_p, c_size_t, U32])
+        self.assertTrue(same_type(argtypes[3], PROGRESS_FN))
+        for bad in ("HAIRIS_API int hairis_f(struct other *o);",
+                    "HAIRIS_API int hairis_f(float values[3]);",
+                    "HAIRIS_API int hairis_f(int (*cb)(int));",
+                    "HAIRIS_API int hairis_f(const char **names);",
+                    "HAIRIS_API int hairis_f(int, ...);",
+                    "HAIRIS_API long hairis_f(void);",
+                    "HAIRIS_API int hairis_f(float);"):
+            with self.subTest(bad=bad):
+                with self.assertRaises(HeaderError):
+                    parse_prototypes([bad])
+
+    def test_addon_prototypes_match_the_headers(self):
         if not OPTIONS.addon_native or not os.path.exists(OPTIONS.addon_native):
             self.skipTest("no --addon-native")
         spec = importlib.util.spec_from_file_location("hairis_addon_native", OPTIONS.addon_native)
         native = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(native)
-        self.check_structs(native.STRUCTS, "addon/hairis/native.py")
-        self.assertEqual(set(native.SIGNATURES), set(SIGNATURES), "the add-on binds every function")
+        if not hasattr(native, "PROTOTYPES"):
+            self.skipTest("%s defines no PROTOTYPES yet (the add-on's binding is not ported to "
+                          "the option-string API)" % OPTIONS.addon_native)
+        problems = prototype_problems(self.expected, native.PROTOTYPES, "addon/hairis/native.py")
+        self.assertEqual(problems, [], "\n".join(problems))
+
+    def test_library_exports_exactly_the_headers_functions(self):
+        nm = OPTIONS.nm or "nm"
+        output = subprocess.run([nm, "-D", "--defined-only", OPTIONS.library], check=True,
+                                capture_output=True, text=True).stdout
+        exported = set()
+        for line in output.splitlines():
+            parts = line.split()
+            if len(parts) >= 3:
+                exported.add(parts[2].split("@")[0])
+        self.assertTrue(exported, "nm found no symbols in %s" % OPTIONS.library)
+        others = sorted(name for name in exported if not name.startswith("hairis_"))
+        self.assertEqual(others, [], "libhairis.so exports only hairis_* symbols")
+        self.assertEqual(sorted(exported - set(self.expected)), [],
+                         "exported hairis_* symbols the headers do not declare")
+        self.assertEqual(sorted(set(self.expected) - exported), [],
+                         "header functions the library does not export")
 
 
 class TestLibrary(unittest.TestCase):
 
     def test_version(self):
-        self.assertEqual(lib().hairis_api_version(), 1)
+        self.assertEqual(lib().hairis_api_version(), 2)
         self.assertEqual(last_error(), "")
         version = lib().hairis_version_string().decode()
         if OPTIONS.version:
             self.assertEqual(version, OPTIONS.version)
         self.assertRegex(version, r"^\d+\.\d+\.\d+")
 
-    def test_every_header_function_is_exported(self):
-        if not OPTIONS.header:
-            self.skipTest("no --header")
-        with open(OPTIONS.header) as f:
-            text = f.read()
-        names = set(re.findall(r"HAIRIS_API\s+[^;(]*?\b(hairis_\w+)\s*\(", text))
-        self.assertEqual(names, set(SIGNATURES))
-        for name in names:
-            self.assertTrue(hasattr(lib(), name), name)
-
     def test_errors_are_strings_and_per_thread(self):
-        self.assertIsNone(lib().hairis_fiber_create_principled(None))
+        self.assertIsNone(make_fiber("roughness=2"))
         message = last_error()
-        self.assertIn("node must not be NULL", message)
+        self.assertIn("roughness", message)
         seen = []
         thread = threading.Thread(target=lambda: seen.append(last_error()))
         thread.start()
@@ -345,18 +457,42 @@ class TestLibrary(unittest.TestCase):
         self.assertEqual(last_error(), "")
 
 
-class TestFibers(unittest.TestCase):
+class TestOptions(unittest.TestCase):
 
-    def test_defaults(self):
-        node = node_defaults()
-        self.assertEqual(node.parametrization, PARAM_COLOR)
-        self.assertAlmostEqual(node.ior, 1.55, places=6)
-        self.assertAlmostEqual(node.offset, 0.0349065848, places=7)
-        params = MarschnerParams()
-        lib().hairis_marschner_defaults(ctypes.byref(params))
-        self.assertAlmostEqual(params.sigma_a[0], 0.15, places=6)
-        self.assertAlmostEqual(params.eccentricity, 0.9, places=6)
-        self.assertEqual(last_error(), "")
+    def test_defaults_of_every_kind(self):
+        for kind in KINDS:
+            with self.subTest(kind=kind):
+                self.assertTrue(items(defaults(kind)), kind)
+        self.assertEqual(items(defaults("chiang"))["ior"], "1.54999995")
+        self.assertEqual(items(defaults("marschner"))["sigma_a"],
+                         "0.150000006,0.200000003,0.300000012")
+        self.assertEqual(items(defaults("render"))["max_bounces"], "12")
+        self.assertIsNone(lib().hairis_defaults(b"nonsense"))
+        self.assertIn("camera", last_error())
+
+    def test_fiber_defaults_round_trip(self):
+        for kind, bare in (("chiang", ""), ("marschner", "model=marschner")):
+            with self.subTest(kind=kind):
+                a, b = make_fiber(defaults(kind)), make_fiber(bare)
+                self.assertTrue(a and b, last_error())
+                self.assertEqual(lib().hairis_fiber_parameters(a), lib().hairis_fiber_parameters(b))
+                lib().hairis_fiber_destroy(a)
+                lib().hairis_fiber_destroy(b)
+
+    def test_unknown_and_repeated_names(self):
+        self.assertIsNone(make_fiber("roughnes=0.3"))
+        message = last_error()
+        self.assertIn('"roughnes"', message)
+        for name in items(defaults("chiang")):
+            self.assertIn(name, message)
+        self.assertIsNone(make_fiber("coat=0.1;coat=0.2"))
+        self.assertIn("coat is given twice", last_error())
+        self.assertIsNone(lib().hairis_sampler_create(None, None, b"strategy=uniform;n_h=1;x=1"))
+        self.assertIn('unknown option "x"', last_error())
+        self.assertIn("multiple_weight", last_error())
+
+
+class TestFibers(unittest.TestCase):
 
     def test_create_and_strings(self):
         fiber = make_fiber()
@@ -366,30 +502,25 @@ class TestFibers(unittest.TestCase):
         self.assertTrue(parameters.startswith("sigma_a.r="), parameters)
         self.assertEqual(len(parameters.split(";")), 8)
         lib().hairis_fiber_destroy(fiber)
-        params = MarschnerParams()
-        lib().hairis_marschner_defaults(ctypes.byref(params))
-        marschner = lib().hairis_fiber_create_marschner(ctypes.byref(params))
+        marschner = make_fiber("model=marschner")
         self.assertTrue(marschner, last_error())
         self.assertEqual(lib().hairis_fiber_model(marschner), b"marschner2003")
         lib().hairis_fiber_destroy(marschner)
 
     def test_invalid_inputs_name_the_argument(self):
         cases = [
-            (dict(roughness=1.5), "node.roughness"),
-            (dict(ior=1.0), "node.ior"),
-            (dict(coat=float("nan")), "node.coat"),
-            (dict(parametrization=3), "node.parametrization"),
-            (dict(random=-0.5), "node.random"),
+            ("roughness=1.5", "roughness"),
+            ("ior=1", "ior"),
+            ("coat=nan", "coat"),
+            ("parametrization=3", "parametrization"),
+            ("random=-0.5", "random"),
+            ("model=marschner;caustic_limit=-1", "caustic_limit"),
+            ("model=marschner;eta=inf", "eta"),
         ]
-        for changes, word in cases:
-            with self.subTest(changes=changes):
-                self.assertIsNone(make_fiber(**changes))
+        for options, word in cases:
+            with self.subTest(options=options):
+                self.assertIsNone(make_fiber(options))
                 self.assertIn(word, last_error())
-        params = MarschnerParams()
-        lib().hairis_marschner_defaults(ctypes.byref(params))
-        params.caustic_intensity_limit = -1
-        self.assertIsNone(lib().hairis_fiber_create_marschner(ctypes.byref(params)))
-        self.assertIn("params.caustic_intensity_limit", last_error())
 
     @unittest.skipIf(np is None, "numpy")
     def test_eval_far_and_near(self):
@@ -406,14 +537,14 @@ class TestFibers(unittest.TestCase):
         self.assertTrue(np.all(np.isfinite(out)) and np.all(out >= 0))
         self.assertFalse(np.array_equal(far, out), "near and far fields differ")
         wi[7, 1] = np.nan
+        out[:] = -1
         self.assertEqual(lib().hairis_fiber_eval(fiber, n, ptr(wi), ptr(wo), None, ptr(out)),
                          ERROR_INVALID_ARGUMENT)
         self.assertIn("wi item 7", last_error())
+        self.assertTrue(np.all(out == -1), "a refused batch writes nothing")
         lib().hairis_fiber_destroy(fiber)
 
-        params = MarschnerParams()
-        lib().hairis_marschner_defaults(ctypes.byref(params))
-        marschner = lib().hairis_fiber_create_marschner(ctypes.byref(params))
+        marschner = make_fiber("model=marschner")
         wi[7, 1] = 0.0
         wi[7] /= np.linalg.norm(wi[7])
         self.assertEqual(lib().hairis_fiber_eval(marschner, n, ptr(wi), ptr(wo), ptr(h), ptr(out)),
@@ -436,7 +567,7 @@ class TestTables(unittest.TestCase):
             return 0
 
         callback = PROGRESS_FN(progress)
-        tables = lib().hairis_tables_bake(fiber, ctypes.byref(tiny_options()), callback, None)
+        tables = lib().hairis_tables_bake(fiber, TINY_BAKE, callback, None)
         self.assertTrue(tables, last_error())
         self.assertEqual(last_error(), "")
         self.assertEqual(seen[-1], 1.0)
@@ -444,18 +575,22 @@ class TestTables(unittest.TestCase):
         self.assertEqual(lib().hairis_tables_match_fiber(tables, fiber), 1)
         self.assertEqual(lib().hairis_tables_parameters(tables),
                          lib().hairis_fiber_parameters(fiber))
+        self.assertEqual(items(lib().hairis_tables_info(tables).decode()),
+                         {"source": "exact", "theta_r": "4", "theta_i": "8", "phi": "8",
+                          "n_h": "1,2"})
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "t.exr")
             self.assertEqual(lib().hairis_tables_write(tables, path.encode()), OK, last_error())
             loaded = lib().hairis_tables_load_file(path.encode())
             self.assertTrue(loaded, last_error())
             self.assertEqual(lib().hairis_tables_match_fiber(loaded, fiber), 1)
+            self.assertEqual(lib().hairis_tables_info(loaded), lib().hairis_tables_info(tables))
             lib().hairis_tables_destroy(loaded)
             bad = os.path.join(folder, "missing", "t.exr")
             self.assertEqual(lib().hairis_tables_write(tables, bad.encode()), ERROR_IO)
             self.assertIn("missing", last_error())
         lib().hairis_tables_destroy(tables)
-        other = make_fiber(coat=0.5)
+        other = make_fiber("coat=0.5")
         loaded = load_memory(default_table_bytes())
         self.assertTrue(loaded, last_error())
         self.assertEqual(lib().hairis_tables_model(loaded), b"chiang2016")
@@ -468,19 +603,31 @@ class TestTables(unittest.TestCase):
 
     def test_cancelled_bake(self):
         fiber = make_fiber()
-        callback = PROGRESS_FN(lambda _user, _fraction: 1)
-        self.assertIsNone(lib().hairis_tables_bake(fiber, ctypes.byref(tiny_options()),
-                                                   callback, None))
+        calls = []
+
+        def cancel(_user, fraction):
+            calls.append(fraction)
+            return 1
+
+        callback = PROGRESS_FN(cancel)
+        self.assertIsNone(lib().hairis_tables_bake(fiber, TINY_BAKE, callback, None))
+        self.assertEqual(last_error(), "cancelled")
+        self.assertEqual(len(calls), 1, "no progress call after cancelling")
+        # The defaults (minutes of work) are accepted and cancelled just as promptly.
+        self.assertIsNone(lib().hairis_tables_bake(fiber, defaults("bake").encode(), callback,
+                                                   None))
         self.assertEqual(last_error(), "cancelled")
         lib().hairis_fiber_destroy(fiber)
 
     def test_bad_options(self):
         fiber = make_fiber()
-        options = tiny_options()
-        options.phi_count = 0
-        self.assertIsNone(lib().hairis_tables_bake(fiber, ctypes.byref(options), PROGRESS_FN(),
-                                                   None))
-        self.assertIn("phi_count", last_error())
+        for options, word in ((b"theta_r=4;theta_i=8;phi=0", "phi"),
+                              (b"n_h=2,1", "increasing"),
+                              (b"source=approximate", "gaussian"),
+                              (b"phi_count=8", '"phi_count"')):
+            with self.subTest(options=options):
+                self.assertIsNone(lib().hairis_tables_bake(fiber, options, PROGRESS_FN(), None))
+                self.assertIn(word, last_error())
         lib().hairis_fiber_destroy(fiber)
 
     def test_corrupt_buffers_are_refused(self):
@@ -514,9 +661,10 @@ class TestSampling(unittest.TestCase):
         wo = unit_vectors(rng, n)
         h = rng.uniform(-1, 1, n).astype(np.float32)
         u = rng.random((n, 3), dtype=np.float32)
-        for strategy in (UNIFORM, ANALYTIC, GAUSSIAN, TABLE):
+        for strategy in ("uniform", "analytic", "gaussian", "table"):
             with self.subTest(strategy=strategy):
-                sampler = lib().hairis_sampler_create(strategy, self.fiber, self.tables, 0.25, 2)
+                options = ("strategy=%s;multiple_weight=0.25;n_h=2" % strategy).encode()
+                sampler = lib().hairis_sampler_create(self.fiber, self.tables, options)
                 self.assertTrue(sampler, last_error())
                 wi = np.zeros((n, 3), np.float32)
                 pdf = np.zeros(n, np.float32)
@@ -534,7 +682,7 @@ class TestSampling(unittest.TestCase):
 
     def test_table_sampler_outlives_its_tables(self):
         tables = load_memory(default_table_bytes())
-        sampler = lib().hairis_sampler_create(TABLE, None, tables, 0.5, 1)
+        sampler = lib().hairis_sampler_create(None, tables, b"multiple_weight=0.5;n_h=1")
         self.assertTrue(sampler, last_error())
         lib().hairis_tables_destroy(tables)
         wo = np.array([[0.2, 0.0, -0.9797959]], np.float32)
@@ -547,13 +695,19 @@ class TestSampling(unittest.TestCase):
         lib().hairis_sampler_destroy(sampler)
 
     def test_refusals(self):
-        self.assertIsNone(lib().hairis_sampler_create(TABLE, self.fiber, None, 0.25, 2))
+        self.assertIsNone(lib().hairis_sampler_create(self.fiber, None, b"strategy=table"))
         self.assertIn("tables", last_error())
-        self.assertIsNone(lib().hairis_sampler_create(12, None, None, 0.25, 2))
+        self.assertIsNone(lib().hairis_sampler_create(None, None, b"strategy=12"))
         self.assertIn("strategy", last_error())
-        self.assertIsNone(lib().hairis_sampler_create(GAUSSIAN, None, None, -0.1, 2))
+        self.assertIn("uniform", last_error())
+        self.assertIsNone(lib().hairis_sampler_create(None, None,
+                                                      b"strategy=gaussian;multiple_weight=-0.1"))
         self.assertIn("multiple_weight", last_error())
-        sampler = lib().hairis_sampler_create(UNIFORM, None, None, 0.0, 1)
+        rougher = make_fiber("roughness=0.6")
+        self.assertIsNone(lib().hairis_sampler_create(rougher, self.tables, b"strategy=table"))
+        self.assertIn("baked for", last_error())
+        lib().hairis_fiber_destroy(rougher)
+        sampler = lib().hairis_sampler_create(None, None, b"strategy=uniform")
         wo = np.array([[0, 1, 0]], np.float32)
         u = np.array([[0.5, 1.0, 0.5]], np.float32)
         wi = np.zeros((1, 3), np.float32)
@@ -568,14 +722,14 @@ class TestSampling(unittest.TestCase):
 class TestRender(unittest.TestCase):
     W, H = 16, 12
 
-    def make_scene(self, tables, **node_changes):
-        node = node_defaults()
-        for name, value in node_changes.items():
-            setattr(node, name, value)
+    def make_scene(self, tables, fiber_options=""):
+        fiber = make_fiber(fiber_options)
+        self.assertTrue(fiber, last_error())
         scene = lib().hairis_scene_create()
-        self.assertEqual(lib().hairis_scene_add_hair_material(scene, ctypes.byref(node), tables), 0)
-        self.assertEqual(lib().hairis_scene_add_diffuse_material(scene, vec(0.5, 0.5, 0.5),
-                                                                 vec(0, 0, 0)), 1)
+        self.assertEqual(lib().hairis_scene_add_hair_material(scene, fiber, tables), 0)
+        lib().hairis_fiber_destroy(fiber)  # the scene keeps what it needs
+        self.assertEqual(lib().hairis_scene_add_surface_material(
+            scene, b"type=diffuse;color=0.5,0.5,0.5"), 1)
         curves, points = 6, 5
         first = np.arange(0, curves * points + 1, points, dtype=np.uint32)
         x = np.linspace(-1.5, 1.5, points)
@@ -591,48 +745,44 @@ class TestRender(unittest.TestCase):
         self.assertEqual(lib().hairis_scene_add_mesh(scene, 3, ptr(vertices), 1,
                                                      ptr(indices, c_uint32),
                                                      ptr(materials, c_int32)), OK, last_error())
-        self.assertEqual(lib().hairis_scene_add_sun(scene, vec(0.2, 0.4, 1), vec(1, 1, 1), 2.0,
-                                                    0.02), OK)
-        self.assertEqual(lib().hairis_scene_set_world(scene, vec(0.05, 0.05, 0.08), 1.0), OK)
-        self.assertEqual(lib().hairis_scene_add_point_light(scene, vec(1, 1, 2), vec(1, 0.9, 0.8),
-                                                            20.0, 0.1), OK, last_error())
-        area = np.array([[1, 0, 0, -1], [0, 1, 0, 0], [0, 0, 1, 2.5], [0, 0, 0, 1]], np.float32)
-        self.assertEqual(lib().hairis_scene_add_area_light(scene, ptr(area), 2, 0.5, 0.5,
-                                                           vec(1, 1, 1), 30.0), OK, last_error())
-        self.assertEqual(lib().hairis_scene_add_area_light(scene, ptr(area), 9, 0.5, 0.5,
-                                                           vec(1, 1, 1), 30.0),
+        for light in (b"type=sun;direction=0.2,0.4,1;strength=2;angle=0.02",
+                      b"type=point;position=1,1,2;color=1,0.9,0.8;power=20;radius=0.1",
+                      b"type=area;matrix=1,0,0,-1,0,1,0,0,0,0,1,2.5,0,0,0,1;shape=disk;size=0.5;"
+                      b"size_y=0.5;power=30"):
+            self.assertEqual(lib().hairis_scene_add_light(scene, light), OK, last_error())
+        self.assertEqual(lib().hairis_scene_set_world(scene, b"color=0.05,0.05,0.08"), OK)
+        self.assertEqual(lib().hairis_scene_add_light(scene, b"type=area;shape=9"),
                          ERROR_INVALID_ARGUMENT)
         self.assertIn("shape", last_error())
-        camera = Camera()
-        camera.camera_to_world[:] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3, 0, 0, 0, 1]
         ax, ay = 0.4, 0.3  # 4:3 like the resolution
-        camera.frame[:] = [ax, ay, -1, ax, -ay, -1, -ax, -ay, -1, -ax, ay, -1]
-        camera.width, camera.height = self.W, self.H
-        self.assertEqual(lib().hairis_scene_set_camera(scene, ctypes.byref(camera)), OK,
-                         last_error())
+        frame = [ax, ay, -1, ax, -ay, -1, -ax, -ay, -1, -ax, ay, -1]
+        camera = "matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;frame=%s;width=%d;height=%d" % (
+            ",".join("%.9g" % v for v in frame), self.W, self.H)
+        self.assertEqual(lib().hairis_scene_set_camera(scene, camera.encode()), OK, last_error())
         return scene
 
-    def settings(self, strategy, samples=4):
-        s = RenderSettings()
-        lib().hairis_render_settings_defaults(ctypes.byref(s))
-        s.samples, s.max_bounces, s.strategy, s.threads, s.seed = samples, 2, strategy, 2, 3
-        return s
+    @staticmethod
+    def settings(strategy, samples=4):
+        return ("samples=%d;max_bounces=2;strategy=%s;threads=2;seed=3" % (
+            samples, strategy)).encode()
 
     def test_tiny_render(self):
         tables = load_memory(default_table_bytes())
         scene = self.make_scene(tables)
         lib().hairis_tables_destroy(tables)  # the scene keeps what it needs
-        for strategy in (ANALYTIC, TABLE):
+        for strategy in ("analytic", "table"):
             with self.subTest(strategy=strategy):
                 rgba = np.full((self.H, self.W, 4), -1, np.float32)
-                stats = RenderStats()
-                status = lib().hairis_render(scene, ctypes.byref(self.settings(strategy)),
-                                             ptr(rgba), PROGRESS_FN(), None, ctypes.byref(stats))
+                status = lib().hairis_render(scene, self.settings(strategy), ptr(rgba),
+                                             PROGRESS_FN(), None)
                 self.assertEqual(status, OK, last_error())
                 self.assertTrue(np.all(np.isfinite(rgba)) and np.all(rgba >= 0))
                 self.assertTrue(np.all(rgba[..., 3] == 1))
                 self.assertGreater(rgba[..., :3].sum(), 0)
-                self.assertEqual(stats.camera_rays, self.W * self.H * 4)
+                stats = items(lib().hairis_last_render_stats().decode())
+                self.assertEqual(int(stats["camera_rays"]), self.W * self.H * 4)
+                self.assertEqual(int(stats["threads"]), 2)
+                self.assertTrue(0 < float(stats["seconds"]) < 600)
         lib().hairis_scene_destroy(scene)
 
     def test_cancel_from_python(self):
@@ -644,25 +794,25 @@ class TestRender(unittest.TestCase):
             calls.append(fraction)
             return 1
 
-        status = lib().hairis_render(scene, ctypes.byref(self.settings(ANALYTIC, 1 << 16)),
-                                     ptr(rgba), PROGRESS_FN(progress), None, None)
+        status = lib().hairis_render(scene, self.settings("analytic", 1 << 16), ptr(rgba),
+                                     PROGRESS_FN(progress), None)
         self.assertEqual(status, ERROR_CANCELLED)
         self.assertIn("cancelled", last_error())
-        self.assertGreaterEqual(len(calls), 1)
+        self.assertEqual(len(calls), 1)
+        self.assertEqual(items(lib().hairis_last_render_stats().decode())["cancelled"], "1")
+        self.assertTrue(np.all(np.isfinite(rgba)))
         lib().hairis_scene_destroy(scene)
 
     def test_table_refusals(self):
         rgba = np.zeros((self.H, self.W, 4), np.float32)
         scene = self.make_scene(None)
-        status = lib().hairis_render(scene, ctypes.byref(self.settings(TABLE)), ptr(rgba),
-                                     PROGRESS_FN(), None, None)
+        status = lib().hairis_render(scene, self.settings("table"), ptr(rgba), PROGRESS_FN(), None)
         self.assertEqual(status, ERROR_INVALID_TABLE)
         self.assertIn("material 0", last_error())
         lib().hairis_scene_destroy(scene)
         tables = load_memory(default_table_bytes())
-        scene = self.make_scene(tables, radial_roughness=0.6)
-        status = lib().hairis_render(scene, ctypes.byref(self.settings(TABLE)), ptr(rgba),
-                                     PROGRESS_FN(), None, None)
+        scene = self.make_scene(tables, "radial_roughness=0.6")
+        status = lib().hairis_render(scene, self.settings("table"), ptr(rgba), PROGRESS_FN(), None)
         self.assertEqual(status, ERROR_INVALID_TABLE)
         self.assertIn("material 0", last_error())
         self.assertIn("baked for", last_error())
@@ -672,10 +822,34 @@ class TestRender(unittest.TestCase):
     def test_empty_scene(self):
         scene = lib().hairis_scene_create()
         rgba = np.zeros((self.H, self.W, 4), np.float32)
-        status = lib().hairis_render(scene, ctypes.byref(self.settings(ANALYTIC)), ptr(rgba),
-                                     PROGRESS_FN(), None, None)
+        status = lib().hairis_render(scene, self.settings("analytic"), ptr(rgba), PROGRESS_FN(),
+                                     None)
         self.assertEqual(status, ERROR_INVALID_ARGUMENT)
         self.assertIn("camera", last_error())
+        lib().hairis_scene_destroy(scene)
+
+    def test_film_transparent_and_clip(self):
+        """Transparent film: a camera sample that misses adds neither the world nor alpha."""
+        scene = self.make_scene(None)
+        opaque = np.zeros((self.H, self.W, 4), np.float32)
+        rgba = np.zeros((self.H, self.W, 4), np.float32)
+        settings = self.settings("analytic")
+        self.assertEqual(lib().hairis_render(scene, settings, ptr(opaque), PROGRESS_FN(), None), OK)
+        self.assertTrue(np.all(opaque[..., 3] == 1))
+        self.assertEqual(lib().hairis_render(scene, settings + b";film_transparent=1", ptr(rgba),
+                                             PROGRESS_FN(), None), OK)
+        alpha = rgba[..., 3]
+        self.assertTrue(alpha.min() < 0.5 and alpha.max() == 1, "some samples miss, some hit")
+        # Same seed, same paths: what is missing is the world (0.05, 0.05, 0.08) of the
+        # samples that missed (the sun is behind the camera).
+        world = np.array([0.05, 0.05, 0.08], np.float32)
+        np.testing.assert_allclose(opaque[..., :3] - rgba[..., :3],
+                                   (1 - alpha)[..., None] * world, atol=1e-5)
+        self.assertEqual(lib().hairis_scene_set_camera(
+            scene, b"matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;width=16;height=12;clip_end=1"), OK)
+        self.assertEqual(lib().hairis_render(scene, settings + b";film_transparent=1", ptr(rgba),
+                                             PROGRESS_FN(), None), OK)
+        self.assertTrue(np.all(rgba == 0), "everything is past clip_end: nothing is seen")
         lib().hairis_scene_destroy(scene)
 
 
@@ -683,8 +857,9 @@ def main():
     global OPTIONS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--library", required=True, help="libhairis.so")
-    parser.add_argument("--layout-tool", help="capi_test, which prints the C layouts")
-    parser.add_argument("--header", help="hairis.h")
+    parser.add_argument("--header", action="append", default=[],
+                        help="a public header (hairis.h, hairis_render.h); repeat for each")
+    parser.add_argument("--nm", help="the nm program (default: nm on PATH)")
     parser.add_argument("--addon-native", help="addon/hairis/native.py")
     parser.add_argument("--version", help="the project's version")
     OPTIONS, rest = parser.parse_known_args()

@@ -1,16 +1,13 @@
-/* Tests of the hairis C API (lib/include/hairis/hairis.h), written in C11 against the shared
- * library, as a renderer embedding hairis would use it.
+/* Tests of the hairis C API (lib/include/hairis/hairis.h, hairis_render.h), written in C11
+ * against the shared library, as a renderer embedding hairis would use it.
  *
- * Usage: capi_test [--layout]
- *   (no argument)  runs every check and prints "N passed, M failed"; exits 1 on a failure.
- *   --layout       prints "struct <name> <sizeof>" and "field <struct> <field> <offset>" lines
- *                  for every struct of the header (capi_ctypes_test.py compares its ctypes
- *                  mirrors against them) and exits.
+ * Usage: capi_test   runs every check and prints "N passed, M failed"; exits 1 on a failure.
  *
  * HAIRIS_EXPECTED_VERSION (a compile definition) is the project's version.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "hairis/hairis.h"
+#include "hairis/hairis_render.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -108,84 +105,126 @@ static int all_finite_non_negative(const float *v, size_t n)
     return 1;
 }
 
-/* ---- Layout dump (for the ctypes test) ---------------------------------------------------- */
+/* ---- Option strings, read here independently of the library ------------------------------- */
 
-#define PRINT_SIZE(type) printf("struct %s %zu\n", #type, sizeof(type))
-#define PRINT_FIELD(type, field) printf("field %s %s %zu\n", #type, #field, offsetof(type, field))
+enum { TEXT = 4096 };
 
-static void print_layout(void)
+/* Copies a string the library returned (it lives until the next call on this thread). */
+static const char *keep(char *into, const char *text)
 {
-    PRINT_SIZE(hairis_principled_hair);
-    PRINT_FIELD(hairis_principled_hair, parametrization);
-    PRINT_FIELD(hairis_principled_hair, color);
-    PRINT_FIELD(hairis_principled_hair, melanin);
-    PRINT_FIELD(hairis_principled_hair, melanin_redness);
-    PRINT_FIELD(hairis_principled_hair, tint);
-    PRINT_FIELD(hairis_principled_hair, absorption_coefficient);
-    PRINT_FIELD(hairis_principled_hair, roughness);
-    PRINT_FIELD(hairis_principled_hair, radial_roughness);
-    PRINT_FIELD(hairis_principled_hair, coat);
-    PRINT_FIELD(hairis_principled_hair, ior);
-    PRINT_FIELD(hairis_principled_hair, offset);
-    PRINT_FIELD(hairis_principled_hair, random_color);
-    PRINT_FIELD(hairis_principled_hair, random_roughness);
-    PRINT_FIELD(hairis_principled_hair, random);
-    PRINT_SIZE(hairis_marschner_params);
-    PRINT_FIELD(hairis_marschner_params, eta);
-    PRINT_FIELD(hairis_marschner_params, sigma_a);
-    PRINT_FIELD(hairis_marschner_params, alpha_r);
-    PRINT_FIELD(hairis_marschner_params, alpha_tt);
-    PRINT_FIELD(hairis_marschner_params, alpha_trt);
-    PRINT_FIELD(hairis_marschner_params, beta_r);
-    PRINT_FIELD(hairis_marschner_params, beta_tt);
-    PRINT_FIELD(hairis_marschner_params, beta_trt);
-    PRINT_FIELD(hairis_marschner_params, eccentricity);
-    PRINT_FIELD(hairis_marschner_params, glint_scale);
-    PRINT_FIELD(hairis_marschner_params, caustic_width);
-    PRINT_FIELD(hairis_marschner_params, caustic_fade);
-    PRINT_FIELD(hairis_marschner_params, caustic_intensity_limit);
-    PRINT_SIZE(hairis_bake_options);
-    PRINT_FIELD(hairis_bake_options, theta_r_count);
-    PRINT_FIELD(hairis_bake_options, theta_i_count);
-    PRINT_FIELD(hairis_bake_options, phi_count);
-    PRINT_FIELD(hairis_bake_options, n_h_count);
-    PRINT_FIELD(hairis_bake_options, n_h_values);
-    PRINT_FIELD(hairis_bake_options, source);
-    PRINT_FIELD(hairis_bake_options, threads);
-    PRINT_SIZE(hairis_camera);
-    PRINT_FIELD(hairis_camera, camera_to_world);
-    PRINT_FIELD(hairis_camera, orthographic);
-    PRINT_FIELD(hairis_camera, frame);
-    PRINT_FIELD(hairis_camera, width);
-    PRINT_FIELD(hairis_camera, height);
-    PRINT_SIZE(hairis_render_settings);
-    PRINT_FIELD(hairis_render_settings, samples);
-    PRINT_FIELD(hairis_render_settings, max_bounces);
-    PRINT_FIELD(hairis_render_settings, strategy);
-    PRINT_FIELD(hairis_render_settings, multiple_weight);
-    PRINT_FIELD(hairis_render_settings, n_h);
-    PRINT_FIELD(hairis_render_settings, seed);
-    PRINT_FIELD(hairis_render_settings, threads);
-    PRINT_SIZE(hairis_render_stats);
-    PRINT_FIELD(hairis_render_stats, seconds);
-    PRINT_FIELD(hairis_render_stats, camera_rays);
-    PRINT_FIELD(hairis_render_stats, dropped_samples);
-    PRINT_FIELD(hairis_render_stats, peak_memory_bytes);
+    snprintf(into, TEXT, "%s", text ? text : "(null)");
+    return into;
 }
+
+/* Item `index` of "name=value;..." as name and value; 0 past the last item. */
+static int option_item(const char *options, int index, char *name, char *value, size_t size)
+{
+    const char *p = options;
+    for (int i = 0; i < index; ++i) {
+        p = strchr(p, ';');
+        if (!p) return 0;
+        ++p;
+    }
+    if (*p == '\0') return 0;
+    const char *end = strchr(p, ';'), *eq = strchr(p, '=');
+    if (!end) end = p + strlen(p);
+    if (!eq || eq > end) return 0;
+    snprintf(name, size, "%.*s", (int)(eq - p), p);
+    snprintf(value, size, "%.*s", (int)(end - eq - 1), eq + 1);
+    return 1;
+}
+
+/* The value of `name` in "name=value;..."; 0 when absent. */
+static int option_value(const char *options, const char *name, char *value, size_t size)
+{
+    char n[256], v[TEXT];
+    for (int i = 0; option_item(options, i, n, v, sizeof v); ++i)
+        if (strcmp(n, name) == 0) {
+            snprintf(value, size, "%s", v);
+            return 1;
+        }
+    return 0;
+}
+
+/* `options` with the value of `name` (which must be there) replaced; into has TEXT bytes. */
+static const char *with_option(char *into, const char *options, const char *name,
+                               const char *value)
+{
+    char n[256], v[TEXT], out[TEXT] = "";
+    int found = 0;
+    for (int i = 0; option_item(options, i, n, v, sizeof v); ++i) {
+        const int same = strcmp(n, name) == 0;
+        found |= same;
+        size_t used = strlen(out);
+        const int n_out =
+            snprintf(out + used, sizeof out - used, "%s%s=%s", i ? ";" : "", n, same ? value : v);
+        CHECK(n_out > 0 && (size_t)n_out < sizeof out - used, "with_option: too long");
+    }
+    CHECK(found, "with_option: \"%s\" has no %s", options, name);
+    snprintf(into, TEXT, "%s", out);
+    return into;
+}
+
+/* The message lists `name` among the known names "(known: a, b, c)". */
+static int lists_known_name(const char *message, const char *name)
+{
+    const char *p = strstr(message, "(known:");
+    if (!p) return 0;
+    p += strlen("(known:");
+    const size_t n = strlen(name);
+    while (*p && *p != ')') {
+        while (*p == ' ') ++p;
+        const char *end = p;
+        while (*end && *end != ',' && *end != ')') ++end;
+        if ((size_t)(end - p) == n && strncmp(p, name, n) == 0) return 1;
+        p = *end == ',' ? end + 1 : end;
+    }
+    return 0;
+}
+
+/* ---- Shared fixtures ---------------------------------------------------------------------- */
+
+#define TINY_BAKE "theta_r=4;theta_i=8;phi=8;n_h=1,2;threads=2"
+
+typedef struct progress_state {
+    int calls;
+    int cancel_at; /* cancel on this call (1-based); 0 = never */
+    float last;
+    int decreasing;
+} progress_state;
+
+static int on_progress(void *user, float progress)
+{
+    progress_state *s = (progress_state *)user;
+    ++s->calls;
+    if (progress < s->last) s->decreasing = 1;
+    s->last = progress;
+    return s->cancel_at > 0 && s->calls >= s->cancel_at;
+}
+
+static int cancel_at_once(void *user, float progress)
+{
+    (void)user;
+    (void)progress;
+    return 1;
+}
+
+static hairis_tables *g_tables = NULL; /* baked for the default Chiang fiber, n_h {1, 2} */
 
 /* ---- Library ------------------------------------------------------------------------------ */
 
 static int set_error_in_thread(void *arg)
 {
     (void)arg;
-    hairis_fiber *fiber = hairis_fiber_create_principled(NULL);
+    hairis_fiber *fiber = hairis_fiber_create("roughness=2");
     return fiber == NULL && hairis_last_error()[0] != '\0' ? 0 : 1;
 }
 
 static void test_library(void)
 {
     section("library");
-    CHECK(hairis_api_version() == HAIRIS_API_VERSION, "api version %d", hairis_api_version());
+    CHECK(hairis_api_version() == 2 && HAIRIS_API_VERSION == 2, "api version %d",
+          hairis_api_version());
     CHECK_NO_ERROR();
     const char *version = hairis_version_string();
     CHECK(version != NULL && strcmp(version, HAIRIS_EXPECTED_VERSION) == 0,
@@ -203,7 +242,7 @@ static void test_library(void)
     CHECK_NO_ERROR();
 
     /* An error is cleared by the next successful call. */
-    CHECK(hairis_fiber_create_principled(NULL) == NULL, "NULL node refused");
+    CHECK(hairis_fiber_create("ior=0.5") == NULL, "IOR 0.5 refused");
     CHECK(hairis_last_error()[0] != '\0', "an error is reported");
     hairis_api_version();
     CHECK_NO_ERROR();
@@ -211,88 +250,277 @@ static void test_library(void)
 
 /* ---- Defaults ----------------------------------------------------------------------------- */
 
+/* hairis_defaults(kind) holds name=expected. */
+static void expect_default(const char *kind, const char *name, const char *expected)
+{
+    char value[TEXT];
+    const char *defaults = hairis_defaults(kind);
+    CHECK(defaults != NULL && option_value(defaults, name, value, sizeof value) &&
+              strcmp(value, expected) == 0,
+          "hairis_defaults(\"%s\"): %s should be %s in \"%s\"", kind, name, expected,
+          defaults ? defaults : "(null)");
+}
+
+static const char *const g_kinds[] = {"chiang", "marschner", "bake",  "sampler", "diffuse", "sun",
+                                      "point",  "area",      "world", "camera",  "render"};
+enum { KIND_COUNT = sizeof g_kinds / sizeof g_kinds[0] };
+
 static void test_defaults(void)
 {
     section("defaults");
-    hairis_principled_hair node;
-    memset(&node, 0xff, sizeof node);
-    hairis_principled_hair_defaults(&node);
+    /* Blender's Principled Hair node (Direct Coloring), in radians. */
+    expect_default("chiang", "model", "chiang");
+    expect_default("chiang", "parametrization", "color");
+    expect_default("chiang", "ior", "1.54999995");
+    expect_default("chiang", "roughness", "0.300000012");
+    expect_default("chiang", "radial_roughness", "0.300000012");
+    expect_default("chiang", "offset", "0.0349065848"); /* 2 degrees */
+    expect_default("chiang", "color", "0.0175129995,0.00576299988,0.00205900008");
+    expect_default("chiang", "coat", "0");
+    expect_default("chiang", "random", "0");
+    expect_default("chiang", "cycles", "3.4");
+    /* The seed's Marschner parameters (blonde). */
+    expect_default("marschner", "model", "marschner");
+    expect_default("marschner", "eta", "1.55");
+    expect_default("marschner", "sigma_a", "0.150000006,0.200000003,0.300000012");
+    expect_default("marschner", "alpha_r_deg", "-7.5");
+    expect_default("marschner", "eccentricity", "0.9");
+    expect_default("bake", "theta_r", "31");
+    expect_default("bake", "theta_i", "64");
+    expect_default("bake", "phi", "64");
+    expect_default("bake", "n_h", "1,2,4,8,16");
+    expect_default("bake", "source", "exact");
+    expect_default("bake", "threads", "0");
+    expect_default("sampler", "strategy", "table");
+    expect_default("sampler", "multiple_weight", "0");
+    expect_default("sampler", "n_h", "2");
+    expect_default("render", "samples", "64");
+    expect_default("render", "max_bounces", "12");
+    expect_default("render", "max_diffuse_bounces", "4");
+    expect_default("render", "max_transmission_bounces", "12");
+    expect_default("render", "tile_size", "16");
+    expect_default("render", "film_transparent", "0");
+    expect_default("render", "strategy", "table");
+    expect_default("render", "seed", "0");
+    expect_default("render", "threads", "0");
+    expect_default("camera", "width", "64");
+    expect_default("camera", "clip_start", "0");
+    expect_default("sun", "type", "sun");
+    expect_default("area", "shape", "square");
+    expect_default("diffuse", "type", "diffuse");
     CHECK_NO_ERROR();
-    CHECK(node.parametrization == HAIRIS_PARAM_COLOR, "Direct Coloring by default");
-    CHECK(fabsf(node.ior - 1.55f) < 1e-6f, "ior %g", node.ior);
-    CHECK(fabsf(node.roughness - 0.3f) < 1e-6f && fabsf(node.radial_roughness - 0.3f) < 1e-6f,
-          "roughness %g %g", node.roughness, node.radial_roughness);
-    CHECK(fabsf(node.offset - 0.034906585f) < 1e-6f, "offset 2 degrees in radians, got %g",
-          node.offset);
-    CHECK(fabsf(node.color[0] - 0.017513f) < 1e-6f, "colour %g", node.color[0]);
-    CHECK(node.coat == 0.0f && node.random == 0.0f && node.random_roughness == 0.0f,
-          "coat and randoms 0");
 
-    hairis_marschner_params m;
-    memset(&m, 0xff, sizeof m);
-    hairis_marschner_defaults(&m);
-    CHECK_NO_ERROR();
-    CHECK(fabsf(m.eta - 1.55f) < 1e-6f, "eta %g", m.eta);
-    CHECK(fabsf(m.sigma_a[0] - 0.15f) < 1e-6f && fabsf(m.sigma_a[1] - 0.2f) < 1e-6f &&
-              fabsf(m.sigma_a[2] - 0.3f) < 1e-6f,
-          "blonde sigma_a (%g, %g, %g)", m.sigma_a[0], m.sigma_a[1], m.sigma_a[2]);
-    CHECK(fabsf(m.alpha_r + 0.1308997f) < 1e-6f, "alpha_r -7.5 degrees, got %g", m.alpha_r);
-    CHECK(fabsf(m.eccentricity - 0.9f) < 1e-6f, "eccentricity %g", m.eccentricity);
+    /* Every kind the header names has defaults; the others are refused, listing the kinds. */
+    for (int k = 0; k < KIND_COUNT; ++k) {
+        const char *d = hairis_defaults(g_kinds[k]);
+        CHECK(d != NULL && strchr(d, '=') != NULL, "defaults of %s: \"%s\"", g_kinds[k],
+              d ? d : "(null)");
+    }
+    CHECK(hairis_defaults("principled") == NULL, "unknown kind");
+    for (int k = 0; k < KIND_COUNT; ++k) CHECK_ERROR_MENTIONS(g_kinds[k]);
+    CHECK_ERROR_MENTIONS("principled");
+    CHECK(hairis_defaults(NULL) == NULL, "NULL kind");
+    CHECK_ERROR_MENTIONS("kind");
+}
 
-    hairis_bake_options o;
-    memset(&o, 0xff, sizeof o);
-    hairis_bake_options_defaults(&o);
-    CHECK_NO_ERROR();
-    CHECK(o.theta_r_count == 31 && o.theta_i_count == 64 && o.phi_count == 64,
-          "resolution %d %d %d", o.theta_r_count, o.theta_i_count, o.phi_count);
-    CHECK(o.n_h_count == 5 && o.n_h_values[0] == 1 && o.n_h_values[4] == 16 &&
-              o.n_h_values[5] == 0 && o.n_h_values[15] == 0,
-          "n_h values");
-    CHECK(o.source == 0 && o.threads == 0, "source %d threads %d", o.source, o.threads);
+/* ---- Option strings: the grammar and the refusals every call shares ----------------------- */
 
-    hairis_render_settings r;
-    memset(&r, 0xff, sizeof r);
-    hairis_render_settings_defaults(&r);
-    CHECK_NO_ERROR();
-    CHECK(r.samples == 64 && r.max_bounces == 12 && r.strategy == HAIRIS_STRATEGY_TABLE,
-          "samples %d bounces %d strategy %d", r.samples, r.max_bounces, r.strategy);
-    CHECK(r.multiple_weight == 0.0f && r.n_h == 2 && r.seed == 0 &&
-              r.threads == 0,
-          "weight %g n_h %d", r.multiple_weight, r.n_h);
+static hairis_fiber *g_option_fiber;   /* default Chiang fiber */
+static hairis_scene *g_option_scene;   /* a scene for the scene calls */
+static float g_option_rgba[16 * 16 * 4];
 
-    /* NULL is refused without a crash. */
-    hairis_principled_hair_defaults(NULL);
-    CHECK_ERROR_MENTIONS("node");
-    hairis_marschner_defaults(NULL);
-    CHECK_ERROR_MENTIONS("params");
-    hairis_bake_options_defaults(NULL);
-    CHECK_ERROR_MENTIONS("options");
-    hairis_render_settings_defaults(NULL);
-    CHECK_ERROR_MENTIONS("settings");
+/* Each tries one call of a kind with `options` and returns whether it was accepted. */
+static int try_fiber(const char *kind, const char *options)
+{
+    char text[TEXT];
+    snprintf(text, sizeof text, "model=%s;%s", kind, options);
+    hairis_fiber *f = hairis_fiber_create(text);
+    if (f) hairis_fiber_destroy(f); /* (destroy would clear a refusal's message) */
+    return f != NULL;
+}
+
+static int try_options(const char *kind, const char *options)
+{
+    char text[TEXT];
+    if (strcmp(kind, "chiang") == 0 || strcmp(kind, "marschner") == 0)
+        return try_fiber(kind, options);
+    if (strcmp(kind, "bake") == 0) {
+        /* Accepted options reach the first progress call, which cancels. */
+        hairis_tables *t = hairis_tables_bake(g_option_fiber, options, cancel_at_once, NULL);
+        if (t) hairis_tables_destroy(t);
+        return t != NULL || strcmp(hairis_last_error(), "cancelled") == 0;
+    }
+    if (strcmp(kind, "sampler") == 0) {
+        hairis_sampler *s = hairis_sampler_create(g_option_fiber, g_tables, options);
+        if (s) hairis_sampler_destroy(s);
+        return s != NULL;
+    }
+    if (strcmp(kind, "render") == 0) {
+        const int status =
+            hairis_render(g_option_scene, options, g_option_rgba, cancel_at_once, NULL);
+        return status == HAIRIS_OK || status == HAIRIS_ERROR_CANCELLED;
+    }
+    if (strcmp(kind, "diffuse") == 0) {
+        snprintf(text, sizeof text, "type=diffuse;%s", options);
+        return hairis_scene_add_surface_material(g_option_scene, text) >= 0;
+    }
+    if (strcmp(kind, "sun") == 0 || strcmp(kind, "point") == 0 || strcmp(kind, "area") == 0) {
+        snprintf(text, sizeof text, "type=%s;%s", kind, options);
+        return hairis_scene_add_light(g_option_scene, text) == HAIRIS_OK;
+    }
+    if (strcmp(kind, "world") == 0)
+        return hairis_scene_set_world(g_option_scene, options) == HAIRIS_OK;
+    if (strcmp(kind, "camera") == 0) {
+        /* The scene's camera stays 16 x 16 (g_option_rgba's size). */
+        snprintf(text, sizeof text, "width=16;height=16;%s", options);
+        return hairis_scene_set_camera(g_option_scene, text) == HAIRIS_OK;
+    }
+    CHECK(0, "no call for kind %s", kind);
+    return 0;
+}
+
+static void test_option_strings(void)
+{
+    section("option strings");
+    g_option_fiber = hairis_fiber_create("");
+    g_option_scene = hairis_scene_create();
+    const int hair = hairis_scene_add_hair_material(g_option_scene, g_option_fiber, g_tables);
+    const float p[6] = {-1, 0, 0, 1, 0, 0}, r[2] = {0.05f, 0.05f};
+    const uint32_t first[2] = {0, 2};
+    CHECK(hairis_scene_add_curves(g_option_scene, hair, 1, first, 2, p, r) == HAIRIS_OK &&
+              hairis_scene_set_camera(g_option_scene,
+                                      "matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;width=16;height=16") ==
+                  HAIRIS_OK,
+          "a scene to render");
+
+    char text[TEXT];
+    for (int k = 0; k < KIND_COUNT; ++k) {
+        const char *kind = g_kinds[k];
+        /* What the kind's call accepts without a name of its own. */
+        CHECK(try_options(kind, ""), "%s: no options are its defaults", kind);
+        if (strcmp(kind, "bake") != 0 && strcmp(kind, "render") != 0) CHECK_NO_ERROR();
+
+        /* An unknown name: refused, naming it and listing every name of the kind. */
+        CHECK(!try_options(kind, "bogus_name=1"), "%s: an unknown name is refused", kind);
+        char message[TEXT];
+        keep(message, hairis_last_error());
+        CHECK(strstr(message, "\"bogus_name\"") != NULL, "%s: the message names it: %s", kind,
+              message);
+        char defaults[TEXT], name[256], value[TEXT];
+        keep(defaults, hairis_defaults(kind));
+        for (int i = 0; option_item(defaults, i, name, value, sizeof value); ++i)
+            CHECK(lists_known_name(message, name), "%s: the message lists %s: %s", kind, name,
+                  message);
+
+        /* A name given twice, an item without '=', an item without a name. */
+        option_item(defaults, 1, name, value, sizeof value);
+        CHECK(snprintf(text, sizeof text, "%s=%s;%s=%s", name, value, name, value) < TEXT, "fits");
+        CHECK(!try_options(kind, text), "%s: %s given twice is refused", kind, name);
+        CHECK_ERROR_MENTIONS("given twice");
+        CHECK_ERROR_MENTIONS(name);
+        snprintf(text, sizeof text, "%s", name);
+        CHECK(!try_options(kind, text), "%s: \"%s\" without a value is refused", kind, name);
+        CHECK_ERROR_MENTIONS("name=value");
+        CHECK(!try_options(kind, "=3"), "%s: an item without a name is refused", kind);
+        CHECK_ERROR_MENTIONS("no name");
+
+        /* Spaces around names and values and empty items are allowed. */
+        CHECK(snprintf(text, sizeof text, " ;; %s = %s ; ", name, value) < TEXT, "fits");
+        CHECK(try_options(kind, text), "%s: \"%s\" is accepted", kind, text);
+    }
+
+    /* A Marschner name is unknown to Chiang and the other way round; preset is not an option. */
+    CHECK(!try_fiber("chiang", "eta=1.5"), "eta for Chiang");
+    CHECK_ERROR_MENTIONS("\"eta\"");
+    CHECK_ERROR_MENTIONS("model=chiang");
+    CHECK(!try_fiber("marschner", "roughness=0.3"), "roughness for Marschner");
+    CHECK_ERROR_MENTIONS("\"roughness\"");
+    CHECK_ERROR_MENTIONS("model=marschner");
+    CHECK(!try_fiber("chiang", "preset=blonde"), "preset");
+    CHECK_ERROR_MENTIONS("\"preset\"");
+    CHECK(!try_fiber("chiang", "offset=0.1;offset_deg=3"), "offset and offset_deg");
+    CHECK_ERROR_MENTIONS("offset_deg");
+
+    /* Unknown choice words: refused naming the option and listing the words it takes. */
+    struct {
+        const char *kind, *options, *name, *allowed;
+    } words[] = {
+        {"chiang", "parametrization=7", "parametrization", "melanin"},
+        {"chiang", "parametrization=Color", "parametrization", "absorption"},
+        {"sampler", "strategy=9", "strategy", "analytic"},
+        {"sampler", "strategy=TABLE", "strategy", "gaussian"},
+        {"render", "strategy=tables", "strategy", "uniform"},
+        {"bake", "source=2", "source", "gaussian"},
+        {"area", "shape=hexagon", "shape", "ellipse"},
+        {"render", "film_transparent=2", "film_transparent", "true"},
+        {"camera", "orthographic=yes", "orthographic", "false"},
+    };
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
+        CHECK(!try_options(words[i].kind, words[i].options), "%s: %s refused", words[i].kind,
+              words[i].options);
+        CHECK_ERROR_MENTIONS(words[i].name);
+        CHECK_ERROR_MENTIONS(words[i].allowed);
+    }
+    CHECK(hairis_fiber_create("model=hair") == NULL, "an unknown model");
+    CHECK_ERROR_MENTIONS("marschner");
+    CHECK(hairis_scene_add_light(g_option_scene, "type=spot") != HAIRIS_OK, "a spot light");
+    CHECK_ERROR_MENTIONS("area");
+    CHECK(hairis_scene_add_light(g_option_scene, "strength=2") != HAIRIS_OK, "a light without type");
+    CHECK_ERROR_MENTIONS("type");
+    CHECK(hairis_scene_add_surface_material(g_option_scene, "type=glossy") < 0, "glossy");
+    CHECK_ERROR_MENTIONS("diffuse");
+
+    /* NaN, infinity and numbers that are not numbers, refused by name. */
+    struct {
+        const char *kind, *options, *name;
+    } numbers[] = {
+        {"chiang", "roughness=nan", "roughness"},
+        {"chiang", "coat=NaN", "coat"},
+        {"chiang", "offset=inf", "offset"},
+        {"chiang", "tint=nan,1,1", "tint"},       /* not read by Direct Coloring, still refused */
+        {"chiang", "melanin=-inf", "melanin"},
+        {"chiang", "color=0.5,0.5", "color"},     /* two components */
+        {"marschner", "eta=nan", "eta"},
+        {"marschner", "beta_trt_deg=inf", "beta_trt_deg"},
+        {"bake", "theta_i=8.5", "theta_i"},
+        {"bake", "threads=two", "threads"},
+        {"sampler", "multiple_weight=nan", "multiple_weight"},
+        {"render", "samples=1e3", "samples"},
+        {"render", "seed=-1", "seed"},
+        {"sun", "direction=nan,0,1", "direction"},
+        {"point", "power=inf", "power"},
+        {"world", "strength=-inf", "strength"},
+        {"camera", "frame=0,0,nan,1,1,1,1,1,1,1,1,1", "frame"},
+        {"diffuse", "emission=1,1,inf", "emission"},
+    };
+    for (size_t i = 0; i < sizeof numbers / sizeof numbers[0]; ++i) {
+        CHECK(!try_options(numbers[i].kind, numbers[i].options), "%s: %s refused",
+              numbers[i].kind, numbers[i].options);
+        CHECK_ERROR_MENTIONS(numbers[i].name);
+    }
+
+    /* NULL options read as "": the defaults. */
+    hairis_fiber *from_null = hairis_fiber_create(NULL);
+    CHECK(from_null && strcmp(keep(text, hairis_fiber_parameters(from_null)),
+                              hairis_fiber_parameters(g_option_fiber)) == 0,
+          "hairis_fiber_create(NULL) is the default fiber");
+    hairis_fiber_destroy(from_null);
+    CHECK(hairis_scene_set_world(g_option_scene, NULL) == HAIRIS_OK, "world from NULL");
+    CHECK(hairis_scene_add_surface_material(g_option_scene, NULL) >= 0, "diffuse from NULL");
+    CHECK(hairis_scene_add_light(g_option_scene, NULL) != HAIRIS_OK, "a light needs its type");
+    CHECK_ERROR_MENTIONS("type");
+
+    hairis_scene_destroy(g_option_scene);
+    hairis_fiber_destroy(g_option_fiber);
 }
 
 /* ---- Fibers ------------------------------------------------------------------------------- */
 
-static hairis_fiber *default_chiang(void)
+/* Creating a fiber from `options` fails and the error mentions `word`. */
+static void expect_fiber_refused(const char *options, const char *word)
 {
-    hairis_principled_hair node;
-    hairis_principled_hair_defaults(&node);
-    return hairis_fiber_create_principled(&node);
-}
-
-/* Creating a fiber from `node` fails and the error mentions `word`. */
-static void expect_principled_refused(const hairis_principled_hair *node, const char *word)
-{
-    hairis_fiber *fiber = hairis_fiber_create_principled(node);
-    CHECK(fiber == NULL, "node with a bad %s refused", word);
-    CHECK_ERROR_MENTIONS(word);
-    hairis_fiber_destroy(fiber);
-}
-
-static void expect_marschner_refused(const hairis_marschner_params *params, const char *word)
-{
-    hairis_fiber *fiber = hairis_fiber_create_marschner(params);
-    CHECK(fiber == NULL, "params with a bad %s refused", word);
+    hairis_fiber *fiber = hairis_fiber_create(options);
+    CHECK(fiber == NULL, "\"%s\" refused", options);
     CHECK_ERROR_MENTIONS(word);
     hairis_fiber_destroy(fiber);
 }
@@ -300,12 +528,12 @@ static void expect_marschner_refused(const hairis_marschner_params *params, cons
 static void test_fiber_creation(void)
 {
     section("fiber creation");
-    hairis_principled_hair node;
-    hairis_principled_hair_defaults(&node);
-    for (int p = HAIRIS_PARAM_ABSORPTION; p <= HAIRIS_PARAM_COLOR; ++p) {
-        node.parametrization = p;
-        hairis_fiber *fiber = hairis_fiber_create_principled(&node);
-        CHECK(fiber != NULL, "parametrization %d accepted", p);
+    const char *parametrizations[3] = {"absorption", "melanin", "color"};
+    char text[TEXT], first[TEXT] = "";
+    for (int p = 0; p < 3; ++p) {
+        snprintf(text, sizeof text, "parametrization=%s", parametrizations[p]);
+        hairis_fiber *fiber = hairis_fiber_create(text);
+        CHECK(fiber != NULL, "%s accepted", text);
         CHECK_NO_ERROR();
         CHECK(strcmp(hairis_fiber_model(fiber), "chiang2016") == 0, "model \"%s\"",
               hairis_fiber_model(fiber));
@@ -313,26 +541,37 @@ static void test_fiber_creation(void)
                   strstr(hairis_fiber_parameters(fiber), "offset=") != NULL,
               "parameters \"%s\"", hairis_fiber_parameters(fiber));
         CHECK_NO_ERROR();
+        /* Each parametrization maps the node's defaults to its own absorption. */
+        if (p == 0) keep(first, hairis_fiber_parameters(fiber));
+        else CHECK(strcmp(first, hairis_fiber_parameters(fiber)) != 0, "%s: another sigma_a", text);
         hairis_fiber_destroy(fiber);
         CHECK_NO_ERROR();
     }
 
     /* Two nodes that map to the same closure parameters give the same parameter string. */
     {
-        hairis_fiber *a = default_chiang();
-        hairis_principled_hair other;
-        hairis_principled_hair_defaults(&other);
-        other.melanin = 0.1f; /* not read by Direct Coloring */
-        hairis_fiber *b = hairis_fiber_create_principled(&other);
-        CHECK(a && b && strcmp(hairis_fiber_parameters(a), hairis_fiber_parameters(b)) == 0,
+        hairis_fiber *a = hairis_fiber_create("");
+        hairis_fiber *b = hairis_fiber_create("melanin=0.1"); /* not read by Direct Coloring */
+        CHECK(a && b && strcmp(keep(text, hairis_fiber_parameters(a)),
+                               hairis_fiber_parameters(b)) == 0,
               "unread inputs do not change the parameters");
+        /* offset_deg is offset in degrees. */
+        hairis_fiber *c = hairis_fiber_create("offset_deg=2");
+        CHECK(a && c && strcmp(keep(text, hairis_fiber_parameters(a)),
+                               hairis_fiber_parameters(c)) == 0,
+              "offset_deg=2 is the default offset of 2 degrees");
+        /* Cycles 4.2's tilt changes f, and the parameters say so. */
+        hairis_fiber *d = hairis_fiber_create("cycles=4.2");
+        CHECK(d && strstr(hairis_fiber_parameters(d), "cycles=4.2") != NULL &&
+                  strstr(hairis_fiber_parameters(a), "cycles") == NULL,
+              "cycles=4.2 is recorded: \"%s\"", d ? hairis_fiber_parameters(d) : "");
         hairis_fiber_destroy(a);
         hairis_fiber_destroy(b);
+        hairis_fiber_destroy(c);
+        hairis_fiber_destroy(d);
     }
 
-    hairis_marschner_params m;
-    hairis_marschner_defaults(&m);
-    hairis_fiber *marschner = hairis_fiber_create_marschner(&m);
+    hairis_fiber *marschner = hairis_fiber_create("model=marschner");
     CHECK(marschner != NULL, "Marschner defaults accepted");
     CHECK(strcmp(hairis_fiber_model(marschner), "marschner2003") == 0, "model \"%s\"",
           hairis_fiber_model(marschner));
@@ -342,67 +581,30 @@ static void test_fiber_creation(void)
           "blonde sigma_a: \"%s\"", hairis_fiber_parameters(marschner));
     hairis_fiber_destroy(marschner);
 
-    /* Every kind of bad input: NULL, enum out of range, non-finite, out of range. */
-    expect_principled_refused(NULL, "node");
-    hairis_principled_hair bad;
-    hairis_principled_hair_defaults(&bad);
-    bad.parametrization = 7;
-    expect_principled_refused(&bad, "parametrization");
-    bad.parametrization = -1;
-    expect_principled_refused(&bad, "parametrization");
-    hairis_principled_hair_defaults(&bad);
-    bad.roughness = 2.0f;
-    expect_principled_refused(&bad, "roughness");
-    hairis_principled_hair_defaults(&bad);
-    bad.radial_roughness = -0.5f;
-    expect_principled_refused(&bad, "radial_roughness");
-    hairis_principled_hair_defaults(&bad);
-    bad.ior = 0.9f;
-    expect_principled_refused(&bad, "ior");
-    hairis_principled_hair_defaults(&bad);
-    bad.coat = NAN;
-    expect_principled_refused(&bad, "coat");
-    hairis_principled_hair_defaults(&bad);
-    bad.offset = INFINITY;
-    expect_principled_refused(&bad, "offset");
-    hairis_principled_hair_defaults(&bad);
-    bad.offset = 2.0f; /* more than pi/2 */
-    expect_principled_refused(&bad, "offset");
-    hairis_principled_hair_defaults(&bad);
-    bad.color[1] = 0.0f;
-    expect_principled_refused(&bad, "color");
-    hairis_principled_hair_defaults(&bad);
-    bad.tint[2] = NAN; /* not read by Direct Coloring, but never finite */
-    expect_principled_refused(&bad, "tint");
-    hairis_principled_hair_defaults(&bad);
-    bad.parametrization = HAIRIS_PARAM_MELANIN;
-    bad.melanin = 1.5f;
-    expect_principled_refused(&bad, "melanin");
-    hairis_principled_hair_defaults(&bad);
-    bad.parametrization = HAIRIS_PARAM_ABSORPTION;
-    bad.absorption_coefficient[0] = -1.0f;
-    expect_principled_refused(&bad, "absorption_coefficient");
+    /* Every kind of bad value: unknown word, non-finite, out of range. */
+    expect_fiber_refused("parametrization=7", "parametrization");
+    expect_fiber_refused("parametrization=-1", "parametrization");
+    expect_fiber_refused("roughness=2", "roughness");
+    expect_fiber_refused("radial_roughness=-0.5", "radial_roughness");
+    expect_fiber_refused("ior=0.9", "ior");
+    expect_fiber_refused("ior=1", "ior");
+    expect_fiber_refused("coat=nan", "coat");
+    expect_fiber_refused("offset=inf", "offset");
+    expect_fiber_refused("offset=2", "offset"); /* more than pi/2 */
+    expect_fiber_refused("color=0.5,0,0.5", "color");
+    expect_fiber_refused("tint=1,1,nan", "tint"); /* not read by Direct Coloring, never finite */
+    expect_fiber_refused("parametrization=melanin;melanin=1.5", "melanin");
+    expect_fiber_refused("parametrization=absorption;absorption=-1,0,0", "absorption");
+    expect_fiber_refused("random=-0.5", "random");
+    expect_fiber_refused("cycles=2.8", "cycles");
 
-    expect_marschner_refused(NULL, "params");
-    hairis_marschner_params badm;
-    hairis_marschner_defaults(&badm);
-    badm.eta = NAN;
-    expect_marschner_refused(&badm, "eta");
-    hairis_marschner_defaults(&badm);
-    badm.eta = 0.8f;
-    expect_marschner_refused(&badm, "eta");
-    hairis_marschner_defaults(&badm);
-    badm.eccentricity = 0.5f;
-    expect_marschner_refused(&badm, "eccentricity");
-    hairis_marschner_defaults(&badm);
-    badm.caustic_intensity_limit = 2.0f;
-    expect_marschner_refused(&badm, "caustic_intensity_limit");
-    hairis_marschner_defaults(&badm);
-    badm.sigma_a[1] = -0.1f;
-    expect_marschner_refused(&badm, "sigma_a");
-    hairis_marschner_defaults(&badm);
-    badm.beta_trt = INFINITY;
-    expect_marschner_refused(&badm, "beta_trt");
+    expect_fiber_refused("model=marschner;eta=nan", "eta");
+    expect_fiber_refused("model=marschner;eta=0.8", "eta");
+    expect_fiber_refused("model=marschner;eccentricity=0.5", "eccentricity");
+    expect_fiber_refused("model=marschner;caustic_limit=2", "caustic_limit");
+    expect_fiber_refused("model=marschner;sigma_a=0.1,-0.1,0.1", "sigma_a");
+    expect_fiber_refused("model=marschner;beta_trt_deg=inf", "beta_trt_deg");
+    expect_fiber_refused("model=marschner;beta_r_deg=-1", "beta_r");
 
     /* Getters on NULL. */
     CHECK(strcmp(hairis_fiber_model(NULL), "") == 0, "model of NULL is \"\"");
@@ -416,10 +618,8 @@ static void test_fiber_creation(void)
 static void test_fiber_eval(void)
 {
     section("fiber eval");
-    hairis_fiber *chiang = default_chiang();
-    hairis_marschner_params m;
-    hairis_marschner_defaults(&m);
-    hairis_fiber *marschner = hairis_fiber_create_marschner(&m);
+    hairis_fiber *chiang = hairis_fiber_create("");
+    hairis_fiber *marschner = hairis_fiber_create("model=marschner");
     CHECK(chiang && marschner, "fibers");
 
     enum { N = 64 };
@@ -440,13 +640,13 @@ static void test_fiber_eval(void)
     /* The far field is the near field averaged over h = sin(gamma): (1/2) ∫ f(h) dh. */
     {
         float a[3], b[3];
-        direction_from_angles(-0.3f, 2.6f, a);  /* near the TT lobe */
+        direction_from_angles(-0.3f, 2.6f, a); /* near the TT lobe */
         direction_from_angles(0.25f, -1.5707963f, b);
         float far[3];
         CHECK(hairis_fiber_eval(chiang, 1, a, b, NULL, far) == HAIRIS_OK, "far one");
         enum { K = 4001 };
         static float many_a[3 * K], many_b[3 * K], many_h[K], many_f[3 * K];
-        double weights[K];
+        static double weights[K];
         for (int k = 0; k < K; ++k) {
             const double gamma = -1.5707963267948966 + 3.141592653589793 * k / (K - 1);
             memcpy(many_a + 3 * k, a, sizeof a);
@@ -466,7 +666,7 @@ static void test_fiber_eval(void)
         CHECK(far[0] > 1e-4f, "a direction pair with a visible value (%g)", far[0]);
     }
 
-    /* Refusals. */
+    /* Refusals: the batch is checked whole before anything is written. */
     CHECK(hairis_fiber_eval(marschner, N, wi, wo, h, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "no near field for Marschner");
     CHECK_ERROR_MENTIONS("h must be NULL");
@@ -489,12 +689,15 @@ static void test_fiber_eval(void)
     CHECK(hairis_fiber_eval(chiang, N, wi, wo, NULL, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "NaN wi");
     CHECK_ERROR_MENTIONS("wi item 5");
-    CHECK(rgb[0] == -7.0f, "nothing written on error");
+    int untouched = 1;
+    for (int i = 0; i < 3 * N; ++i) untouched &= rgb[i] == -7.0f;
+    CHECK(untouched, "nothing written on error (items before the bad one included)");
     wi[3 * 5] = saved;
     wo[3 * 2] *= 2.0f; /* not unit length */
     CHECK(hairis_fiber_eval(chiang, N, wi, wo, NULL, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "non-unit wo");
     CHECK_ERROR_MENTIONS("unit");
+    CHECK(rgb[0] == -7.0f, "nothing written on error");
     wo[3 * 2] *= 0.5f;
     h[3] = 1.5f;
     CHECK(hairis_fiber_eval(chiang, N, wi, wo, h, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT,
@@ -503,40 +706,13 @@ static void test_fiber_eval(void)
     h[3] = NAN;
     CHECK(hairis_fiber_eval(chiang, N, wi, wo, h, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT, "NaN h");
     CHECK_ERROR_MENTIONS("h[3]");
+    CHECK(rgb[0] == -7.0f, "nothing written on error");
 
     hairis_fiber_destroy(chiang);
     hairis_fiber_destroy(marschner);
 }
 
 /* ---- Tables ------------------------------------------------------------------------------- */
-
-typedef struct progress_state {
-    int calls;
-    int cancel_at; /* cancel on this call (1-based); 0 = never */
-    float last;
-    int decreasing;
-} progress_state;
-
-static int on_progress(void *user, float progress)
-{
-    progress_state *s = (progress_state *)user;
-    ++s->calls;
-    if (progress < s->last) s->decreasing = 1;
-    s->last = progress;
-    return s->cancel_at > 0 && s->calls >= s->cancel_at;
-}
-
-static void tiny_options(hairis_bake_options *o)
-{
-    hairis_bake_options_defaults(o);
-    o->theta_r_count = 4;
-    o->theta_i_count = 8;
-    o->phi_count = 8;
-    o->n_h_count = 2;
-    o->n_h_values[0] = 1;
-    o->n_h_values[1] = 2;
-    o->threads = 2;
-}
 
 /* Reads a whole file; *size receives its length. NULL on failure. */
 static unsigned char *read_all(const char *path, size_t *size)
@@ -552,56 +728,53 @@ static unsigned char *read_all(const char *path, size_t *size)
     return data;
 }
 
-static hairis_tables *g_tables = NULL; /* baked for the default node, n_h {1, 2} */
-
-static void expect_bake_refused(const hairis_fiber *fiber, const hairis_bake_options *o,
-                                const char *word)
+static void expect_bake_refused(const hairis_fiber *fiber, const char *options, const char *word)
 {
-    hairis_tables *t = hairis_tables_bake(fiber, o, NULL, NULL);
-    CHECK(t == NULL, "bake with a bad %s refused", word);
+    hairis_tables *t = hairis_tables_bake(fiber, options, NULL, NULL);
+    CHECK(t == NULL, "bake with \"%s\" refused", options ? options : "(NULL)");
     CHECK_ERROR_MENTIONS(word);
+    CHECK(strcmp(hairis_last_error(), "cancelled") != 0, "refused, not cancelled");
     hairis_tables_destroy(t);
 }
 
 static void test_tables(const char *temp_dir)
 {
     section("tables");
-    hairis_fiber *fiber = default_chiang();
-    hairis_bake_options o;
-    tiny_options(&o);
+    hairis_fiber *fiber = hairis_fiber_create("");
+    char text[TEXT];
 
     progress_state progress = {0, 0, -1.0f, 0};
-    hairis_tables *baked = hairis_tables_bake(fiber, &o, on_progress, &progress);
+    hairis_tables *baked = hairis_tables_bake(fiber, TINY_BAKE, on_progress, &progress);
     CHECK(baked != NULL, "tiny bake");
     CHECK_NO_ERROR();
     CHECK(progress.calls >= 2 && progress.last == 1.0f && !progress.decreasing,
           "progress: %d calls, last %g", progress.calls, progress.last);
     CHECK(strcmp(hairis_tables_model(baked), "chiang2016") == 0, "model \"%s\"",
           hairis_tables_model(baked));
-    CHECK(strcmp(hairis_tables_parameters(baked), hairis_fiber_parameters(fiber)) == 0,
-          "tables parameters \"%s\" = fiber's \"%s\"", hairis_tables_parameters(baked),
-          hairis_fiber_parameters(fiber));
+    CHECK(strcmp(keep(text, hairis_tables_parameters(baked)), hairis_fiber_parameters(fiber)) == 0,
+          "tables parameters \"%s\" = fiber's \"%s\"", text, hairis_fiber_parameters(fiber));
     CHECK(hairis_tables_match_fiber(baked, fiber) == 1, "matches its fiber");
+    CHECK_NO_ERROR();
+    /* What the tables hold, as the bake asked for. */
+    CHECK(strcmp(hairis_tables_info(baked), "source=exact;theta_r=4;theta_i=8;phi=8;n_h=1,2") == 0,
+          "info \"%s\"", hairis_tables_info(baked));
     CHECK_NO_ERROR();
 
     /* A bake without a progress callback; the Gaussian source. */
-    o.source = 1;
-    hairis_tables *gaussian = hairis_tables_bake(fiber, &o, NULL, NULL);
+    hairis_tables *gaussian = hairis_tables_bake(fiber, TINY_BAKE ";source=gaussian", NULL, NULL);
     CHECK(gaussian != NULL, "gaussian-source bake");
     CHECK(gaussian && hairis_tables_match_fiber(gaussian, fiber) == 1,
           "the source does not change the fiber match");
+    CHECK(gaussian && strcmp(hairis_tables_info(gaussian),
+                             "source=gaussian;theta_r=4;theta_i=8;phi=8;n_h=1,2") == 0,
+          "gaussian info \"%s\"", gaussian ? hairis_tables_info(gaussian) : "");
     hairis_tables_destroy(gaussian);
-    o.source = 0;
 
     /* Marschner tables. */
     {
-        hairis_marschner_params m;
-        hairis_marschner_defaults(&m);
-        hairis_fiber *marschner = hairis_fiber_create_marschner(&m);
-        hairis_bake_options mo;
-        tiny_options(&mo);
-        mo.theta_r_count = 2;
-        hairis_tables *mt = hairis_tables_bake(marschner, &mo, NULL, NULL);
+        hairis_fiber *marschner = hairis_fiber_create("model=marschner");
+        hairis_tables *mt = hairis_tables_bake(
+            marschner, "theta_r=2;theta_i=8;phi=8;n_h=1,2;threads=2", NULL, NULL);
         CHECK(mt != NULL, "Marschner bake");
         CHECK(mt && strcmp(hairis_tables_model(mt), "marschner2003") == 0, "Marschner model");
         CHECK(mt && hairis_tables_match_fiber(mt, marschner) == 1, "Marschner tables match");
@@ -613,36 +786,33 @@ static void test_tables(const char *temp_dir)
 
     /* A cancelled bake. */
     progress_state cancel = {0, 2, -1.0f, 0};
-    hairis_tables *cancelled = hairis_tables_bake(fiber, &o, on_progress, &cancel);
+    hairis_tables *cancelled = hairis_tables_bake(fiber, TINY_BAKE, on_progress, &cancel);
     CHECK(cancelled == NULL, "cancelled bake returns NULL");
     CHECK(strcmp(hairis_last_error(), "cancelled") == 0, "the message is \"cancelled\"");
     CHECK(cancel.calls == 2, "no progress call after cancelling (%d calls)", cancel.calls);
     hairis_tables_destroy(cancelled);
+    /* NULL options are the defaults (31 x 64 x 64, exact): accepted, so cancelled at once. */
+    cancel = (progress_state){0, 1, -1.0f, 0};
+    CHECK(hairis_tables_bake(fiber, NULL, on_progress, &cancel) == NULL &&
+              strcmp(hairis_last_error(), "cancelled") == 0 && cancel.calls == 1,
+          "NULL options: the default bake, cancelled at the first progress call");
 
     /* Bad options. */
-    expect_bake_refused(NULL, &o, "fiber");
-    expect_bake_refused(fiber, NULL, "options");
-    hairis_bake_options bad = o;
-    bad.theta_r_count = 0;
-    expect_bake_refused(fiber, &bad, "theta_r_count");
-    bad = o;
-    bad.theta_i_count = 100000;
-    expect_bake_refused(fiber, &bad, "theta_i_count");
-    bad = o;
-    bad.n_h_count = 17;
-    expect_bake_refused(fiber, &bad, "n_h_count");
-    bad = o;
-    bad.n_h_count = 0;
-    expect_bake_refused(fiber, &bad, "n_h_count");
-    bad = o;
-    bad.n_h_values[1] = 1;
-    expect_bake_refused(fiber, &bad, "increasing");
-    bad = o;
-    bad.source = 2;
-    expect_bake_refused(fiber, &bad, "source");
-    bad = o;
-    bad.threads = -1;
-    expect_bake_refused(fiber, &bad, "threads");
+    expect_bake_refused(NULL, TINY_BAKE, "fiber");
+    expect_bake_refused(fiber, "theta_r=0", "theta_r");
+    expect_bake_refused(fiber, "theta_r=-4", "theta_r");
+    expect_bake_refused(fiber, "theta_i=100000", "theta_i");
+    expect_bake_refused(fiber, "phi=0", "phi");
+    expect_bake_refused(fiber, "n_h=1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17", "n_h");
+    expect_bake_refused(fiber, "n_h=", "n_h");
+    expect_bake_refused(fiber, "n_h=1,1", "increasing");
+    expect_bake_refused(fiber, "n_h=4,2", "increasing");
+    expect_bake_refused(fiber, "source=2", "source");
+    expect_bake_refused(fiber, "source=gaussian;n_h=1,3", "n_h");
+    expect_bake_refused(fiber, "threads=-1", "threads");
+    expect_bake_refused(fiber, "quadrature_points=0", "quadrature_points");
+    /* Every axis in range, the product too large: refused before allocating. */
+    expect_bake_refused(fiber, "theta_r=1024;theta_i=4096;phi=4096", "cells");
 
     /* Write, load from the file and from memory. */
     char path[1024], missing_dir_path[1024], missing_path[1024];
@@ -664,9 +834,12 @@ static void test_tables(const char *temp_dir)
     hairis_tables *from_file = hairis_tables_load_file(path);
     CHECK(from_file != NULL, "load from file");
     CHECK_NO_ERROR();
-    CHECK(from_file && strcmp(hairis_tables_parameters(from_file),
+    CHECK(from_file && strcmp(keep(text, hairis_tables_parameters(from_file)),
                               hairis_tables_parameters(baked)) == 0,
           "parameters survive the file");
+    CHECK(from_file && strcmp(keep(text, hairis_tables_info(from_file)),
+                              hairis_tables_info(baked)) == 0,
+          "info survives the file: \"%s\"", text);
     CHECK(from_file && hairis_tables_match_fiber(from_file, fiber) == 1,
           "loaded tables match the fiber");
 
@@ -713,15 +886,10 @@ static void test_tables(const char *temp_dir)
 
     /* Matching: another roughness, another model. */
     {
-        hairis_principled_hair node;
-        hairis_principled_hair_defaults(&node);
-        node.roughness = 0.4f;
-        hairis_fiber *rougher = hairis_fiber_create_principled(&node);
+        hairis_fiber *rougher = hairis_fiber_create("roughness=0.4");
         CHECK(hairis_tables_match_fiber(baked, rougher) == 0, "another roughness: no match");
         CHECK_NO_ERROR();
-        hairis_marschner_params m;
-        hairis_marschner_defaults(&m);
-        hairis_fiber *marschner = hairis_fiber_create_marschner(&m);
+        hairis_fiber *marschner = hairis_fiber_create("model=marschner");
         CHECK(hairis_tables_match_fiber(baked, marschner) == 0, "another model: no match");
         CHECK(hairis_tables_match_fiber(NULL, fiber) == 0, "NULL tables");
         CHECK_ERROR_MENTIONS("tables");
@@ -729,6 +897,8 @@ static void test_tables(const char *temp_dir)
         CHECK_ERROR_MENTIONS("fiber");
         CHECK(strcmp(hairis_tables_model(NULL), "") == 0, "model of NULL");
         CHECK(strcmp(hairis_tables_parameters(NULL), "") == 0, "parameters of NULL");
+        CHECK(strcmp(hairis_tables_info(NULL), "") == 0, "info of NULL");
+        CHECK_ERROR_MENTIONS("tables");
         hairis_fiber_destroy(rougher);
         hairis_fiber_destroy(marschner);
     }
@@ -744,7 +914,33 @@ static void test_tables(const char *temp_dir)
 
 /* ---- Sampling ----------------------------------------------------------------------------- */
 
-static void check_sample_pdf_consistency(hairis_sampler *sampler, const char *name)
+/* ∫ pdf(ω_i) dω_i over the sphere at one ω_o and h, by the midpoint rule in (θ, φ) with
+ * dω = cos θ dθ dφ: 1 for a normalised density. */
+static double pdf_integral(hairis_sampler *sampler, const float *wo, float h)
+{
+    enum { NT = 512, NPHI = 512, N = NT * NPHI };
+    static float wi[3 * N], wos[3 * N], hs[N], pdf[N];
+    static double weight[N];
+    const double pi = 3.141592653589793;
+    for (int a = 0; a < NT; ++a)
+        for (int b = 0; b < NPHI; ++b) {
+            const int i = a * NPHI + b;
+            const double theta = -0.5 * pi + pi * (a + 0.5) / NT;
+            const double phi = -pi + 2.0 * pi * (b + 0.5) / NPHI;
+            wi[3 * i] = (float)sin(theta);
+            wi[3 * i + 1] = (float)(cos(theta) * cos(phi));
+            wi[3 * i + 2] = (float)(cos(theta) * sin(phi));
+            weight[i] = cos(theta) * (pi / NT) * (2.0 * pi / NPHI);
+            memcpy(wos + 3 * i, wo, 3 * sizeof(float));
+            hs[i] = h;
+        }
+    if (hairis_pdf(sampler, N, wi, wos, hs, pdf) != HAIRIS_OK) return -1.0;
+    double sum = 0;
+    for (int i = 0; i < N; ++i) sum += weight[i] * pdf[i];
+    return sum;
+}
+
+static void check_sample_pdf_consistency(hairis_sampler *sampler, const char *name, int normalised)
 {
     enum { N = 4096 };
     static float wo[3 * N], h[N], u[3 * N], wi[3 * N], pdf[N], pdf_again[N];
@@ -780,6 +976,20 @@ static void check_sample_pdf_consistency(hairis_sampler *sampler, const char *na
     printf("   %s: %d/%d sampled, worst relative pdf difference %.3g\n", name, produced, N,
            worst);
 
+    /* The density integrates to 1 over the sphere (at a few views and offsets). */
+    if (normalised) {
+        const float views[3][2] = {{0.3f, 0.0f}, {-0.9f, 0.7f}, {1.2f, -0.4f}};
+        for (int v = 0; v < 3; ++v) {
+            float w[3];
+            direction_from_angles(views[v][0], 1.0f, w);
+            const double integral = pdf_integral(sampler, w, views[v][1]);
+            CHECK(fabs(integral - 1.0) < 0.005, "%s: ∫ pdf dω = %.5f at θ_o = %g, h = %g", name,
+                  integral, views[v][0], views[v][1]);
+            printf("   %s: ∫ pdf dω = %.5f at θ_o = %g, h = %g\n", name, integral, views[v][0],
+                   views[v][1]);
+        }
+    }
+
     /* h = NULL means h = 0. */
     float h0[8] = {0}, pdf_null[8], pdf_zero[8];
     CHECK(hairis_pdf(sampler, 8, wi, wo, NULL, pdf_null) == HAIRIS_OK &&
@@ -805,36 +1015,35 @@ static int sample_in_thread(void *arg)
 static void test_sampling(void)
 {
     section("sampling");
-    hairis_fiber *chiang = default_chiang();
-    hairis_marschner_params m;
-    hairis_marschner_defaults(&m);
-    hairis_fiber *marschner = hairis_fiber_create_marschner(&m);
+    hairis_fiber *chiang = hairis_fiber_create("");
+    hairis_fiber *marschner = hairis_fiber_create("model=marschner");
 
-    hairis_sampler *uniform_s = hairis_sampler_create(HAIRIS_STRATEGY_UNIFORM, NULL, NULL, 0, 1);
+    hairis_sampler *uniform_s = hairis_sampler_create(NULL, NULL, "strategy=uniform");
     CHECK(uniform_s != NULL, "UNIFORM without fiber or tables");
     CHECK_NO_ERROR();
-    hairis_sampler *analytic = hairis_sampler_create(HAIRIS_STRATEGY_ANALYTIC, chiang, NULL,
-                                                     0.25f, 2);
+    hairis_sampler *analytic = hairis_sampler_create(chiang, NULL, "strategy=analytic");
     CHECK(analytic != NULL, "ANALYTIC with a Chiang fiber");
-    hairis_sampler *gaussian = hairis_sampler_create(HAIRIS_STRATEGY_GAUSSIAN, NULL, NULL,
-                                                     0.25f, 2);
+    hairis_sampler *gaussian =
+        hairis_sampler_create(NULL, NULL, "strategy=gaussian;multiple_weight=0.25;n_h=2");
     CHECK(gaussian != NULL, "GAUSSIAN");
-    hairis_sampler *table = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, NULL, g_tables, 0.25f,
-                                                  2);
+    hairis_sampler *table =
+        hairis_sampler_create(NULL, g_tables, "strategy=table;multiple_weight=0.25;n_h=2");
     CHECK(table != NULL, "TABLE");
     /* With a Chiang fiber, TABLE follows the near field at h (near_field_table.h). */
-    hairis_sampler *table_near = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, chiang, g_tables,
-                                                       0.25f, 2);
+    hairis_sampler *table_near =
+        hairis_sampler_create(chiang, g_tables, "strategy=table;multiple_weight=0.25;n_h=2");
     CHECK(table_near != NULL, "TABLE with a Chiang fiber");
+    /* The defaults: TABLE, weight 0, n_h 2 (which the tables hold). */
+    char text[TEXT];
+    hairis_sampler *by_default = hairis_sampler_create(chiang, g_tables, NULL);
+    CHECK(by_default != NULL, "NULL options: the default TABLE sampler");
 
     /* A TABLE sampler stays valid after its tables handle is destroyed. */
     hairis_sampler *orphan = NULL;
     {
-        hairis_fiber *fiber = default_chiang();
-        hairis_bake_options o;
-        tiny_options(&o);
-        hairis_tables *t = hairis_tables_bake(fiber, &o, NULL, NULL);
-        orphan = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, NULL, t, 1.0f, 1);
+        hairis_fiber *fiber = hairis_fiber_create("");
+        hairis_tables *t = hairis_tables_bake(fiber, TINY_BAKE, NULL, NULL);
+        orphan = hairis_sampler_create(NULL, t, "multiple_weight=1;n_h=1");
         CHECK(orphan != NULL, "TABLE sampler from short-lived tables");
         hairis_tables_destroy(t);
         hairis_fiber_destroy(fiber);
@@ -844,27 +1053,50 @@ static void test_sampling(void)
        mass at grazing below the smallest double (the near-field table refused it once). */
     hairis_sampler *smooth = NULL;
     {
-        hairis_principled_hair node;
-        hairis_principled_hair_defaults(&node);
-        node.roughness = 0.0f;
-        hairis_fiber *fiber = hairis_fiber_create_principled(&node);
-        hairis_bake_options o;
-        tiny_options(&o);
-        o.source = 1; /* the seed's Gaussians: fast, and enough for a sampler */
-        hairis_tables *t = hairis_tables_bake(fiber, &o, NULL, NULL);
-        smooth = hairis_sampler_create(HAIRIS_STRATEGY_TABLE, fiber, t, 0.0f, 1);
+        hairis_fiber *fiber = hairis_fiber_create("roughness=0");
+        /* The seed's Gaussians: fast, and enough for a sampler. */
+        hairis_tables *t = hairis_tables_bake(fiber, TINY_BAKE ";source=gaussian", NULL, NULL);
+        smooth = hairis_sampler_create(fiber, t, "multiple_weight=0;n_h=1");
         CHECK(smooth != NULL, "TABLE with a fiber of roughness 0: %s", hairis_last_error());
         hairis_tables_destroy(t);
         hairis_fiber_destroy(fiber);
     }
 
-    if (uniform_s) check_sample_pdf_consistency(uniform_s, "uniform");
-    if (smooth) check_sample_pdf_consistency(smooth, "table with a fiber of roughness 0");
-    if (analytic) check_sample_pdf_consistency(analytic, "analytic");
-    if (gaussian) check_sample_pdf_consistency(gaussian, "gaussian");
-    if (table) check_sample_pdf_consistency(table, "table");
-    if (table_near) check_sample_pdf_consistency(table_near, "table with a fiber (near field)");
-    if (orphan) check_sample_pdf_consistency(orphan, "table (tables destroyed)");
+    if (uniform_s) check_sample_pdf_consistency(uniform_s, "uniform", 1);
+    if (smooth) check_sample_pdf_consistency(smooth, "table with a fiber of roughness 0", 0);
+    if (analytic) check_sample_pdf_consistency(analytic, "analytic", 1);
+    if (gaussian) check_sample_pdf_consistency(gaussian, "gaussian", 1);
+    if (table) check_sample_pdf_consistency(table, "table", 1);
+    if (table_near) check_sample_pdf_consistency(table_near, "table with a fiber (near field)", 1);
+    if (orphan) check_sample_pdf_consistency(orphan, "table (tables destroyed)", 1);
+    if (by_default) check_sample_pdf_consistency(by_default, "table by default", 1);
+
+    /* The defaults round-trip: hairis_defaults("sampler") samples as no options do. */
+    {
+        hairis_sampler *from_defaults =
+            hairis_sampler_create(chiang, g_tables, keep(text, hairis_defaults("sampler")));
+        CHECK(from_defaults != NULL, "the sampler defaults are accepted");
+        enum { M = 512 };
+        static float wo[3 * M], u[3 * M], h[M], wi_a[3 * M], pdf_a[M], wi_b[3 * M], pdf_b[M];
+        for (int i = 0; i < M; ++i) {
+            random_direction(wo + 3 * i);
+            h[i] = 2.0f * uniform() - 1.0f;
+            for (int k = 0; k < 3; ++k) u[3 * i + k] = uniform();
+        }
+        CHECK(from_defaults && by_default &&
+                  hairis_sample(from_defaults, M, wo, h, u, wi_a, pdf_a) == HAIRIS_OK &&
+                  hairis_sample(by_default, M, wo, h, u, wi_b, pdf_b) == HAIRIS_OK &&
+                  memcmp(wi_a, wi_b, sizeof wi_a) == 0 && memcmp(pdf_a, pdf_b, sizeof pdf_a) == 0,
+              "hairis_defaults(\"sampler\") and NULL options sample alike");
+        /* ... and the options are read: another weight samples otherwise. */
+        hairis_sampler *weighted =
+            hairis_sampler_create(chiang, g_tables, "multiple_weight=0.5");
+        CHECK(weighted && hairis_sample(weighted, M, wo, h, u, wi_b, pdf_b) == HAIRIS_OK &&
+                  memcmp(pdf_a, pdf_b, sizeof pdf_a) != 0,
+              "multiple_weight=0.5 samples another density");
+        hairis_sampler_destroy(weighted);
+        hairis_sampler_destroy(from_defaults);
+    }
 
     /* The uniform density. */
     {
@@ -901,36 +1133,49 @@ static void test_sampling(void)
     }
 
     /* Refusals. */
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_ANALYTIC, NULL, NULL, 0.25f, 2) == NULL,
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=analytic") == NULL,
           "ANALYTIC without fiber");
     CHECK_ERROR_MENTIONS("fiber");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_ANALYTIC, marschner, NULL, 0.25f, 2) == NULL,
+    CHECK(hairis_sampler_create(marschner, NULL, "strategy=analytic") == NULL,
           "ANALYTIC with a Marschner fiber");
     CHECK_ERROR_MENTIONS("chiang2016");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_TABLE, chiang, NULL, 0.25f, 2) == NULL,
+    CHECK(hairis_sampler_create(chiang, NULL, "strategy=table") == NULL,
           "TABLE without tables");
     CHECK_ERROR_MENTIONS("tables");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_TABLE, NULL, g_tables, 0.25f, 8) == NULL,
+    CHECK(hairis_sampler_create(chiang, NULL, NULL) == NULL, "TABLE (the default) without tables");
+    CHECK_ERROR_MENTIONS("tables");
+    CHECK(hairis_sampler_create(NULL, g_tables, "n_h=8") == NULL,
           "TABLE with an n_h the tables lack");
     CHECK_ERROR_MENTIONS("n_h");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_GAUSSIAN, NULL, NULL, 0.25f, 3) == NULL,
+    /* Tables baked for other parameters than the fiber's. */
+    {
+        hairis_fiber *rougher = hairis_fiber_create("roughness=0.45");
+        hairis_sampler *s = hairis_sampler_create(rougher, g_tables, "strategy=table");
+        CHECK(s == NULL, "TABLE with tables of another fiber");
+        CHECK_ERROR_MENTIONS("baked for");
+        hairis_sampler_destroy(s);
+        /* (A handle call has no status: test_render checks the code, INVALID_TABLE.) */
+        hairis_fiber_destroy(rougher);
+    }
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=gaussian;n_h=3") == NULL,
           "GAUSSIAN with n_h 3");
     CHECK_ERROR_MENTIONS("n_h");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_GAUSSIAN, NULL, NULL, 1.5f, 2) == NULL,
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=gaussian;multiple_weight=1.5") == NULL,
           "weight 1.5");
     CHECK_ERROR_MENTIONS("multiple_weight");
-    CHECK(hairis_sampler_create(HAIRIS_STRATEGY_UNIFORM, NULL, NULL, NAN, 2) == NULL,
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=uniform;multiple_weight=nan") == NULL,
           "weight NaN");
     CHECK_ERROR_MENTIONS("multiple_weight");
-    CHECK(hairis_sampler_create((hairis_strategy)9, NULL, NULL, 0.25f, 2) == NULL,
-          "strategy 9");
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=9") == NULL, "strategy 9");
     CHECK_ERROR_MENTIONS("strategy");
-    CHECK(hairis_sampler_create((hairis_strategy)-1, NULL, NULL, 0.25f, 2) == NULL,
-          "strategy -1");
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=-1") == NULL, "strategy -1");
     CHECK_ERROR_MENTIONS("strategy");
+    CHECK(hairis_sampler_create(NULL, NULL, "strategy=uniform;weight=0.5") == NULL,
+          "an unknown name");
+    CHECK_ERROR_MENTIONS("\"weight\"");
 
     float wo[6] = {0, 1, 0, 0, 0, 1}, u[6] = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
-    float wi[6], pdf[2];
+    float wi[6] = {-7, -7, -7, -7, -7, -7}, pdf[2] = {-7, -7};
     CHECK(hairis_sample(NULL, 2, wo, NULL, u, wi, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "NULL sampler");
     CHECK_ERROR_MENTIONS("sampler");
@@ -945,25 +1190,34 @@ static void test_sampling(void)
     CHECK(hairis_sample(uniform_s, 2, wo, NULL, u, wi, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "u = 1 is outside [0, 1)");
     CHECK_ERROR_MENTIONS("u[4]");
+    CHECK(wi[0] == -7 && pdf[0] == -7, "nothing written before the bad item was found");
+    u[4] = NAN;
+    CHECK(hairis_sample(uniform_s, 2, wo, NULL, u, wi, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "u NaN");
+    CHECK_ERROR_MENTIONS("u[4]");
     u[4] = 0.5f;
-    wo[1] = NAN;
+    wo[4] = NAN;
     CHECK(hairis_sample(uniform_s, 2, wo, NULL, u, wi, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "NaN wo");
-    CHECK_ERROR_MENTIONS("wo item 0");
+    CHECK_ERROR_MENTIONS("wo item 1");
+    CHECK(wi[0] == -7 && pdf[0] == -7, "nothing written before the bad item was found");
     CHECK(hairis_pdf(uniform_s, 2, wo, wo, NULL, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "pdf: NaN wi");
-    CHECK_ERROR_MENTIONS("wi item 0");
-    wo[1] = 1.0f;
+    CHECK_ERROR_MENTIONS("wi item 1");
+    CHECK(pdf[0] == -7, "pdf: nothing written");
+    wo[4] = 0.0f;
     float bad_h[2] = {0.0f, -2.0f};
     CHECK(hairis_pdf(uniform_s, 2, wo, wo, bad_h, pdf) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "pdf: h out of range");
     CHECK_ERROR_MENTIONS("h[1]");
+    CHECK(pdf[0] == -7, "pdf: nothing written");
 
     hairis_sampler_destroy(uniform_s);
     hairis_sampler_destroy(analytic);
     hairis_sampler_destroy(gaussian);
     hairis_sampler_destroy(table);
     hairis_sampler_destroy(table_near);
+    hairis_sampler_destroy(by_default);
     hairis_sampler_destroy(orphan);
     hairis_sampler_destroy(smooth);
     hairis_sampler_destroy(NULL);
@@ -976,19 +1230,12 @@ static void test_sampling(void)
 
 enum { W = 16, H = 16 };
 
-static void test_camera(hairis_camera *camera)
-{
-    static const float to_world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3, 0, 0, 0, 1};
-    /* view_frame order: top right, bottom right, bottom left, top left. */
-    static const float frame[12] = {0.4f,  0.4f,  -1, 0.4f,  -0.4f, -1,
-                                    -0.4f, -0.4f, -1, -0.4f, 0.4f,  -1};
-    memset(camera, 0, sizeof *camera);
-    memcpy(camera->camera_to_world, to_world, sizeof to_world);
-    memcpy(camera->frame, frame, sizeof frame);
-    camera->orthographic = 0;
-    camera->width = W;
-    camera->height = H;
-}
+/* Camera at z = 3 looking down -Z; view_frame order: top right, bottom right, bottom left,
+ * top left. */
+#define CAMERA                                                                                     \
+    "matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;"                                                      \
+    "frame=0.4,0.4,-1,0.4,-0.4,-1,-0.4,-0.4,-1,-0.4,0.4,-1;width=16;height=16"
+#define SKY "color=0.1,0.12,0.15;strength=1"
 
 /* Five strands along x in the plane z = 0, 4 points each. */
 static int add_strands(hairis_scene *scene, int material)
@@ -1008,6 +1255,7 @@ static int add_strands(hairis_scene *scene, int material)
     return hairis_scene_add_curves(scene, material, C, first, C * P, positions, radii);
 }
 
+/* A triangle at z = -0.5; the camera's top corners see past it. */
 static int add_floor(hairis_scene *scene, int material)
 {
     const float positions[9] = {-3, -3, -0.5f, 3, -3, -0.5f, 0, 3, -0.5f};
@@ -1016,39 +1264,44 @@ static int add_floor(hairis_scene *scene, int material)
     return hairis_scene_add_mesh(scene, 3, positions, 1, indices, materials);
 }
 
-/* The test scene: hair (material 0, tables as given), a diffuse floor (material 1), a sun
- * and a world. */
-static hairis_scene *make_scene(const hairis_principled_hair *node, const hairis_tables *tables)
+/* A scene: hair (material 0: `fiber_options`, tables as given), a floor of `surface`
+ * (material 1), `light`, `world` and `camera` (NULL: none). */
+static hairis_scene *make_scene_of(const char *fiber_options, const hairis_tables *tables,
+                                   const char *surface, const char *light, const char *world,
+                                   const char *camera)
 {
     hairis_scene *scene = hairis_scene_create();
     CHECK(scene != NULL, "scene_create");
     CHECK_NO_ERROR();
-    const int hair = hairis_scene_add_hair_material(scene, node, tables);
+    hairis_fiber *fiber = hairis_fiber_create(fiber_options);
+    CHECK(fiber != NULL, "fiber \"%s\"", fiber_options);
+    const int hair = hairis_scene_add_hair_material(scene, fiber, tables);
+    hairis_fiber_destroy(fiber); /* the scene keeps what it needs */
     CHECK(hair == 0, "hair material index %d", hair);
-    const float albedo[3] = {0.5f, 0.5f, 0.5f}, black[3] = {0, 0, 0};
-    const int diffuse = hairis_scene_add_diffuse_material(scene, albedo, black);
-    CHECK(diffuse == 1, "diffuse material index %d", diffuse);
+    const int diffuse = hairis_scene_add_surface_material(scene, surface);
+    CHECK(diffuse == 1, "surface material index %d", diffuse);
     CHECK(add_strands(scene, hair) == HAIRIS_OK, "curves");
     CHECK(add_floor(scene, diffuse) == HAIRIS_OK, "mesh");
-    const float to_sun[3] = {0.3f, 0.2f, 1.0f}, white[3] = {1, 1, 1};
-    CHECK(hairis_scene_add_sun(scene, to_sun, white, 3.0f, 0.05f) == HAIRIS_OK, "sun");
-    const float sky[3] = {0.1f, 0.12f, 0.15f};
-    CHECK(hairis_scene_set_world(scene, sky, 1.0f) == HAIRIS_OK, "world");
-    hairis_camera camera;
-    test_camera(&camera);
-    CHECK(hairis_scene_set_camera(scene, &camera) == HAIRIS_OK, "camera");
+    if (light) CHECK(hairis_scene_add_light(scene, light) == HAIRIS_OK, "light \"%s\"", light);
+    CHECK(hairis_scene_set_world(scene, world) == HAIRIS_OK, "world \"%s\"", world);
+    if (camera) CHECK(hairis_scene_set_camera(scene, camera) == HAIRIS_OK, "camera \"%s\"", camera);
     CHECK_NO_ERROR();
     return scene;
 }
 
-static void tiny_settings(hairis_render_settings *s, int strategy)
+/* The test scene: a sun and a sky over hair and a grey floor. */
+static hairis_scene *make_scene(const char *fiber_options, const hairis_tables *tables)
 {
-    hairis_render_settings_defaults(s);
-    s->samples = 4;
-    s->max_bounces = 3;
-    s->strategy = strategy;
-    s->seed = 7;
-    s->threads = 2;
+    return make_scene_of(fiber_options, tables, "type=diffuse;color=0.5,0.5,0.5;emission=0,0,0",
+                         "type=sun;direction=0.3,0.2,1;color=1,1,1;strength=3;angle=0.05", SKY,
+                         CAMERA);
+}
+
+/* Tiny settings with `strategy` and `extra` ("" or ";name=value..."). */
+static const char *tiny_settings(char *into, const char *strategy, const char *extra)
+{
+    snprintf(into, TEXT, "samples=4;max_bounces=3;strategy=%s%s", strategy, extra);
+    return into;
 }
 
 static int pixels_ok(const float *rgba)
@@ -1060,24 +1313,34 @@ static int pixels_ok(const float *rgba)
     return 1;
 }
 
-static double pixel_sum(const float *rgba)
+static double pixel_sum(const float *rgba, int pixels)
 {
     double sum = 0;
-    for (int i = 0; i < W * H; ++i) sum += rgba[4 * i] + rgba[4 * i + 1] + rgba[4 * i + 2];
+    for (int i = 0; i < pixels; ++i) sum += rgba[4 * i] + rgba[4 * i + 1] + rgba[4 * i + 2];
     return sum;
+}
+
+/* An unsigned integer from hairis_last_render_stats(); -1 when absent. */
+static double stat_of(const char *name)
+{
+    char value[TEXT];
+    if (!option_value(hairis_last_render_stats(), name, value, sizeof value)) return -1.0;
+    return strtod(value, NULL);
 }
 
 typedef struct render_job {
     hairis_scene *scene;
-    hairis_render_settings settings;
+    char settings[TEXT];
     float rgba[W * H * 4];
     int status;
+    char stats_before[TEXT];
 } render_job;
 
 static int render_in_thread(void *arg)
 {
     render_job *job = (render_job *)arg;
-    job->status = hairis_render(job->scene, &job->settings, job->rgba, NULL, NULL, NULL);
+    keep(job->stats_before, hairis_last_render_stats());
+    job->status = hairis_render(job->scene, job->settings, job->rgba, NULL, NULL);
     return 0;
 }
 
@@ -1085,156 +1348,198 @@ static void test_render(void)
 {
     section("render");
     static float rgba[W * H * 4], again[W * H * 4];
-    hairis_principled_hair node;
-    hairis_principled_hair_defaults(&node);
+    char s[TEXT];
 
-    hairis_scene *scene = make_scene(&node, g_tables);
-    const int strategies[4] = {HAIRIS_STRATEGY_UNIFORM, HAIRIS_STRATEGY_ANALYTIC,
-                               HAIRIS_STRATEGY_GAUSSIAN, HAIRIS_STRATEGY_TABLE};
+    hairis_scene *scene = make_scene("", g_tables);
+    const char *strategies[4] = {"uniform", "analytic", "gaussian", "table"};
     for (int k = 0; k < 4; ++k) {
-        hairis_render_settings s;
-        tiny_settings(&s, strategies[k]);
-        hairis_render_stats stats;
-        memset(&stats, 0xff, sizeof stats);
         for (int i = 0; i < W * H * 4; ++i) rgba[i] = -1.0f;
         progress_state progress = {0, 0, -1.0f, 0};
-        const int status = hairis_render(scene, &s, rgba, on_progress, &progress, &stats);
-        CHECK(status == HAIRIS_OK, "render with strategy %d", strategies[k]);
+        const int status =
+            hairis_render(scene, tiny_settings(s, strategies[k], ";seed=7;threads=2"), rgba,
+                          on_progress, &progress);
+        CHECK(status == HAIRIS_OK, "render with strategy %s", strategies[k]);
         CHECK_NO_ERROR();
-        CHECK(pixels_ok(rgba), "strategy %d: pixels finite, >= 0, alpha 1", strategies[k]);
-        CHECK(pixel_sum(rgba) > 0.0, "strategy %d: the image is not black", strategies[k]);
-        CHECK(stats.camera_rays == (uint64_t)W * H * 4, "camera rays %llu",
-              (unsigned long long)stats.camera_rays);
-        CHECK(stats.seconds > 0 && stats.seconds < 600, "seconds %g", stats.seconds);
-        CHECK(stats.peak_memory_bytes > 0 && stats.peak_memory_bytes < (1ull << 40),
-              "peak memory %llu", (unsigned long long)stats.peak_memory_bytes);
-        CHECK(stats.dropped_samples == 0, "dropped %llu",
-              (unsigned long long)stats.dropped_samples);
-        CHECK(progress.calls >= 1 && progress.last == 1.0f, "progress ends at 1 (%d calls)",
-              progress.calls);
+        CHECK(pixels_ok(rgba), "%s: pixels finite, >= 0, alpha 1", strategies[k]);
+        CHECK(pixel_sum(rgba, W * H) > 0.0, "%s: the image is not black", strategies[k]);
+        CHECK(progress.calls >= 1 && progress.last == 1.0f && !progress.decreasing,
+              "progress ends at 1 (%d calls)", progress.calls);
+        /* What the render did. */
+        const char *stats = hairis_last_render_stats();
+        CHECK(stat_of("camera_rays") == W * H * 4, "camera rays: \"%s\"", stats);
+        CHECK(stat_of("rays") >= W * H * 4, "rays: \"%s\"", stats);
+        CHECK(stat_of("shadow_rays") > 0, "shadow rays: \"%s\"", stats);
+        CHECK(stat_of("seconds") > 0 && stat_of("seconds") < 600, "seconds: \"%s\"", stats);
+        CHECK(stat_of("peak_memory_bytes") > 0 && stat_of("peak_memory_bytes") < 1e12,
+              "peak memory: \"%s\"", stats);
+        CHECK(stat_of("dropped_samples") == 0, "dropped: \"%s\"", stats);
+        CHECK(stat_of("threads") == 2, "threads: \"%s\"", stats);
+        CHECK(stat_of("cancelled") == 0, "cancelled: \"%s\"", stats);
     }
 
-    /* Same seed, same image, whatever the thread count; stats may be NULL. */
+    /* Same seed, same image, whatever the thread count or tile size; another seed differs. */
     {
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        s.threads = 1;
-        CHECK(hairis_render(scene, &s, again, NULL, NULL, NULL) == HAIRIS_OK, "1 thread");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=2"), rgba, NULL,
+                            NULL) == HAIRIS_OK,
+              "2 threads");
+        const double peak_16 = stat_of("peak_memory_bytes");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=2;tile_size=1"),
+                            again, NULL, NULL) == HAIRIS_OK,
+              "tiles of 1 pixel");
+        CHECK(memcmp(rgba, again, sizeof rgba) == 0, "bit-identical with tiles of 16 and 1");
+        /* The tile size reaches the renderer: its buffers are per tile (render.h). */
+        CHECK(stat_of("peak_memory_bytes") < peak_16, "tiles of 1 need less memory (%g < %g)",
+              stat_of("peak_memory_bytes"), peak_16);
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=1;tile_size=5"),
+                            again, NULL, NULL) == HAIRIS_OK,
+              "1 thread, tiles of 5");
+        CHECK(stat_of("threads") == 1, "1 thread: \"%s\"", hairis_last_render_stats());
         CHECK(memcmp(rgba, again, sizeof rgba) == 0, "bit-identical with 1 and 2 threads");
-        s.seed = 8;
-        CHECK(hairis_render(scene, &s, again, NULL, NULL, NULL) == HAIRIS_OK, "seed 8");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=8;threads=2"), again, NULL,
+                            NULL) == HAIRIS_OK,
+              "seed 8");
         CHECK(memcmp(rgba, again, sizeof rgba) != 0, "another seed, another image");
     }
 
-    /* Two renders of one scene at once, from two threads, each as if alone. */
+    /* Two renders of one scene at once, from two threads, each as if alone; the stats are
+     * per thread ("" on a thread that has not rendered). */
     {
         static render_job jobs[2];
         thrd_t threads[2];
         for (int t = 0; t < 2; ++t) {
             jobs[t].scene = scene;
-            tiny_settings(&jobs[t].settings, HAIRIS_STRATEGY_TABLE);
-            jobs[t].settings.threads = 1;
+            tiny_settings(jobs[t].settings, "table", ";seed=7;threads=1");
             thrd_create(&threads[t], render_in_thread, &jobs[t]);
         }
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        CHECK(hairis_render(scene, &s, again, NULL, NULL, NULL) == HAIRIS_OK, "reference");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=2"), again, NULL,
+                            NULL) == HAIRIS_OK,
+              "reference");
         for (int t = 0; t < 2; ++t) {
             thrd_join(threads[t], NULL);
             CHECK(jobs[t].status == HAIRIS_OK && memcmp(jobs[t].rgba, again, sizeof again) == 0,
                   "concurrent render %d equals the reference", t);
+            CHECK(jobs[t].stats_before[0] == '\0', "no stats before a thread's first render: \"%s\"",
+                  jobs[t].stats_before);
         }
+        CHECK(stat_of("threads") == 2, "this thread's stats are its own render's: \"%s\"",
+              hairis_last_render_stats());
     }
 
     /* Cancelling from the progress callback. */
     {
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        s.samples = 1 << 16; /* far more than can finish before the first callback */
-        hairis_render_stats stats;
         progress_state cancel = {0, 1, -1.0f, 0};
-        const int status = hairis_render(scene, &s, rgba, on_progress, &cancel, &stats);
-        CHECK(status == HAIRIS_ERROR_CANCELLED, "cancelled render returns CANCELLED (%d)",
-              status);
+        /* Far more samples than can finish before the first callback. */
+        const int status = hairis_render(
+            scene, "samples=65536;max_bounces=3;strategy=analytic;threads=2", rgba, on_progress,
+            &cancel);
+        CHECK(status == HAIRIS_ERROR_CANCELLED, "cancelled render returns CANCELLED (%d)", status);
         CHECK_ERROR_MENTIONS("cancelled");
-        CHECK(stats.camera_rays < (uint64_t)W * H * s.samples, "stopped early (%llu rays)",
-              (unsigned long long)stats.camera_rays);
+        CHECK(cancel.calls == 1, "no progress call after cancelling (%d)", cancel.calls);
+        CHECK(stat_of("cancelled") == 1, "the stats say so: \"%s\"", hairis_last_render_stats());
+        CHECK(stat_of("camera_rays") < (double)W * H * 65536, "stopped early (%g camera rays)",
+              stat_of("camera_rays"));
         CHECK(all_finite_non_negative(rgba, W * H * 4), "the partial image is finite");
     }
 
     /* Bad settings and arguments. */
     {
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        s.samples = 0;
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK(hairis_render(scene, "samples=0;strategy=analytic", rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "samples 0");
         CHECK_ERROR_MENTIONS("samples");
-        tiny_settings(&s, 11);
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
-              "strategy 11");
+        CHECK(hairis_render(scene, "strategy=eleven", rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
+              "an unknown strategy");
         CHECK_ERROR_MENTIONS("strategy");
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        s.multiple_weight = NAN;
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK_ERROR_MENTIONS("analytic");
+        CHECK(hairis_render(scene, "multiple_weight=nan", rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "weight NaN");
         CHECK_ERROR_MENTIONS("multiple_weight");
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        s.n_h = 4; /* not baked */
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";n_h=4"), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_TABLE,
               "TABLE with an n_h the tables lack");
         CHECK_ERROR_MENTIONS("material 0");
-        tiny_settings(&s, HAIRIS_STRATEGY_GAUSSIAN);
-        s.n_h = 3;
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK_ERROR_MENTIONS("n_h");
+        CHECK(hairis_render(scene, tiny_settings(s, "gaussian", ";n_h=3"), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "GAUSSIAN with n_h 3");
         CHECK_ERROR_MENTIONS("n_h");
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        s.max_bounces = -1;
-        CHECK(hairis_render(scene, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
-              "max_bounces -1");
-        CHECK_ERROR_MENTIONS("max_bounces");
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        CHECK(hairis_render(NULL, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        const char *bad[][2] = {{"max_bounces=-1", "max_bounces"},
+                                {"max_bounces=1025", "max_bounces"},
+                                {"max_diffuse_bounces=-1", "max_diffuse_bounces"},
+                                {"max_transmission_bounces=2000", "max_transmission_bounces"},
+                                {"tile_size=0", "tile_size"},
+                                {"tile_size=4097", "tile_size"},
+                                {"threads=-1", "threads"},
+                                {"rr_start_bounce=0", "rr_start_bounce"},
+                                {"samples=16777217", "samples"},
+                                {"film_transparent=maybe", "film_transparent"}};
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+            for (int k = 0; k < W * H * 4; ++k) rgba[k] = -7.0f;
+            CHECK(hairis_render(scene, bad[i][0], rgba, NULL, NULL) ==
+                      HAIRIS_ERROR_INVALID_ARGUMENT,
+                  "%s refused", bad[i][0]);
+            CHECK_ERROR_MENTIONS(bad[i][1]);
+            CHECK(rgba[0] == -7.0f && rgba[W * H * 4 - 1] == -7.0f, "%s: nothing written",
+                  bad[i][0]);
+        }
+        CHECK(hairis_render(NULL, "strategy=analytic", rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "NULL scene");
         CHECK_ERROR_MENTIONS("scene");
-        CHECK(hairis_render(scene, NULL, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
-              "NULL settings");
-        CHECK_ERROR_MENTIONS("settings");
-        CHECK(hairis_render(scene, &s, NULL, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK(hairis_render(scene, "strategy=analytic", NULL, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "NULL rgba");
         CHECK_ERROR_MENTIONS("rgba");
+    }
+
+    /* NULL settings, "" and hairis_defaults("render") are one render (64 samples, TABLE). */
+    {
+        static float by_default[W * H * 4];
+        char defaults[TEXT];
+        keep(defaults, hairis_defaults("render"));
+        CHECK(hairis_render(scene, NULL, rgba, NULL, NULL) == HAIRIS_OK, "NULL settings");
+        CHECK(stat_of("camera_rays") == W * H * 64, "64 samples by default: \"%s\"",
+              hairis_last_render_stats());
+        CHECK(hairis_render(scene, "", again, NULL, NULL) == HAIRIS_OK, "\"\" settings");
+        CHECK(memcmp(rgba, again, sizeof rgba) == 0, "NULL and \"\" render alike");
+        CHECK(hairis_render(scene, defaults, by_default, NULL, NULL) == HAIRIS_OK,
+              "the defaults are accepted");
+        CHECK(memcmp(rgba, by_default, sizeof rgba) == 0,
+              "hairis_defaults(\"render\") renders as no settings do");
+        char changed[TEXT];
+        CHECK(hairis_render(scene, with_option(changed, defaults, "seed", "1"), again, NULL,
+                            NULL) == HAIRIS_OK &&
+                  memcmp(rgba, again, sizeof rgba) != 0,
+              "and the defaults string is read: seed=1 changes the image");
     }
     hairis_scene_destroy(scene);
 
     /* TABLE with a material that has no tables. */
     {
-        hairis_scene *no_tables = make_scene(&node, NULL);
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        CHECK(hairis_render(no_tables, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+        hairis_scene *no_tables = make_scene("", NULL);
+        CHECK(hairis_render(no_tables, tiny_settings(s, "table", ""), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_TABLE,
               "TABLE without tables is refused");
         CHECK_ERROR_MENTIONS("material 0");
         CHECK_ERROR_MENTIONS("without tables");
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        CHECK(hairis_render(no_tables, &s, rgba, NULL, NULL, NULL) == HAIRIS_OK,
+        CHECK(hairis_render(no_tables, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) ==
+                  HAIRIS_OK,
               "ANALYTIC needs no tables");
         hairis_scene_destroy(no_tables);
     }
 
     /* TABLE with tables baked for other parameters. */
     {
-        hairis_principled_hair other = node;
-        other.roughness = 0.5f;
-        hairis_scene *mismatch = make_scene(&other, g_tables);
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_TABLE);
-        CHECK(hairis_render(mismatch, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+        hairis_scene *mismatch = make_scene("roughness=0.5", g_tables);
+        CHECK(hairis_render(mismatch, tiny_settings(s, "table", ""), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_TABLE,
               "TABLE with mismatched tables is refused");
         CHECK_ERROR_MENTIONS("material 0");
         CHECK_ERROR_MENTIONS("baked for");
-        tiny_settings(&s, HAIRIS_STRATEGY_UNIFORM);
-        CHECK(hairis_render(mismatch, &s, rgba, NULL, NULL, NULL) == HAIRIS_OK,
+        CHECK(hairis_render(mismatch, tiny_settings(s, "uniform", ""), rgba, NULL, NULL) ==
+                  HAIRIS_OK,
               "UNIFORM ignores the tables");
         hairis_scene_destroy(mismatch);
     }
@@ -1242,17 +1547,14 @@ static void test_render(void)
     /* An empty scene, a scene without camera. */
     {
         hairis_scene *empty = hairis_scene_create();
-        hairis_camera camera;
-        test_camera(&camera);
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        CHECK(hairis_render(empty, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK(hairis_render(empty, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "no camera");
         CHECK_ERROR_MENTIONS("camera");
-        CHECK(hairis_scene_set_camera(empty, &camera) == HAIRIS_OK, "camera");
-        const float white[3] = {1, 1, 1};
-        CHECK(hairis_scene_set_world(empty, white, 1.0f) == HAIRIS_OK, "world");
-        CHECK(hairis_render(empty, &s, rgba, NULL, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+        CHECK(hairis_scene_set_camera(empty, CAMERA) == HAIRIS_OK, "camera");
+        CHECK(hairis_scene_set_world(empty, "color=1,1,1") == HAIRIS_OK, "world");
+        CHECK(hairis_render(empty, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
               "empty scene");
         CHECK_ERROR_MENTIONS("empty");
         hairis_scene_destroy(empty);
@@ -1260,70 +1562,262 @@ static void test_render(void)
 
     /* Point and area lights, an emissive triangle, an orthographic camera. */
     {
-        hairis_scene *lit = hairis_scene_create();
-        const int hair = hairis_scene_add_hair_material(lit, &node, NULL);
-        const float albedo[3] = {0.7f, 0.6f, 0.5f}, black[3] = {0, 0, 0}, glow[3] = {2, 2, 2};
-        const int floor = hairis_scene_add_diffuse_material(lit, albedo, black);
-        const int lamp = hairis_scene_add_diffuse_material(lit, black, glow);
-        CHECK(hair == 0 && floor == 1 && lamp == 2, "material indices");
-        CHECK(add_strands(lit, hair) == HAIRIS_OK, "curves");
-        CHECK(add_floor(lit, floor) == HAIRIS_OK, "floor");
+        hairis_scene *lit = make_scene_of("", NULL, "color=0.7,0.6,0.5", NULL, "", NULL);
+        const int lamp = hairis_scene_add_surface_material(lit, "color=0,0,0;emission=2,2,2");
+        CHECK(lamp == 2, "material index %d", lamp);
         const float lamp_positions[9] = {-1, -1, 2, 1, -1, 2, 0, 1, 2};
         const uint32_t lamp_indices[3] = {0, 2, 1};
         const int32_t lamp_materials[1] = {lamp};
         CHECK(hairis_scene_add_mesh(lit, 3, lamp_positions, 1, lamp_indices, lamp_materials) ==
                   HAIRIS_OK,
               "emissive triangle");
-        const float position[3] = {1, 1, 2}, warm[3] = {1, 0.9f, 0.8f};
-        CHECK(hairis_scene_add_point_light(lit, position, warm, 50.0f, 0.1f) == HAIRIS_OK,
+        CHECK(hairis_scene_add_light(lit, "type=point;position=1,1,2;color=1,0.9,0.8;power=50;"
+                                          "radius=0.1") == HAIRIS_OK,
               "point light");
-        CHECK(hairis_scene_add_point_light(lit, position, warm, 20.0f, 0.0f) == HAIRIS_OK,
+        CHECK(hairis_scene_add_light(lit, "type=point;position=1,1,2;color=1,0.9,0.8;power=20") ==
+                  HAIRIS_OK,
               "point light of radius 0");
-        const float area_to_world[16] = {1, 0, 0, -1, 0, 1, 0, 0, 0, 0, 1, 2.5f, 0, 0, 0, 1};
-        for (int shape = HAIRIS_AREA_SQUARE; shape <= HAIRIS_AREA_ELLIPSE; ++shape)
-            CHECK(hairis_scene_add_area_light(lit, area_to_world, shape, 0.5f, 0.3f, warm,
-                                              30.0f) == HAIRIS_OK,
-                  "area light shape %d", shape);
-        hairis_camera camera;
-        test_camera(&camera);
-        camera.orthographic = 1;
-        const float ortho_frame[12] = {1.2f,  1.2f,  -1, 1.2f,  -1.2f, -1,
-                                       -1.2f, -1.2f, -1, -1.2f, 1.2f,  -1};
-        memcpy(camera.frame, ortho_frame, sizeof ortho_frame);
-        CHECK(hairis_scene_set_camera(lit, &camera) == HAIRIS_OK, "orthographic camera");
-        hairis_render_settings s;
-        tiny_settings(&s, HAIRIS_STRATEGY_ANALYTIC);
-        CHECK(hairis_render(lit, &s, rgba, NULL, NULL, NULL) == HAIRIS_OK, "lit render");
-        CHECK(pixels_ok(rgba) && pixel_sum(rgba) > 0.0, "lit pixels finite, >= 0, not black");
+        const char *shapes[4] = {"square", "rectangle", "disk", "ellipse"};
+        for (int k = 0; k < 4; ++k) {
+            char light[TEXT];
+            snprintf(light, sizeof light,
+                     "type=area;matrix=1,0,0,-1,0,1,0,0,0,0,1,2.5,0,0,0,1;shape=%s;size=0.5;"
+                     "size_y=0.3;color=1,0.9,0.8;power=30",
+                     shapes[k]);
+            CHECK(hairis_scene_add_light(lit, light) == HAIRIS_OK, "area light %s", shapes[k]);
+        }
+        CHECK(hairis_scene_set_camera(lit, "matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;orthographic=1;"
+                                           "frame=1.2,1.2,-1,1.2,-1.2,-1,-1.2,-1.2,-1,-1.2,1.2,-1;"
+                                           "width=16;height=16") == HAIRIS_OK,
+              "orthographic camera");
+        CHECK(hairis_render(lit, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) == HAIRIS_OK,
+              "lit render");
+        CHECK(pixels_ok(rgba) && pixel_sum(rgba, W * H) > 0.0,
+              "lit pixels finite, >= 0, not black");
         hairis_scene_destroy(lit);
     }
 }
+
+/* ---- Render settings and camera options the first C API lacked ---------------------------- */
+
+static void test_render_options(void)
+{
+    section("render options");
+    static float full[W * H * 4], image[W * H * 4], direct[W * H * 4];
+    char s[TEXT];
+    const char *base = "samples=4;max_bounces=3;strategy=analytic;seed=5;threads=2";
+    hairis_scene *scene = make_scene("", NULL);
+
+    /* Bounce limits per kind count like max_bounces: with both at 0 every path ends after its
+     * first continuation, which is what max_bounces=0 (direct light only) does. */
+    CHECK(hairis_render(scene, base, full, NULL, NULL) == HAIRIS_OK, "all bounces");
+    snprintf(s, sizeof s, "%s", "samples=4;max_bounces=0;strategy=analytic;seed=5;threads=2");
+    CHECK(hairis_render(scene, s, direct, NULL, NULL) == HAIRIS_OK, "max_bounces=0");
+    CHECK(memcmp(full, direct, sizeof full) != 0 && pixel_sum(direct, W * H) < pixel_sum(full, W * H),
+          "direct light alone is less light (%g < %g)", pixel_sum(direct, W * H),
+          pixel_sum(full, W * H));
+    snprintf(s, sizeof s, "%s;max_diffuse_bounces=0;max_transmission_bounces=0", base);
+    CHECK(hairis_render(scene, s, image, NULL, NULL) == HAIRIS_OK, "both limits 0");
+    CHECK(memcmp(image, direct, sizeof image) == 0,
+          "max_diffuse_bounces=0 and max_transmission_bounces=0 render as max_bounces=0");
+    const char *limits[2] = {"max_diffuse_bounces", "max_transmission_bounces"};
+    for (int k = 0; k < 2; ++k) {
+        snprintf(s, sizeof s, "%s;%s=0", base, limits[k]);
+        CHECK(hairis_render(scene, s, image, NULL, NULL) == HAIRIS_OK, "%s=0", limits[k]);
+        const double sum = pixel_sum(image, W * H);
+        CHECK(memcmp(image, full, sizeof image) != 0 && memcmp(image, direct, sizeof image) != 0 &&
+                  sum < pixel_sum(full, W * H) && sum > pixel_sum(direct, W * H),
+              "%s=0 cuts some bounces: %g between %g and %g", limits[k], sum,
+              pixel_sum(direct, W * H), pixel_sum(full, W * H));
+    }
+
+    /* film_transparent: camera rays that miss add neither the world nor alpha. The camera's
+     * top corners look past the floor. */
+    {
+        const int corner = (H - 1) * W + (W - 1); /* top right (bottom row first) */
+        CHECK(pixels_ok(full), "opaque film: alpha 1 everywhere");
+        CHECK(fabsf(full[4 * corner] - 0.1f) < 1e-6f && fabsf(full[4 * corner + 2] - 0.15f) < 1e-6f,
+              "the corner sees the sky (%g, %g, %g)", full[4 * corner], full[4 * corner + 1],
+              full[4 * corner + 2]);
+        snprintf(s, sizeof s, "%s;film_transparent=1", base);
+        CHECK(hairis_render(scene, s, image, NULL, NULL) == HAIRIS_OK, "film_transparent=1");
+        CHECK(image[4 * corner] == 0 && image[4 * corner + 1] == 0 && image[4 * corner + 2] == 0 &&
+                  image[4 * corner + 3] == 0,
+              "a ray that misses: rgba 0 (%g, %g, %g, %g)", image[4 * corner],
+              image[4 * corner + 1], image[4 * corner + 2], image[4 * corner + 3]);
+        const int centre = (H / 2) * W + W / 2;
+        CHECK(image[4 * centre + 3] == 1.0f, "a ray that hits: alpha 1 (%g)", image[4 * centre + 3]);
+        int transparent = 0;
+        for (int i = 0; i < W * H; ++i) transparent += image[4 * i + 3] == 0.0f;
+        CHECK(transparent > 0 && transparent < W * H / 4, "%d transparent pixels", transparent);
+        snprintf(s, sizeof s, "%s;film_transparent=true", base);
+        CHECK(hairis_render(scene, s, direct, NULL, NULL) == HAIRIS_OK &&
+                  memcmp(image, direct, sizeof image) == 0,
+              "film_transparent=true is 1");
+    }
+    hairis_scene_destroy(scene);
+
+    /* The camera's clip range: geometry outside it is not seen (the hair is ~3 away, the floor
+     * 3.5). Every pixel is then the sky. */
+    {
+        const char *clips[3] = {"clip_end=1", "clip_start=10", "clip_start=2;clip_end=2.5"};
+        for (int k = 0; k < 3; ++k) {
+            char camera[TEXT];
+            snprintf(camera, sizeof camera, CAMERA ";%s", clips[k]);
+            hairis_scene *clipped = make_scene_of("", NULL, "", "type=sun;direction=0.3,0.2,1",
+                                                  SKY, camera);
+            CHECK(hairis_render(clipped, base, image, NULL, NULL) == HAIRIS_OK, "%s", clips[k]);
+            int sky = 0;
+            for (int i = 0; i < W * H; ++i)
+                sky += fabsf(image[4 * i] - 0.1f) < 1e-6f && fabsf(image[4 * i + 1] - 0.12f) < 1e-6f &&
+                       fabsf(image[4 * i + 2] - 0.15f) < 1e-6f && image[4 * i + 3] == 1.0f;
+            CHECK(sky == W * H, "%s: %d of %d pixels are the sky", clips[k], sky, W * H);
+            hairis_scene_destroy(clipped);
+        }
+        /* A range that holds the geometry sees it. */
+        char camera[TEXT];
+        snprintf(camera, sizeof camera, CAMERA ";clip_start=2;clip_end=4");
+        hairis_scene *clipped =
+            make_scene_of("", NULL, "", "type=sun;direction=0.3,0.2,1", SKY, camera);
+        CHECK(hairis_render(clipped, base, image, NULL, NULL) == HAIRIS_OK, "clip 2 to 4");
+        int sky = 0;
+        for (int i = 0; i < W * H; ++i) sky += fabsf(image[4 * i] - 0.1f) < 1e-6f;
+        CHECK(sky < W * H / 2, "clip 2 to 4 sees the hair and the floor (%d sky pixels)", sky);
+        CHECK(hairis_scene_set_camera(clipped, CAMERA ";clip_start=2;clip_end=1") ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
+              "clip_end before clip_start");
+        CHECK_ERROR_MENTIONS("clip_end");
+        CHECK(hairis_scene_set_camera(clipped, CAMERA ";clip_start=-1") ==
+                  HAIRIS_ERROR_INVALID_ARGUMENT,
+              "negative clip_start");
+        CHECK_ERROR_MENTIONS("clip_start");
+        hairis_scene_destroy(clipped);
+    }
+}
+
+/* ---- Defaults round-trip: each kind's defaults, passed back, are what omitting them gives -- */
+
+enum { CW = 64, CH = 64 };
+
+/* Renders a scene of the round-trip test (hair with ANALYTIC, a floor) into rgba. */
+static int render_round_trip(const char *surface, const char *light, const char *world,
+                             const char *camera, float *rgba)
+{
+    hairis_scene *scene = make_scene_of("", NULL, surface, light, world, camera);
+    const int status =
+        hairis_render(scene, "samples=2;max_bounces=2;strategy=analytic;seed=3;threads=2", rgba,
+                      NULL, NULL);
+    hairis_scene_destroy(scene);
+    return status;
+}
+
+static void test_defaults_round_trip(void)
+{
+    section("defaults round-trip");
+    char d[TEXT], a_text[TEXT], text[TEXT];
+
+    /* Fibers: the defaults of a model are what its model name alone gives. */
+    hairis_fiber *a = hairis_fiber_create(keep(d, hairis_defaults("chiang")));
+    hairis_fiber *b = hairis_fiber_create("");
+    CHECK(a && b && strcmp(keep(a_text, hairis_fiber_parameters(a)), hairis_fiber_parameters(b)) == 0,
+          "hairis_fiber_create(hairis_defaults(\"chiang\")) is hairis_fiber_create(\"\")");
+    hairis_fiber *c = hairis_fiber_create(with_option(text, d, "roughness", "0.4"));
+    CHECK(c && strcmp(a_text, hairis_fiber_parameters(c)) != 0, "and roughness in it is read");
+    hairis_fiber_destroy(a);
+    hairis_fiber_destroy(b);
+    hairis_fiber_destroy(c);
+    a = hairis_fiber_create(keep(d, hairis_defaults("marschner")));
+    b = hairis_fiber_create("model=marschner");
+    CHECK(a && b && strcmp(keep(a_text, hairis_fiber_parameters(a)), hairis_fiber_parameters(b)) == 0,
+          "Marschner's defaults are model=marschner's: \"%s\" vs \"%s\"", a_text,
+          b ? hairis_fiber_parameters(b) : "");
+    c = hairis_fiber_create(with_option(text, d, "eta", "1.6"));
+    CHECK(c && strcmp(a_text, hairis_fiber_parameters(c)) != 0, "and eta in it is read");
+    hairis_fiber_destroy(a);
+    hairis_fiber_destroy(b);
+    hairis_fiber_destroy(c);
+
+    /* Bakes: the defaults are accepted (cancelled at once: the default bake takes minutes);
+     * at a small resolution they bake what they say. */
+    hairis_fiber *fiber = hairis_fiber_create("");
+    keep(d, hairis_defaults("bake"));
+    CHECK(hairis_tables_bake(fiber, d, cancel_at_once, NULL) == NULL &&
+              strcmp(hairis_last_error(), "cancelled") == 0,
+          "the bake defaults are accepted");
+    with_option(text, d, "theta_r", "2");
+    with_option(text, keep(a_text, text), "theta_i", "4");
+    with_option(text, keep(a_text, text), "phi", "8");
+    with_option(text, keep(a_text, text), "source", "gaussian");
+    hairis_tables *t = hairis_tables_bake(fiber, text, NULL, NULL);
+    CHECK(t && strcmp(hairis_tables_info(t), "source=gaussian;theta_r=2;theta_i=4;phi=8;n_h=1,2,4,8,16") == 0,
+          "\"%s\" bakes \"%s\"", text, t ? hairis_tables_info(t) : hairis_last_error());
+    hairis_tables_destroy(t);
+    hairis_fiber_destroy(fiber);
+
+    /* Scene options: each kind's defaults render as the kind with no options; one value
+     * changed in them renders otherwise (so the comparison can fail). */
+    static float with_defaults[CW * CH * 4], without[CW * CH * 4], changed[CW * CH * 4];
+    const char *sun = "type=sun;direction=0.3,0.2,1;strength=2";
+    struct {
+        const char *kind, *bare, *name, *value;
+    } cases[] = {
+        {"diffuse", "type=diffuse", "color", "0.3,0.3,0.3"},
+        {"sun", "type=sun", "strength", "2"},
+        {"point", "type=point", "power", "30"},
+        {"area", "type=area", "power", "30"},
+        {"world", "", "color", "0.2,0.2,0.2"},
+        {"camera", "", "orthographic", "1"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        const char *kind = cases[k].kind;
+        keep(d, hairis_defaults(kind));
+        with_option(text, d, cases[k].name, cases[k].value);
+        const int is_surface = strcmp(kind, "diffuse") == 0, is_world = strcmp(kind, "world") == 0,
+                  is_camera = strcmp(kind, "camera") == 0;
+        const int is_light = !is_surface && !is_world && !is_camera;
+        const char *camera = is_camera ? NULL : CAMERA;
+        const int pixels = is_camera ? CW * CH : W * H;
+        const char *options[3] = {d, cases[k].bare, text};
+        float *images[3] = {with_defaults, without, changed};
+        for (int v = 0; v < 3; ++v) {
+            char camera_text[TEXT];
+            if (is_camera) snprintf(camera_text, sizeof camera_text, "%s", options[v]);
+            const int status = render_round_trip(
+                is_surface ? options[v] : "color=0.5,0.5,0.5", is_light ? options[v] : sun,
+                is_world ? options[v] : SKY, is_camera ? camera_text : camera, images[v]);
+            CHECK(status == HAIRIS_OK, "%s: render with \"%s\"", kind, options[v]);
+        }
+        CHECK(memcmp(with_defaults, without, sizeof(float) * 4 * (size_t)pixels) == 0,
+              "%s: hairis_defaults renders as \"%s\"", kind, cases[k].bare);
+        CHECK(memcmp(with_defaults, changed, sizeof(float) * 4 * (size_t)pixels) != 0,
+              "%s: %s=%s in the defaults renders otherwise", kind, cases[k].name, cases[k].value);
+    }
+}
+
+/* ---- Scene refusals ----------------------------------------------------------------------- */
 
 static void test_scene_refusals(void)
 {
     section("scene refusals");
     hairis_scene *scene = hairis_scene_create();
-    hairis_principled_hair node;
-    hairis_principled_hair_defaults(&node);
-    const float white[3] = {1, 1, 1}, black[3] = {0, 0, 0};
+    hairis_fiber *chiang = hairis_fiber_create("");
+    hairis_fiber *marschner = hairis_fiber_create("model=marschner");
 
-    node.roughness = -1.0f;
-    CHECK(hairis_scene_add_hair_material(scene, &node, NULL) == -1, "bad node");
-    CHECK_ERROR_MENTIONS("node.roughness");
-    hairis_principled_hair_defaults(&node);
-    CHECK(hairis_scene_add_hair_material(NULL, &node, NULL) == -1, "NULL scene");
+    CHECK(hairis_scene_add_hair_material(scene, marschner, NULL) == -1, "Marschner hair");
+    CHECK_ERROR_MENTIONS("chiang2016");
+    CHECK(hairis_scene_add_hair_material(NULL, chiang, NULL) == -1, "NULL scene");
     CHECK_ERROR_MENTIONS("scene");
-    CHECK(hairis_scene_add_hair_material(scene, NULL, NULL) == -1, "NULL node");
-    CHECK_ERROR_MENTIONS("node");
-    const float too_bright[3] = {0.5f, 1.5f, 0.5f};
-    CHECK(hairis_scene_add_diffuse_material(scene, too_bright, black) == -1, "albedo > 1");
-    CHECK_ERROR_MENTIONS("albedo[1]");
-    const float negative[3] = {0, -1, 0};
-    CHECK(hairis_scene_add_diffuse_material(scene, white, negative) == -1, "negative emission");
-    CHECK_ERROR_MENTIONS("emission[1]");
+    CHECK(hairis_scene_add_hair_material(scene, NULL, NULL) == -1, "NULL fiber");
+    CHECK_ERROR_MENTIONS("fiber");
+    CHECK(hairis_scene_add_surface_material(scene, "color=0.5,1.5,0.5") == -1, "colour > 1");
+    CHECK_ERROR_MENTIONS("color");
+    CHECK(hairis_scene_add_surface_material(scene, "emission=0,-1,0") == -1, "negative emission");
+    CHECK_ERROR_MENTIONS("emission");
+    CHECK(hairis_scene_add_surface_material(NULL, "") == -1, "NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
 
-    const int hair = hairis_scene_add_hair_material(scene, &node, NULL);
-    const int diffuse = hairis_scene_add_diffuse_material(scene, white, black);
+    const int hair = hairis_scene_add_hair_material(scene, chiang, NULL);
+    const int diffuse = hairis_scene_add_surface_material(scene, "color=1,1,1");
     CHECK(hair == 0 && diffuse == 1, "indices %d %d", hair, diffuse);
 
     uint32_t first[3] = {0, 2, 4};
@@ -1367,6 +1861,13 @@ static void test_scene_refusals(void)
               HAIRIS_ERROR_INVALID_ARGUMENT,
           "curves: NULL first");
     CHECK_ERROR_MENTIONS("first");
+    CHECK(hairis_scene_add_curves(scene, hair, 2, first, 4, positions, NULL) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "curves: NULL radii");
+    CHECK_ERROR_MENTIONS("radii");
+    CHECK(hairis_scene_add_curves(scene, hair, (size_t)1 << 40, first, (size_t)1 << 41, NULL,
+                                  NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "curves: huge counts with NULL arrays, refused before reading them");
     CHECK(hairis_scene_add_curves(scene, hair, 2, first, 4, positions, radii) == HAIRIS_OK,
           "curves: valid");
     CHECK_NO_ERROR();
@@ -1394,100 +1895,79 @@ static void test_scene_refusals(void)
               HAIRIS_ERROR_INVALID_ARGUMENT,
           "mesh: NULL positions");
     CHECK_ERROR_MENTIONS("positions");
+    CHECK(hairis_scene_add_mesh(NULL, 3, tri, 1, indices, materials) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "mesh: NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
     CHECK(hairis_scene_add_mesh(scene, 3, tri, 1, indices, materials) == HAIRIS_OK,
           "mesh: valid");
 
-    const float zero[3] = {0, 0, 0}, up[3] = {0, 0, 1}, nan3[3] = {NAN, 0, 1};
-    CHECK(hairis_scene_add_sun(scene, zero, white, 1, 0) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "sun: zero direction");
-    CHECK_ERROR_MENTIONS("direction");
-    CHECK(hairis_scene_add_sun(scene, nan3, white, 1, 0) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "sun: NaN direction");
-    CHECK_ERROR_MENTIONS("direction[0]");
-    CHECK(hairis_scene_add_sun(scene, up, white, -1, 0) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "sun: negative strength");
-    CHECK_ERROR_MENTIONS("strength");
-    CHECK(hairis_scene_add_sun(scene, up, white, 1, 4.0f) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "sun: angle >= pi");
-    CHECK_ERROR_MENTIONS("angle");
-    CHECK(hairis_scene_add_sun(scene, up, negative, 1, 0) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "sun: negative colour");
-    CHECK_ERROR_MENTIONS("color[1]");
-    CHECK(hairis_scene_add_point_light(scene, up, white, 10, -1) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "point: negative radius");
-    CHECK_ERROR_MENTIONS("radius");
-    CHECK(hairis_scene_add_point_light(scene, nan3, white, 10, 0) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "point: NaN position");
-    CHECK_ERROR_MENTIONS("position");
-    CHECK(hairis_scene_add_point_light(scene, up, white, INFINITY, 0) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "point: infinite power");
-    CHECK_ERROR_MENTIONS("power");
-    const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    const float flat[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1};
-    CHECK(hairis_scene_add_area_light(scene, identity, 7, 1, 1, white, 10) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "area: shape 7");
-    CHECK_ERROR_MENTIONS("shape");
-    CHECK(hairis_scene_add_area_light(scene, flat, HAIRIS_AREA_DISK, 1, 1, white, 10) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "area: zero Z axis");
-    CHECK_ERROR_MENTIONS("light_to_world");
-    CHECK(hairis_scene_add_area_light(scene, identity, HAIRIS_AREA_DISK, -1, 1, white, 10) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "area: negative size");
-    CHECK_ERROR_MENTIONS("size_x");
-    CHECK(hairis_scene_add_area_light(scene, NULL, HAIRIS_AREA_DISK, 1, 1, white, 10) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "area: NULL matrix");
-    CHECK_ERROR_MENTIONS("light_to_world");
-    CHECK(hairis_scene_set_world(scene, white, -2) == HAIRIS_ERROR_INVALID_ARGUMENT,
+    /* Lights, world and camera: every bad value named. */
+    const char *bad[][2] = {
+        {"type=sun;direction=0,0,0", "direction"},
+        {"type=sun;direction=nan,0,1", "direction"},
+        {"type=sun;strength=-1", "strength"},
+        {"type=sun;angle=4", "angle"},
+        {"type=sun;color=1,-1,1", "color"},
+        {"type=sun;radius=1", "\"radius\""},
+        {"type=point;radius=-1", "radius"},
+        {"type=point;position=nan,0,0", "position"},
+        {"type=point;power=inf", "power"},
+        {"type=area;shape=7", "shape"},
+        {"type=area;matrix=1,0,0,0,0,1,0,0,0,0,0,0,0,0,0,1", "Z axis"},
+        {"type=area;size=-1", "size"},
+        {"type=area;matrix=1,0,0", "matrix"},
+        {"type=area;size_x=1", "\"size_x\""},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        CHECK(hairis_scene_add_light(scene, bad[i][0]) == HAIRIS_ERROR_INVALID_ARGUMENT,
+              "light \"%s\" refused", bad[i][0]);
+        CHECK_ERROR_MENTIONS(bad[i][1]);
+    }
+    CHECK(hairis_scene_add_light(NULL, "type=sun") == HAIRIS_ERROR_INVALID_ARGUMENT, "NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
+    CHECK(hairis_scene_set_world(scene, "strength=-2") == HAIRIS_ERROR_INVALID_ARGUMENT,
           "world: negative strength");
     CHECK_ERROR_MENTIONS("strength");
-    CHECK(hairis_scene_set_world(scene, NULL, 1) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "world: NULL colour");
+    CHECK(hairis_scene_set_world(scene, "color=1,1") == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "world: two components");
     CHECK_ERROR_MENTIONS("color");
+    CHECK(hairis_scene_set_world(NULL, "") == HAIRIS_ERROR_INVALID_ARGUMENT, "world: NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
 
-    hairis_camera camera;
-    test_camera(&camera);
-    camera.width = 0;
-    CHECK(hairis_scene_set_camera(scene, &camera) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "camera: width 0");
-    CHECK_ERROR_MENTIONS("width");
-    test_camera(&camera);
-    camera.orthographic = 2;
-    CHECK(hairis_scene_set_camera(scene, &camera) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "camera: orthographic 2");
-    CHECK_ERROR_MENTIONS("orthographic");
-    test_camera(&camera);
-    camera.frame[0] = NAN;
-    CHECK(hairis_scene_set_camera(scene, &camera) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "camera: NaN frame");
-    CHECK_ERROR_MENTIONS("frame");
-    test_camera(&camera);
-    /* Corners in the wrong order (top left first). */
-    const float wrong[12] = {-0.4f, 0.4f, -1, 0.4f, 0.4f,  -1,
-                             0.4f,  -0.4f, -1, -0.4f, -0.4f, -1};
-    memcpy(camera.frame, wrong, sizeof wrong);
-    CHECK(hairis_scene_set_camera(scene, &camera) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "camera: corners out of order");
-    CHECK_ERROR_MENTIONS("frame");
-    CHECK(hairis_scene_set_camera(scene, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
-          "camera: NULL");
-    CHECK_ERROR_MENTIONS("camera");
+    const char *bad_cameras[][2] = {
+        {"width=0", "width"},
+        {"height=65537", "height"},
+        {"orthographic=2", "orthographic"},
+        {"frame=nan,0.4,-1,0.4,-0.4,-1,-0.4,-0.4,-1,-0.4,0.4,-1", "frame"},
+        /* Corners in the wrong order (top left first). */
+        {"frame=-0.4,0.4,-1,0.4,0.4,-1,0.4,-0.4,-1,-0.4,-0.4,-1", "frame"},
+        {"matrix=nan,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1", "matrix"},
+        {"matrix=0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1", "camera_to_world"},
+        {"lens=50", "\"lens\""},
+    };
+    for (size_t i = 0; i < sizeof bad_cameras / sizeof bad_cameras[0]; ++i) {
+        CHECK(hairis_scene_set_camera(scene, bad_cameras[i][0]) == HAIRIS_ERROR_INVALID_ARGUMENT,
+              "camera \"%s\" refused", bad_cameras[i][0]);
+        CHECK_ERROR_MENTIONS(bad_cameras[i][1]);
+    }
+    CHECK(hairis_scene_set_camera(NULL, "") == HAIRIS_ERROR_INVALID_ARGUMENT, "camera: NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
+    /* A refused camera leaves the scene without one. */
+    static float rgba[W * H * 4];
+    CHECK(hairis_render(scene, "strategy=analytic", rgba, NULL, NULL) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "render after refused cameras");
+    CHECK_ERROR_MENTIONS("no camera");
     hairis_scene_destroy(scene);
     hairis_scene_destroy(NULL);
     CHECK_NO_ERROR();
+    hairis_fiber_destroy(chiang);
+    hairis_fiber_destroy(marschner);
 }
 
-int main(int argc, char **argv)
+int main(void)
 {
-    if (argc > 1 && strcmp(argv[1], "--layout") == 0) {
-        print_layout();
-        return 0;
-    }
     const char *temp_dir = getenv("TMPDIR");
     if (!temp_dir || !*temp_dir) temp_dir = "/tmp";
 
@@ -1497,11 +1977,14 @@ int main(int argc, char **argv)
     test_fiber_eval();
     test_tables(temp_dir);
     if (g_tables) {
+        test_option_strings();
         test_sampling();
         test_render();
     } else {
-        CHECK(0, "no tables: the sampling and render tests cannot run");
+        CHECK(0, "no tables: the option, sampling and render tests cannot run");
     }
+    test_render_options();
+    test_defaults_round_trip();
     test_scene_refusals();
     hairis_tables_destroy(g_tables);
 
