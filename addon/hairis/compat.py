@@ -50,6 +50,13 @@ def version_string(version=None):
     return ".".join(str(part) for part in (version or running_version()))
 
 
+def cycles_version(version=None):
+    """The "major.minor" of the Blender (and so the Cycles) whose hair model hairis follows:
+    Cycles 4.2 changed where the Chiang model applies the cuticle tilt."""
+    version = running_version() if version is None else version
+    return "%d.%d" % (version[0], version[1])
+
+
 def version_problem(version=None):
     """None when Hairis supports ``version`` (default: the running one), else why not."""
     version = tuple(version or running_version())

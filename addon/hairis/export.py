@@ -80,6 +80,8 @@ class HairParameters:
     random_color: float = 0.0
     random_roughness: float = 0.0
     random: float = 0.0
+    cycles: str = "3.4"
+    """The Blender version whose Cycles evaluates the node (compat.cycles_version)."""
 
     def as_dict(self):
         """The values keyed by C field name."""
@@ -367,7 +369,8 @@ def read_hair_node(node, material_name="?"):
     if parametrization not in PARAMETRIZATIONS:
         return None, warnings, ("material %r: unknown Principled Hair parametrization %r"
                                 % (material_name, parametrization))
-    values = {"parametrization": PARAMETRIZATIONS[parametrization]}
+    values = {"parametrization": PARAMETRIZATIONS[parametrization],
+              "cycles": compat.cycles_version()}
     for field_name, input_name, components in HAIR_INPUTS:
         socket = _input(node, input_name)
         if socket is None:

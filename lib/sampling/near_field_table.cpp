@@ -83,17 +83,8 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
     table.fiber_ = std::move(fiber);
 
     const int nodes = options.theta_o_nodes, cells = options.theta_i_cells;
-    std::vector<float> theta_o(static_cast<size_t>(nodes));
-    for (int r = 0; r < nodes; ++r)
-        theta_o[size_t(r)] = float(-kHalfPi + kPi * r / (nodes - 1));
-    theta_o.front() = -float(kHalfPi);
-    theta_o.back() = float(kHalfPi);
-    Expected<ThetaRNodes> made_nodes = ThetaRNodes::create(theta_o);
-    if (!made_nodes) return made_nodes.error();
-    table.nodes_ = std::move(made_nodes).value();
-    Expected<LongitudinalCells> made_cells = LongitudinalCells::create(cells);
-    if (!made_cells) return made_cells.error();
-    table.cells_ = std::move(made_cells).value();
+    if (Status s = table.set_grid(nodes, cells)) return *s;
+    const std::vector<float> &theta_o = table.nodes_.values();
 
     // Cell masses, one row per (node, lobe); rows are independent, so the result does not
     // depend on how TBB splits them.
@@ -139,11 +130,7 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
     data->cone.assign(size_t(rows), 0);
     // The CDFs of the stored (float) masses, as from_data builds them; the probes below read them.
     table.data_ = data;
-    Expected<DiscreteCdfs> cdfs = DiscreteCdfs::create(rows, cells, [&](int row, double *w) {
-        std::copy_n(data->mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
-    });
-    if (!cdfs) return cdfs.error();
-    table.cdfs_ = std::move(cdfs).value();
+    if (Status s = table.set_cdfs()) return *s;
 
     // Per node and lobe, the table row or the cone, whichever is closer to M_p over the
     // θ_o around the node: the sum of both adjacent intervals' divergences, each averaged
@@ -222,24 +209,34 @@ Expected<NearFieldTable> NearFieldTable::from_data(std::shared_ptr<const ChiangF
     if (Status s = data->validate()) return *s;
     NearFieldTable table;
     table.fiber_ = std::move(fiber);
-    const int nodes = data->theta_o_nodes, cells = data->theta_i_cells;
+    if (Status s = table.set_grid(data->theta_o_nodes, data->theta_i_cells)) return *s;
+    table.data_ = std::move(data);
+    if (Status s = table.set_cdfs()) return Error{"near-field table: " + s->message, ErrorKind::InvalidTable};
+    return table;
+}
+
+Status NearFieldTable::set_grid(int nodes, int cells) {
     std::vector<float> theta_o(static_cast<size_t>(nodes));
     for (int r = 0; r < nodes; ++r) theta_o[size_t(r)] = float(-kHalfPi + kPi * r / (nodes - 1));
     theta_o.front() = -float(kHalfPi);
     theta_o.back() = float(kHalfPi);
     Expected<ThetaRNodes> made_nodes = ThetaRNodes::create(theta_o);
     if (!made_nodes) return made_nodes.error();
-    table.nodes_ = std::move(made_nodes).value();
+    nodes_ = std::move(made_nodes).value();
     Expected<LongitudinalCells> made_cells = LongitudinalCells::create(cells);
     if (!made_cells) return made_cells.error();
-    table.cells_ = std::move(made_cells).value();
-    Expected<DiscreteCdfs> cdfs = DiscreteCdfs::create(data->rows(), cells, [&](int row, double *w) {
-        std::copy_n(data->mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
+    cells_ = std::move(made_cells).value();
+    return std::nullopt;
+}
+
+Status NearFieldTable::set_cdfs() {
+    const int cells = data_->theta_i_cells;
+    Expected<DiscreteCdfs> cdfs = DiscreteCdfs::create(data_->rows(), cells, [&](int row, double *w) {
+        std::copy_n(data_->mass.begin() + std::ptrdiff_t(row) * cells, cells, w);
     });
-    if (!cdfs) return Error{"near-field table: " + cdfs.error().message, ErrorKind::InvalidTable};
-    table.cdfs_ = std::move(cdfs).value();
-    table.data_ = std::move(data);
-    return table;
+    if (!cdfs) return cdfs.error();
+    cdfs_ = std::move(cdfs).value();
+    return std::nullopt;
 }
 
 NearFieldTable::Divergences NearFieldTable::divergences(int r, int p, float t_node) const {

@@ -133,6 +133,8 @@ class NearFieldTable {
         double table = 0, cone = 0;
     };
     Divergences divergences(int r, int p, float t_node) const;
+    Status set_grid(int nodes, int cells);  // nodes_ equally spaced, ends included; cells_
+    Status set_cdfs();                      // cdfs_ of data_->mass
 
     std::shared_ptr<const ChiangFiber> fiber_;
     std::shared_ptr<const NearFieldData> data_;

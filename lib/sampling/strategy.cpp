@@ -88,8 +88,8 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
                 if (!near_field) {
                     // From the tables' data alone: nothing is tabulated from the fiber here.
                     if (!t.near_field)
-                        return table_error("the tables have no near-field part (they were baked for the far field "
-                                           "only, or from the seed's Gaussians); bake exact tables for this fiber");
+                        return table_error("the tables have no near-field part (they were not baked for a Chiang "
+                                           "fiber); bake tables for this fiber");
                     Expected<NearFieldTable> made = NearFieldTable::from_data(in.chiang, t.near_field);
                     if (!made) return table_error(made.error().message);
                     near_field = std::make_shared<const NearFieldTable>(std::move(made).value());

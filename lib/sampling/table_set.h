@@ -26,8 +26,8 @@ struct TableSet {
     std::vector<int> n_h_values;       ///< strands for the multiple tables, increasing
     std::vector<float> direct;    ///< [r][i][j]: theta_r_count × theta_i_count × phi_count
     std::vector<float> multiple;  ///< [r][k][i]: theta_r_count × n_h count × theta_i_count
-    /// Chiang's near-field tables (what TABLE samples single scattering from); null for other
-    /// models and for the seed's Gaussian source.
+    /// Chiang's near-field tables (what TABLE samples single scattering from for a fiber); null
+    /// for other models.
     std::shared_ptr<const NearFieldData> near_field;
 
     int theta_r_count() const { return int(theta_r_nodes.size()); }

@@ -132,8 +132,9 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
             });
         }
     }
-    // Chiang's near field: what TABLE samples single scattering from (near_field_table.h).
-    if (const auto *chiang = dynamic_cast<const ChiangFiber *>(&model); chiang && options.source == "exact") {
+    // Chiang's near field, whatever the far part's source: what TABLE samples single
+    // scattering from for a fiber (near_field_table.h).
+    if (const auto *chiang = dynamic_cast<const ChiangFiber *>(&model)) {
         Expected<NearFieldTable> near_field = NearFieldTable::create(std::make_shared<const ChiangFiber>(*chiang));
         if (!near_field) return Error{"near-field table: " + near_field.error().message};
         t.near_field = near_field.value().shared_data();
