@@ -27,6 +27,7 @@ Writes HAIRIS_STUDY_OUT (bench/results)/render_versions.{json,md}. Environment:
 HAIRIS_VERSIONS_SCENES (compare,demo,sphere), _LOW (16), _HIGH (64), _REPEATS (3), _THREADS (1).
 """
 
+import copy
 import importlib.util
 import json
 import os
@@ -99,6 +100,32 @@ def make_scene(name):
     return scene, bounces
 
 
+class OldHair:
+    """HairParameters as the binding before ABI v2 knows them: without the Cycles version,
+    which must be 3.4's (the only semantics it has)."""
+
+    def __init__(self, hair):
+        if hair.cycles != "3.4":
+            raise RuntimeError("the old library has only Cycles 3.4's Chiang; this Blender's is %s"
+                               % hair.cycles)
+        self.hair = hair
+
+    def as_dict(self):
+        values = self.hair.as_dict()
+        del values["cycles"]
+        return values
+
+
+def for_old_binding(data):
+    """A copy of ``data`` whose hair materials the old binding reads."""
+    data = copy.copy(data)
+    data.materials = [copy.copy(m) for m in data.materials]
+    for material in data.materials:
+        if material.hair is not None:
+            material.hair = OldHair(material.hair)
+    return data
+
+
 class Version:
     """One Hairis version: its binding, its library and the scene built with them."""
 
@@ -109,9 +136,11 @@ class Version:
         self.tables = package.tables
         self.library = self.native.load_library(library_path)
         self.baked = {}
+        self.adapt = for_old_binding if name == "old" else (lambda data: data)
 
     def bake(self, data):
         """Tables for every hair material of ``data`` (index → Tables)."""
+        data = self.adapt(data)
         for index, material in data.hair_materials():
             node = self.tables.principled_struct(self.library, material.hair)
             with self.library.fiber_principled(node) as fiber:
@@ -119,6 +148,7 @@ class Version:
 
     def render(self, data, strategy, samples, seed):
         """(rgba, seconds, stats) of one render of ``data``."""
+        data = self.adapt(data)
         settings = type("Settings", (), {})()
         settings.samples, settings.max_bounces, settings.strategy = samples, data.bounces, strategy
         settings.multiple_weight, settings.n_h, settings.seed = 0.0, 2, seed

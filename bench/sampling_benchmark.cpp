@@ -56,6 +56,30 @@ BENCHMARK_CAPTURE(sample_and_pdf, table_far_mixture, 5);
 BENCHMARK_CAPTURE(sample_and_pdf, table_near_direct, 6);
 BENCHMARK_CAPTURE(sample_and_pdf, table_near_mixture, 7);
 
+// What a path vertex pays for hair: prepare the BSDF, f and pdf at a light sample's direction
+// (next-event estimation with MIS), then a BSDF sample with its f.
+void path_vertex(benchmark::State &state, int which) {
+    const auto samplers = all_samplers(setup());
+    const Strategy &s = *samplers[size_t(which)].sampler;
+    state.SetLabel(samplers[size_t(which)].name);
+    const Queries q(4096);
+    ScratchBuffer scratch;
+    size_t k = 0;
+    for (auto _ : state) {
+        scratch.reset();
+        const HairBsdf bsdf = s.at(q.views[k], q.h[k], scratch);
+        float light_pdf = 0.0f;
+        const Rgb light_f = bsdf.f_and_pdf(q.views[(k + 1) & 4095], light_pdf);
+        const auto smp = bsdf.sample(q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
+        float value = light_f.g + light_pdf + (smp ? smp->f.g + smp->pdf : 0.0f);
+        benchmark::DoNotOptimize(value);
+        k = (k + 1) & 4095;
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(path_vertex, analytic, 1);
+BENCHMARK_CAPTURE(path_vertex, table_near_direct, 6);
+
 void chiang_near_field(benchmark::State &state) {
     const Queries q(4096);
     size_t k = 0;

@@ -85,6 +85,42 @@ TEST(SobolRng, BitHelpers) {
     EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end());
 }
 
+// SobolSampleRng::get as its comment defines it, step by step with the bit-by-bit Sobol
+// generator: the reference for the table-driven, reversal-folded implementation.
+float sobol_sample_by_definition(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample,
+                                 std::uint32_t dimension) {
+    const std::uint64_t key = mix64(mix64(seed ^ 0xbb67ae8584caa73bull) ^ pixel);
+    const std::uint32_t pair_hash =
+        std::uint32_t(mix64(key ^ (std::uint64_t(dimension >> 1) * 0x9e3779b97f4a7c15ull)));
+    const std::uint32_t dimension_hash = std::uint32_t(
+        mix64(key ^ (std::uint64_t(dimension) * 0xc2b2ae3d27d4eb4full) ^ 0x165667b19e3779f9ull));
+    const std::uint32_t shuffle = nested_uniform_scramble(std::uint32_t(sample), pair_hash);
+    std::uint32_t point = 0;
+    if (dimension & 1u) {
+        for (std::uint32_t v = 1u << 31, i = shuffle; i != 0; i >>= 1, v ^= v >> 1)
+            if (i & 1u) point ^= v;
+    } else {
+        point = reverse_bits32(shuffle);
+    }
+    return float(nested_uniform_scramble(point, dimension_hash) >> 8) * (1.0f / 16777216.0f);
+}
+
+TEST(SobolRng, MatchesItsDefinition) {
+    std::uint64_t state = 1;
+    for (int k = 0; k < 200000; ++k) {
+        state = mix64(state + 0x9e3779b97f4a7c15ull);
+        const std::uint64_t seed = state & 0xff, pixel = (state >> 8) & 0xfffff;
+        const std::uint64_t sample = (k & 1) ? std::uint64_t(k >> 1) : (state >> 28);
+        const std::uint32_t dimension = std::uint32_t((state >> 60) + (state >> 40) % 37);
+        ASSERT_EQ(SobolSampleRng(seed, pixel, sample).get(dimension),
+                  sobol_sample_by_definition(seed, pixel, sample, dimension))
+            << "seed " << seed << " pixel " << pixel << " sample " << sample << " dimension "
+            << dimension;
+    }
+    for (std::uint32_t i = 0; i < (1u << 16); ++i)
+        ASSERT_EQ(sobol_second_dimension(i * 65599u), detail::sobol_second_dimension_bits(i * 65599u));
+}
+
 TEST(SobolRng, EachDimensionAndPairIsStratified) {
     // 256 samples of one pixel: one per 1/256 interval in every dimension, and one per
     // elementary interval of area 1/256 (1×256, 2×128, ..., 256×1) in every pair.

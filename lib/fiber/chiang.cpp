@@ -355,7 +355,32 @@ float ChiangPoint::pdf(Vec3 wi) const {
     return float(density);
 }
 
-std::optional<DirectionSample> ChiangPoint::sample(float u0, float u1, float u2) const {
+Rgb ChiangPoint::f_and_pdf(Vec3 wi, float &pdf) const {
+    const SinCos i = sin_cos_of(double(wi.x));
+    const double phi = relative_azimuth(wi);
+    const bool cones_tilted = fiber_->params_.tilt == ChiangTilt::Outgoing;
+    Channels sum{};
+    double density = 0;
+    for (int p = 0; p < 4; ++p) {
+        const double azimuthal =
+            p < 3 ? fiber_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
+        const double w = weight_[std::size_t(p)];
+        // tilted_longitudinal is the cone's density where the tilt is on θ_o, and for p = 3.
+        const bool shared = cones_tilted || p == kLobeResidual;
+        const double cone_density = (w > 0 || shared) ? cone(p).density(i.sin, i.cos) : 0.0;
+        const double weight = (shared ? cone_density : longitudinal(p, i.sin, i.cos)) * azimuthal;
+        for (int c = 0; c < 3; ++c) sum[std::size_t(c)] += a_[std::size_t(p)][std::size_t(c)] * weight;
+        if (w > 0) {
+            double term = w * cone_density;
+            term *= azimuthal;
+            density += term;
+        }
+    }
+    pdf = float(density);
+    return to_rgb(sum);
+}
+
+Vec3 ChiangPoint::draw(float u0, float u1, float u2, int &lobe) const {
     // Lobe from u2; what is left of u2 inside the chosen lobe's interval is reused for M_p.
     int last = 3;
     while (last > 0 && weight_[std::size_t(last)] <= 0) --last;
@@ -363,14 +388,24 @@ std::optional<DirectionSample> ChiangPoint::sample(float u0, float u1, float u2)
     int p = 0;
     while (p < last && u >= weight_[std::size_t(p)]) u -= weight_[std::size_t(p++)];
     const double u_longitudinal = std::clamp(u / weight_[std::size_t(p)], 0.0, 1.0);
-
     const double sin_theta_i = off_axis(float(cone(p).sample(u_longitudinal, u1)));
     const double phi = p < 3 ? shift_[std::size_t(p)] + fiber_->azimuthal_.sample(u0) : kTwoPi * double(u0);
+    lobe = p;
+    return direction(sin_theta_i, cos_from_sin(sin_theta_i), phi);
+}
 
+std::optional<DirectionSample> ChiangPoint::sample(float u0, float u1, float u2) const {
     DirectionSample result;
-    result.wi = direction(sin_theta_i, cos_from_sin(sin_theta_i), phi);
-    result.lobe = p;
+    result.wi = draw(u0, u1, u2, result.lobe);
     result.pdf = pdf(result.wi);
+    if (!(result.pdf > 0.0f) || !std::isfinite(result.pdf)) return std::nullopt;
+    return result;
+}
+
+std::optional<DirectionSample> ChiangPoint::sample_with_f(float u0, float u1, float u2, Rgb &f) const {
+    DirectionSample result;
+    result.wi = draw(u0, u1, u2, result.lobe);
+    f = f_and_pdf(result.wi, result.pdf);
     if (!(result.pdf > 0.0f) || !std::isfinite(result.pdf)) return std::nullopt;
     return result;
 }

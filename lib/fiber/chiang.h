@@ -164,6 +164,11 @@ class ChiangPoint final : public FiberPoint {
     std::optional<DirectionSample> sample(float u0, float u1, float u2) const;
     /// Its density per steradian: Σ_p w_p M_p(θ_i | cone_p) N_p(φ − Φ_p).
     float pdf(Vec3 wi) const;
+    /// f(wi) and pdf(wi) in one pass (the same values): ω_i is resolved once, N_p is shared,
+    /// and so is M_p where the tilt is on θ_o.
+    Rgb f_and_pdf(Vec3 wi, float &pdf) const;
+    /// sample() with f·|cos θ_i| at the drawn direction (f_and_pdf's).
+    std::optional<DirectionSample> sample_with_f(float u0, float u1, float u2, Rgb &f) const;
 
     /// A_p (p in [0, 3]).
     Rgb attenuation(int p) const;
@@ -183,6 +188,8 @@ class ChiangPoint final : public FiberPoint {
 
   private:
     double longitudinal(int p, double sin_i, double cos_i) const;
+    // The analytic sampler's direction for (u0, u1, u2) and the lobe it came from.
+    Vec3 draw(float u0, float u1, float u2, int &lobe) const;
 
     const ChiangFiber *fiber_;
     chiang::SinCos o_;

@@ -525,10 +525,25 @@ TEST(ChiangNearField, MatchesTheClosedFormModel) {
             EXPECT_NEAR(pdf, reference_sampler_pdf(p, wi, wo, h), 2e-5 * pdf + 1e-30) << "sampler pdf, case " << i;
             Rgb lobes;
             for (int lobe = 0; lobe < 4; ++lobe) lobes += fiber.at({wo, h}).lobe_f(lobe, wi);
+            // The one-pass evaluation a light sample uses, against the same references.
+            float fused_pdf = -1.0f;
+            const Rgb fused = fiber.at({wo, h}).f_and_pdf(wi, fused_pdf);
+            EXPECT_NEAR(fused_pdf, reference_sampler_pdf(p, wi, wo, h), 2e-5 * pdf + 1e-30) << "fused pdf, case " << i;
             for (int c = 0; c < 3; ++c) {
                 EXPECT_NEAR(actual[c], expected[c], 2e-5 * expected[c] + 1e-30) << "case " << i;
+                EXPECT_NEAR(fused[c], expected[c], 2e-5 * expected[c] + 1e-30) << "fused f, case " << i;
                 EXPECT_NEAR(lobes[c], actual[c], 1e-6 * actual[c] + 1e-30);
             }
+            // sample_with_f: the drawn direction's f and density, by the references.
+            Rgb sampled_f;
+            const auto sample = fiber.at({wo, h}).sample_with_f(float(unit(rng)), float(unit(rng)),
+                                                                  float(unit(rng)), sampled_f);
+            ASSERT_TRUE(sample.has_value());
+            const double sample_pdf = reference_sampler_pdf(p, sample->wi, wo, h);
+            EXPECT_NEAR(sample->pdf, sample_pdf, 2e-5 * sample_pdf) << "sample_with_f pdf, case " << i;
+            const Rgb sample_f = reference_f_cos(p, sample->wi, wo, h);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(sampled_f[c], sample_f[c], 2e-5 * sample_f[c] + 1e-30) << "sample_with_f f, case " << i;
         }
     }
     EXPECT_EQ(make_fiber({}).at({{0, 1, 0}, 0}).lobe_f(4, {1, 0, 0}).r, 0.0f);

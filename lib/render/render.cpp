@@ -76,9 +76,7 @@ class Bsdf {
     // f·|cos θ_i| and the density with which sample() draws wi.
     Rgb eval(Vec3 wi, float &pdf) const {
         if (hair_) {
-            const Vec3 wi_local = frame_.to_local(wi);
-            pdf = hair_->pdf(wi_local);
-            return hair_->f(wi_local);
+            return hair_->f_and_pdf(frame_.to_local(wi), pdf);
         }
         const float c = dot(n_, wi);
         if (!(c > 0.0f)) {

@@ -11,6 +11,14 @@ class AnalyticPoint final : public SamplerPoint {
         return fiber_->sample(u0, u1, u2);
     }
     float pdf(Vec3 wi) const override { return fiber_->pdf(wi); }
+    // `fiber` is fiber_ (HairBsdf pairs a sampler point with its own model's point).
+    Rgb f_and_pdf(Vec3 wi, const FiberPoint *, float &pdf) const override {
+        return fiber_->f_and_pdf(wi, pdf);
+    }
+    std::optional<DirectionSample> sample_with_f(float u0, float u1, float u2, const FiberPoint *,
+                                                 Rgb &f) const override {
+        return fiber_->sample_with_f(u0, u1, u2, f);
+    }
 
   private:
     const ChiangPoint *fiber_;

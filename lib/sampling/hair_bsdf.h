@@ -28,11 +28,15 @@ class HairBsdf {
     Rgb f(Vec3 wi) const { return fiber_ ? fiber_->f(wi) : Rgb{}; }
     /// The density sample() draws from.
     float pdf(Vec3 wi) const { return sampler_->pdf(wi); }
+    /// f(wi) and pdf(wi) together (what a light sample needs), computed in one pass where the
+    /// sampler shares work with the fiber model.
+    Rgb f_and_pdf(Vec3 wi, float &pdf) const { return sampler_->f_and_pdf(wi, fiber_, pdf); }
     /// A direction with its density and f; nullopt when none is produced.
     std::optional<BsdfSample> sample(float u0, float u1, float u2) const {
-        const std::optional<DirectionSample> s = sampler_->sample(u0, u1, u2);
+        Rgb f;
+        const std::optional<DirectionSample> s = sampler_->sample_with_f(u0, u1, u2, fiber_, f);
         if (!s) return std::nullopt;
-        return BsdfSample{s->wi, f(s->wi), s->pdf, s->lobe};
+        return BsdfSample{s->wi, f, s->pdf, s->lobe};
     }
 
   private:

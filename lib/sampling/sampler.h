@@ -20,6 +20,20 @@ class SamplerPoint {
     /// The solid-angle density with which sample() produces ω_i.
     virtual float pdf(Vec3 wi) const = 0;
 
+    /// `fiber`'s f·|cos θ_i| (zero when null) and pdf(wi), at one ω_i. A sampler that shares
+    /// work with its model's f overrides this; the values are the same.
+    virtual Rgb f_and_pdf(Vec3 wi, const FiberPoint *fiber, float &pdf) const {
+        pdf = this->pdf(wi);
+        return fiber ? fiber->f(wi) : Rgb{};
+    }
+    /// sample() and `fiber`'s f·|cos θ_i| at the drawn direction (zero when null).
+    virtual std::optional<DirectionSample> sample_with_f(float u0, float u1, float u2,
+                                                         const FiberPoint *fiber, Rgb &f) const {
+        std::optional<DirectionSample> s = sample(u0, u1, u2);
+        if (s) f = fiber ? fiber->f(s->wi) : Rgb{};
+        return s;
+    }
+
   protected:
     SamplerPoint() = default;
     SamplerPoint(const SamplerPoint &) = default;
