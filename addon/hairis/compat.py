@@ -12,7 +12,11 @@ what the running Blender has, never from socket indices), so the other modules r
   :func:`uses_nodes`;
 - the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang);
 - a render pass's ``rect.foreach_set``: (pixels, 4) rows in 3.4, a flat float buffer in 4.5+:
-  :func:`set_pass_pixels`.
+  :func:`set_pass_pixels`;
+- how Cycles converts lights (``hairis_scene_add_light``'s ``cycles`` option): as 3.4 before
+  4.0, as 4.5 from 4.0 on (area lights 4/π brighter, suns a cone of constant radiance, spots
+  without 3.4's cosine); point and spot lights are spheres in 4.0 and disks with Soft Falloff
+  (``use_soft_falloff``, default on) from 4.1: :func:`cycles_lights`, :func:`soft_falloff`.
 """
 
 import bpy
@@ -108,3 +112,24 @@ def set_pass_pixels(render_pass, rgba):
         render_pass.rect.foreach_set(pixels.reshape(-1))
     except (TypeError, ValueError):
         render_pass.rect.foreach_set(pixels.reshape(-1, 4))
+
+
+CYCLES_4_LIGHTS = (4, 0, 0)
+"""From 4.0 Cycles converts lights as ``cycles=4.5`` says (unchanged up to 5.0)."""
+
+SOFT_FALLOFF = (4, 1, 0)
+"""Point and spot lights have Soft Falloff from 4.1; 4.0 always made them spheres."""
+
+
+def cycles_lights(version=None):
+    """The light conversion ('3.4' or '4.5') of the running Blender's Cycles."""
+    return "4.5" if tuple(version or running_version()) >= CYCLES_4_LIGHTS else "3.4"
+
+
+def soft_falloff(light, version=None):
+    """A point or spot light's Soft Falloff: its ``use_soft_falloff`` from 4.1, off (a sphere)
+    in 4.0, on (the disk, Cycles 3.4's only shape) before."""
+    version = tuple(version or running_version())
+    if CYCLES_4_LIGHTS <= version < SOFT_FALLOFF:
+        return False
+    return bool(getattr(light, "use_soft_falloff", True))

@@ -58,6 +58,27 @@ def camera_options(camera):
             "width": int(camera.width), "height": int(camera.height)}
 
 
+def light_options(light):
+    """The C API's light options from :class:`export.LightData`."""
+    values = {"type": light.kind.lower(), "color": light.color, "cycles": light.cycles}
+    if light.kind == "SUN":
+        values.update(direction=light.direction, strength=float(light.strength),
+                      angle=float(light.angle))
+    elif light.kind == "POINT":
+        values.update(position=light.position, power=float(light.strength),
+                      radius=float(light.radius), soft_falloff=bool(light.soft_falloff))
+    elif light.kind == "SPOT":
+        values.update(matrix=np.asarray(light.matrix, np.float64).reshape(-1),
+                      power=float(light.strength), radius=float(light.radius),
+                      spot_size=float(light.spot_size), spot_blend=float(light.spot_blend),
+                      soft_falloff=bool(light.soft_falloff))
+    else:
+        values.update(matrix=np.asarray(light.matrix, np.float64).reshape(-1),
+                      shape=str(light.shape).lower(), size=float(light.size_x),
+                      size_y=float(light.size_y), power=float(light.strength))
+    return values
+
+
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``."""
     return {"samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
@@ -92,14 +113,14 @@ def build_native_scene(library, data, hair_tables):
         for mesh in data.meshes:
             scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
         for light in data.lights:
-            if light.kind == "SUN":
-                scene.add_sun(light.direction, light.color, light.strength, light.angle)
-            elif light.kind == "POINT":
-                scene.add_point_light(light.position, light.color, light.strength, light.radius)
-            elif light.kind == "AREA":
-                scene.add_area_light(light.matrix, light.shape, light.size_x, light.size_y,
-                                     light.color, light.strength)
-        scene.set_world(data.world_color, data.world_strength)
+            scene.add_light(light_options(light))
+        environment = data.world_environment
+        if environment is None:
+            scene.set_world(data.world_color, data.world_strength)
+        elif environment.path is not None:
+            scene.set_world_options(dict(environment.options(), image=environment.path))
+        else:
+            scene.set_world_pixels(environment.options(), environment.pixels)
         scene.set_camera(camera_options(data.camera))
     except BaseException:
         scene.close()

@@ -18,6 +18,7 @@ Rules follow Cycles 3.4 (``intern/cycles/blender/curves.cpp``, ``object.cpp``, `
 """
 
 import math
+import os
 from dataclasses import dataclass, field
 
 import bpy
@@ -138,7 +139,7 @@ class MeshData:
 
 @dataclass
 class LightData:
-    """A light: ``kind`` 'SUN', 'POINT' or 'AREA'; unused fields keep their defaults."""
+    """A light: ``kind`` 'SUN', 'POINT', 'SPOT' or 'AREA'; unused fields keep their defaults."""
 
     name: str
     kind: str
@@ -150,10 +151,49 @@ class LightData:
     position: tuple = (0.0, 0.0, 0.0)
     radius: float = 0.0
     matrix: np.ndarray = None
-    """Row-major 4×4 light-to-world (area lights)."""
+    """Row-major 4×4 light-to-world (spot and area lights)."""
     shape: str = "SQUARE"
     size_x: float = 0.0
     size_y: float = 0.0
+    spot_size: float = math.radians(45.0)
+    spot_blend: float = 0.15
+    soft_falloff: bool = True
+    """Blender 4.1+'s Soft Falloff of point and spot lights (always a disk before)."""
+    cycles: str = "3.4"
+    """The Cycles whose light conversion this Blender's Cycles uses (compat.CYCLES_LIGHTS)."""
+
+
+@dataclass
+class EnvironmentData:
+    """A world whose Background Color is an Environment Texture (through a Mapping node)."""
+
+    image_name: str
+    path: str = None
+    """An image file the library reads, or None when ``pixels`` hold the image."""
+    pixels: np.ndarray = None
+    """(height, width, channels) floats, bottom row first, for packed or generated images."""
+    color_space: str = "linear"
+    """'linear' or 'srgb' (the image's colour space)."""
+    matrix: np.ndarray = None
+    """Row-major 4×4 world → texture map before the Mapping (Texture Coordinate Object)."""
+    mapping: str = "point"
+    rotation: tuple = (0.0, 0.0, 0.0)
+    scale: tuple = (1.0, 1.0, 1.0)
+    strength: float = 1.0
+    sampling: str = "auto"
+    """World > Settings > Sampling: 'auto', 'manual' or 'none'."""
+    map_resolution: int = 1024
+
+    def options(self):
+        """The world options of hairis_render.h (without the image or pixels)."""
+        values = {"strength": float(self.strength), "color_space": self.color_space,
+                  "mapping": self.mapping, "rotation": self.rotation, "scale": self.scale,
+                  "sampling": self.sampling}
+        if self.matrix is not None:
+            values["matrix"] = np.asarray(self.matrix, np.float64).reshape(-1)
+        if self.sampling == "manual":
+            values["map_resolution"] = int(self.map_resolution)
+        return values
 
 
 @dataclass
@@ -178,6 +218,8 @@ class SceneData:
     lights: list = field(default_factory=list)
     world_color: tuple = (0.0, 0.0, 0.0)
     world_strength: float = 0.0
+    world_environment: EnvironmentData = None
+    """Set when the world is an Environment Texture (then world_color is not used)."""
     camera: CameraData = None
     warnings: list = field(default_factory=list)
 
@@ -441,6 +483,163 @@ def read_surface_material(material):
     return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
 
 
+# ---- Environment Texture worlds -------------------------------------------------------------
+
+ENVIRONMENT_NODE_IDNAME = "ShaderNodeTexEnvironment"
+MAPPING_TYPES = {"POINT": "point", "TEXTURE": "texture", "VECTOR": "vector", "NORMAL": "normal"}
+LINEAR_COLOR_SPACES = {"Linear", "Linear Rec.709", "Non-Color", "Raw", "Linear BT.709"}
+"""Image colour spaces whose values are scene-linear Rec.709 (or data) as stored."""
+SRGB_COLOR_SPACES = {"sRGB", "sRGB 2.1"}
+SAMPLING_METHODS = {"AUTOMATIC": "auto", "MANUAL": "manual", "NONE": "none"}
+"""Cycles' World > Settings > Sampling (``world.cycles.sampling_method``)."""
+
+
+def _node_label(node):
+    return "%s %r" % (node.bl_label or node.bl_idname, node.name)
+
+
+def _environment_image(world, node, image, warn):
+    """(path, pixels, colour space) for an Environment Texture's image, or None."""
+    name = image.colorspace_settings.name
+    if name in SRGB_COLOR_SPACES:
+        color_space = "srgb"
+    else:
+        color_space = "linear"
+        if name not in LINEAR_COLOR_SPACES:
+            warn("world %r: image %r has the colour space %r, which hairis does not convert; it "
+                 "reads the values as linear Rec.709" % (world.name, image.name, name))
+    if image.source not in {"FILE", "GENERATED"}:
+        warn("world %r: %s: %s images are not supported; the world is rendered with the "
+             "Background's colour" % (world.name, _node_label(node), image.source.lower()))
+        return None
+    path = None
+    if image.source == "FILE" and image.packed_file is None and not image.is_dirty:
+        candidate = bpy.path.abspath(image.filepath, library=image.library)
+        if candidate and os.path.isfile(candidate) and ";" not in candidate \
+                and candidate == candidate.strip():
+            path = candidate
+    if path is not None:
+        return path, None, color_space
+    # Packed, generated, edited in memory, or a path the C API cannot take: the pixels.
+    width, height = (int(v) for v in image.size)
+    channels = int(image.channels)
+    if width < 1 or height < 1 or channels < 1:
+        warn("world %r: image %r has no pixels (a missing file?); the world is rendered with "
+             "the Background's colour" % (world.name, image.name))
+        return None
+    pixels = np.empty(width * height * channels, np.float32)
+    image.pixels.foreach_get(pixels)
+    return None, pixels.reshape(height, width, channels), color_space
+
+
+def _mapping_vector(world, node, warn):
+    """The Mapping node's (type, rotation, scale), or None when it cannot be followed."""
+    kind = MAPPING_TYPES.get(getattr(node, "vector_type", "POINT"))
+    if kind is None:
+        warn("world %r: %s has an unknown type %r; ignored"
+             % (world.name, _node_label(node), node.vector_type))
+        return None
+    values = {}
+    for name in ("Location", "Rotation", "Scale"):
+        socket = _input(node, name)
+        if socket is None:
+            values[name] = (0.0, 0.0, 0.0) if name != "Scale" else (1.0, 1.0, 1.0)
+            continue
+        if socket.is_linked:
+            warn("world %r: input %r of %s is linked; hairis uses its unlinked value"
+                 % (world.name, name, _node_label(node)))
+        values[name] = tuple(float(v) for v in tuple(socket.default_value)[:3])
+    if kind in {"point", "texture"} and any(v != 0.0 for v in values["Location"]):
+        warn("world %r: the Location of %s is not supported (a direction is not moved); "
+             "hairis uses Location 0" % (world.name, _node_label(node)))
+    if any(v == 0.0 for v in values["Scale"]):
+        warn("world %r: %s has a zero Scale; hairis uses Scale 1" % (world.name, _node_label(node)))
+        values["Scale"] = (1.0, 1.0, 1.0)
+    return kind, values["Rotation"], values["Scale"]
+
+
+def _coordinates(world, vector_socket, warn):
+    """The world → texture matrix of what feeds a Vector input: a Texture Coordinate's
+    Generated (identity) or Object output, or nothing; None for anything else."""
+    node, socket = _follow_link(vector_socket)
+    if node is None:
+        return np.eye(4)
+    if node.bl_idname != "ShaderNodeTexCoord":
+        warn("world %r: %s feeds the texture's Vector and is not supported; hairis looks the "
+             "texture up with the ray direction" % (world.name, _node_label(node)))
+        return np.eye(4)
+    output = socket.identifier or socket.name
+    if output == "Generated":
+        return np.eye(4)
+    if output == "Object":
+        obj = getattr(node, "object", None)
+        if obj is None:
+            return np.eye(4)
+        matrix = _matrix(obj.matrix_world)
+        if np.any(matrix[:3, 3] != 0.0):
+            warn("world %r: the Texture Coordinate's object %r is not at the origin; hairis "
+                 "uses its rotation and scale alone" % (world.name, obj.name))
+        linear = matrix[:3, :3]
+        if abs(np.linalg.det(linear)) == 0.0:
+            warn("world %r: the Texture Coordinate's object %r has a zero scale; ignored"
+                 % (world.name, obj.name))
+            return np.eye(4)
+        out = np.eye(4)
+        out[:3, :3] = np.linalg.inv(linear)
+        return out
+    warn("world %r: the Texture Coordinate's %s output is not supported in the world; hairis "
+         "uses Generated (the ray direction)" % (world.name, socket.name))
+    return np.eye(4)
+
+
+def read_environment(world, color_socket, warn):
+    """The :class:`EnvironmentData` of a Background Color fed by an Environment Texture
+    (optionally through a Mapping node, fed by a Texture Coordinate or nothing), or None
+    with a warning naming the node that is not supported."""
+    node, _ = _follow_link(color_socket)
+    if node is None:
+        return None
+    if node.bl_idname != ENVIRONMENT_NODE_IDNAME:
+        warn("world %r: %s feeds the Background's Color and is not supported (hairis reads an "
+             "Environment Texture, optionally through a Mapping node); it uses the Color's "
+             "unlinked value" % (world.name, _node_label(node)))
+        return None
+    if getattr(node, "projection", "EQUIRECTANGULAR") != "EQUIRECTANGULAR":
+        warn("world %r: %s: the %s projection is not supported; the world is rendered with the "
+             "Background's colour" % (world.name, _node_label(node), node.projection.lower()))
+        return None
+    if getattr(node, "interpolation", "Linear") != "Linear":
+        warn("world %r: %s: %s interpolation is not supported; hairis interpolates linearly"
+             % (world.name, _node_label(node), node.interpolation))
+    image = node.image
+    if image is None:
+        warn("world %r: %s has no image; the world is rendered with the Background's colour"
+             % (world.name, _node_label(node)))
+        return None
+    found = _environment_image(world, node, image, warn)
+    if found is None:
+        return None
+    path, pixels, color_space = found
+    data = EnvironmentData(image_name=image.name, path=path, pixels=pixels,
+                           color_space=color_space)
+    vector = _input(node, "Vector")
+    source, source_socket = _follow_link(vector) if vector is not None else (None, None)
+    if source is not None and source.bl_idname == "ShaderNodeMapping":
+        mapping = _mapping_vector(world, source, warn)
+        if mapping is not None:
+            data.mapping, data.rotation, data.scale = mapping
+        inner = _input(source, "Vector")
+        data.matrix = _coordinates(world, inner, warn) if inner is not None else np.eye(4)
+    elif vector is not None:
+        data.matrix = _coordinates(world, vector, warn)
+    cycles = getattr(world, "cycles", None)
+    method = getattr(cycles, "sampling_method", "AUTOMATIC") if cycles is not None else "AUTOMATIC"
+    data.sampling = SAMPLING_METHODS.get(method, "auto")
+    if data.sampling == "manual":
+        data.map_resolution = int(getattr(cycles, "sample_map_resolution", 1024))
+    return data
+
+
 # ---- The exporter ----------------------------------------------------------------------------
 
 class _Exporter:
@@ -572,7 +771,8 @@ class _Exporter:
                                       width=width, height=height)
 
     def export_world(self):
-        """Background colour·strength of a Background node, or ``world.color``."""
+        """Background colour·strength of a Background node, or ``world.color``, or an
+        Environment Texture feeding the Background's Color (:func:`read_environment`)."""
         world = self.scene.world
         if world is None:
             return
@@ -593,20 +793,31 @@ class _Exporter:
             return
         color = _input(node, "Color")
         strength = _input(node, "Strength")
-        for socket in (color, strength):
-            if socket is not None and socket.is_linked:
-                self.data.warn("world %r: input %r of the Background is linked (environment "
-                               "textures are not supported); hairis uses its unlinked value"
-                               % (world.name, socket.name))
+        if strength is not None and strength.is_linked:
+            self.data.warn("world %r: input 'Strength' of the Background is linked; hairis uses "
+                           "its unlinked value" % world.name)
         self.data.world_color = _rgb(color.default_value) if color else (0.0, 0.0, 0.0)
         self.data.world_strength = float(strength.default_value) if strength else 1.0
+        if color is not None and color.is_linked:
+            environment = read_environment(world, color, self.data.warn)
+            if environment is not None:
+                environment.strength = self.data.world_strength
+                self.data.world_environment = environment
 
     def export_light(self, obj, matrix):
-        """Sun, point and area lights; spot lights are reported and skipped."""
+        """Sun, point, spot and area lights in Blender's units (Cycles' sync_light)."""
         light = obj.data
         color = _rgb(light.color)
+        if getattr(light, "use_temperature", False):  # Blender 5.0+: colour × blackbody
+            color = tuple(c * t for c, t in zip(color, _rgb(light.temperature_color)))
+        energy = float(light.energy) * 2.0 ** float(getattr(light, "exposure", 0.0))
+        if not getattr(light, "normalize", True):
+            self.data.warn("light %r: Normalize off is not supported; hairis normalizes its "
+                           "power by its size" % obj.name)
         if compat.uses_nodes(light):
             self.data.warn("light %r: light node trees are ignored" % obj.name)
+        version = compat.cycles_lights()
+        soft_falloff = compat.soft_falloff(light)
         kind = light.type
         if kind == "SUN":
             direction = matrix[:3, 2]
@@ -615,19 +826,37 @@ class _Exporter:
                 self.data.warn("light %r has a zero scale; skipped" % obj.name)
                 return
             self.data.lights.append(LightData(
-                name=obj.name, kind="SUN", color=color, strength=float(light.energy),
-                direction=tuple(float(v) for v in direction / norm), angle=float(light.angle)))
+                name=obj.name, kind="SUN", color=color, strength=energy,
+                direction=tuple(float(v) for v in direction / norm), angle=float(light.angle),
+                cycles=version))
         elif kind == "POINT":
             self.data.lights.append(LightData(
-                name=obj.name, kind="POINT", color=color, strength=float(light.energy),
+                name=obj.name, kind="POINT", color=color, strength=energy,
                 position=tuple(float(v) for v in matrix[:3, 3]),
-                radius=float(light.shadow_soft_size)))
+                radius=float(light.shadow_soft_size), soft_falloff=soft_falloff,
+                cycles=version))
+        elif kind == "SPOT":
+            if np.linalg.norm(matrix[:3, 2]) == 0:
+                self.data.warn("light %r has a zero scale; skipped" % obj.name)
+                return
+            if version == "4.5" and abs(np.linalg.det(matrix[:3, :3])) == 0:
+                self.data.warn("light %r has a singular matrix; skipped" % obj.name)
+                return
+            self.data.lights.append(LightData(
+                name=obj.name, kind="SPOT", color=color, strength=energy,
+                position=tuple(float(v) for v in matrix[:3, 3]),
+                radius=float(light.shadow_soft_size), matrix=matrix.astype(np.float32),
+                spot_size=float(light.spot_size), spot_blend=float(light.spot_blend),
+                soft_falloff=soft_falloff, cycles=version))
         elif kind == "AREA":
             size_y = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
+            if not math.isclose(float(getattr(light, "spread", math.pi)), math.pi, rel_tol=1e-6):
+                self.data.warn("light %r: Spread is not supported; hairis emits over the whole "
+                               "hemisphere (Spread 180°)" % obj.name)
             self.data.lights.append(LightData(
-                name=obj.name, kind="AREA", color=color, strength=float(light.energy),
+                name=obj.name, kind="AREA", color=color, strength=energy,
                 matrix=matrix.astype(np.float32), shape=light.shape, size_x=float(light.size),
-                size_y=float(size_y)))
+                size_y=float(size_y), cycles=version))
         else:
             self.data.warn("light %r: %s lights are not supported; skipped"
                            % (obj.name, kind.lower()))

@@ -100,6 +100,8 @@ PROTOTYPES = {
                                       POINTER(c_int32)]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, _F, c_size_t, c_size_t,
+                                              c_int]),
     "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
     "hairis_render": (c_int, [c_void_p, c_char_p, _F, PROGRESS_FN, c_void_p]),
     "hairis_last_render_stats": (c_char_p, []),
@@ -670,7 +672,7 @@ class Scene(_Handle):
         self._library._status("hairis_scene_add_mesh", status)
 
     def add_light(self, values):
-        """Adds a light from light options (hairis_render.h: type sun, point or area)."""
+        """Adds a light from light options (hairis_render.h: type sun, point, spot or area)."""
         status = self._library.raw.hairis_scene_add_light(self, options(values).encode())
         self._library._status("hairis_scene_add_light", status)
 
@@ -690,11 +692,37 @@ class Scene(_Handle):
                         "size": float(size_x), "size_y": float(size_y), "color": color,
                         "power": float(power)})
 
+    def add_spot_light(self, light_to_world, color, power, radius, spot_size, spot_blend):
+        """A spot light: row-major 4×4 object matrix (it shines along its −Z), power in W,
+        radius (shadow_soft_size) in m, spot_size (full cone angle, radians), spot_blend."""
+        self.add_light({"type": "spot", "matrix": light_to_world, "color": color,
+                        "power": float(power), "radius": float(radius),
+                        "spot_size": float(spot_size), "spot_blend": float(spot_blend)})
+
     def set_world(self, color, strength):
         """A constant background radiance colour·strength."""
-        text = options({"color": color, "strength": float(strength)})
-        status = self._library.raw.hairis_scene_set_world(self, text.encode())
+        self.set_world_options({"color": color, "strength": float(strength)})
+
+    def set_world_options(self, values):
+        """The world from world options (hairis_render.h: a constant, or image=<path> with
+        the environment's mapping and sampling)."""
+        status = self._library.raw.hairis_scene_set_world(self, options(values).encode())
         self._library._status("hairis_scene_set_world", status)
+
+    def set_world_pixels(self, values, pixels):
+        """An environment world from an image as an array: ``pixels`` (height, width,
+        channels) floats, bottom row first (Blender's ``Image.pixels`` reshaped), with world
+        options (no image; color_space 'linear' or 'srgb')."""
+        pixels = np.ascontiguousarray(pixels, np.float32)
+        if pixels.ndim == 2:
+            pixels = pixels[:, :, None]
+        if pixels.ndim != 3:
+            raise ValueError("pixels must be (height, width, channels), got shape %s"
+                             % (pixels.shape,))
+        height, width, channels = pixels.shape
+        status = self._library.raw.hairis_scene_set_world_pixels(
+            self, options(values).encode(), _ptr(pixels, c_float), width, height, channels)
+        self._library._status("hairis_scene_set_world_pixels", status)
 
     def set_camera(self, camera):
         """Sets the camera from camera options (a dict: matrix, orthographic, frame, width,

@@ -24,6 +24,15 @@ inline constexpr double kHugeOption = 3.40282347e+38;
 static_assert(float(kHugeOption) == std::numeric_limits<float>::max());
 
 // Option names of the core's lights (found by describe()'s argument-dependent lookup).
+
+/// "cycles=3.4|4.5": which Cycles a light follows (lights.h).
+template <typename Fields>
+void describe_version(Fields &f, CyclesVersion &v) {
+    int index = int(v);
+    f.choice("cycles", index, {"3.4", "4.5"});
+    v = CyclesVersion(index);
+}
+
 /// "type=sun": direction towards the sun, W/m², angular diameter (radians).
 template <typename Fields>
 void describe(Fields &f, SunLight &o) {
@@ -31,6 +40,7 @@ void describe(Fields &f, SunLight &o) {
     f.field("color", o.color, 0.0, kHugeOption);
     f.field("strength", o.strength, 0.0, kHugeOption);
     f.field("angle", o.angle, 0.0, std::nextafter(kPi, 0.0));
+    describe_version(f, o.cycles);
 }
 
 /// "type=point": power in W, radius in metres.
@@ -40,13 +50,8 @@ void describe(Fields &f, PointLight &o) {
     f.field("color", o.color, 0.0, kHugeOption);
     f.field("power", o.power, 0.0, kHugeOption);
     f.field("radius", o.radius, 0.0, kHugeOption);
-}
-
-/// The world: a constant background of radiance color × strength.
-template <typename Fields>
-void describe(Fields &f, WorldLight &o) {
-    f.field("color", o.color, 0.0, kHugeOption);
-    f.field("strength", o.strength, 0.0, kHugeOption);
+    describe_version(f, o.cycles);
+    f.field("soft_falloff", o.soft_falloff);
 }
 
 }  // namespace hairis
@@ -54,6 +59,61 @@ void describe(Fields &f, WorldLight &o) {
 namespace hairis::capi {
 
 inline constexpr double kHuge = kHugeOption;
+
+/// "type=spot": the light object's matrix (row-major, with its scale), Blender's spot_size
+/// (full cone angle, radians) and spot_blend, power in W, radius (shadow_soft_size) in metres.
+struct SpotOptions {
+    float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    Rgb color{1.0f};
+    float power = 10.0f;
+    float radius = 0.0f;
+    float spot_size = float(kPi / 4.0);
+    float spot_blend = 0.15f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
+    bool soft_falloff = true;
+};
+template <typename Fields>
+void describe(Fields &f, SpotOptions &o) {
+    float *matrix = o.matrix;
+    f.field("matrix", matrix, 16, -kHuge, kHuge);
+    f.field("color", o.color, 0.0, kHuge);
+    f.field("power", o.power, 0.0, kHuge);
+    f.field("radius", o.radius, 0.0, kHuge);
+    f.field("spot_size", o.spot_size, kPi / 180.0, kPi);
+    f.field("spot_blend", o.spot_blend, 0.0, 1.0);
+    describe_version(f, o.cycles);
+    f.field("soft_falloff", o.soft_falloff);
+}
+
+/// The world: a constant background (color × strength), or an Environment Texture read from
+/// `image` (or handed over by hairis_scene_set_world_pixels) through a Mapping node, times
+/// color and strength, light-sampled as Cycles' World > Settings > Sampling says.
+struct WorldOptions {
+    Rgb color{0.0f};  ///< the constant's colour; with an environment the multiplier (default 1)
+    float strength = 1.0f;
+    std::string image;  ///< a file OpenImageIO reads (EXR, HDR, ...); empty: no environment
+    int color_space = 0;  ///< auto | linear | srgb (ImageColorSpace)
+    float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  ///< world → texture, before the Mapping
+    int mapping = 0;  ///< the Mapping node's type: point | texture | vector | normal
+    Vec3 rotation{0, 0, 0};
+    Vec3 scale{1, 1, 1};
+    int sampling = 0;  ///< auto | manual | none
+    int map_resolution = 1024;  ///< Manual: map_resolution × map_resolution/2
+};
+template <typename Fields>
+void describe(Fields &f, WorldOptions &o) {
+    float *matrix = o.matrix;
+    f.field("color", o.color, 0.0, kHuge);
+    f.field("strength", o.strength, 0.0, kHuge);
+    f.field("image", o.image);
+    f.choice("color_space", o.color_space, {"auto", "linear", "srgb"});
+    f.field("matrix", matrix, 16, -kHuge, kHuge);
+    f.choice("mapping", o.mapping, {"point", "texture", "vector", "normal"});
+    f.field("rotation", o.rotation);
+    f.field("scale", o.scale);
+    f.choice("sampling", o.sampling, {"auto", "manual", "none"});
+    f.field("map_resolution", o.map_resolution, 1, EnvironmentMap::kMaxMapWidth);
+}
 
 /// A hair material as the C API keeps it until a render: its fiber and, optionally, tables
 /// (shared with the hairis_tables they came from). The sampler is made by hairis_render from
@@ -83,6 +143,7 @@ struct AreaOptions {
     float size = 1.0f, size_y = 1.0f;
     Rgb color{1.0f};
     float power = 10.0f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
 };
 template <typename Fields>
 void describe(Fields &f, AreaOptions &o) {
@@ -93,6 +154,7 @@ void describe(Fields &f, AreaOptions &o) {
     f.field("size_y", o.size_y, 0.0, kHuge);
     f.field("color", o.color, 0.0, kHuge);
     f.field("power", o.power, 0.0, kHuge);
+    describe_version(f, o.cycles);
 }
 
 /// The camera as Blender describes it (Camera.view_frame, matrix_world, resolution, clip).

@@ -21,11 +21,12 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "diffuse") return "type=diffuse;" + write_options(DiffuseOptions{});
     if (kind == "sun") return "type=sun;" + write_options(SunLight{});
     if (kind == "point") return "type=point;" + write_options(PointLight{});
+    if (kind == "spot") return "type=spot;" + write_options(SpotOptions{});
     if (kind == "area") return "type=area;" + write_options(AreaOptions{});
-    if (kind == "world") return write_options(WorldLight{});
+    if (kind == "world") return write_options(WorldOptions{});
     if (kind == "camera") return write_options(CameraOptions{});
-    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, area, world, camera (got \"" +
-            kind + "\")");
+    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
+            "spot, area, world, camera (got \"" + kind + "\")");
 }
 
 }  // namespace

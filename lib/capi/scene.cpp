@@ -1,12 +1,16 @@
 // C API: building a render scene incrementally (materials, curves, meshes, lights, world,
 // camera). Every input is checked when it is added, so an error names the call and argument
 // that caused it; Scene::build (at render time) checks the whole again.
+#include <algorithm>
 #include <climits>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "capi_scene.h"
 #include "render/camera.h"
+#include "render/environment_image.h"
+#include "render/environment_map.h"
 #include "render/lights.h"
 
 namespace hairis::capi {
@@ -27,6 +31,64 @@ int add_material(hairis_scene &scene, SceneMaterial material) {
 }
 
 Vec3 vec3(const float *v) { return {v[0], v[1], v[2]}; }
+
+// The world of `o` around an environment image (already read): the Mapping and the matrix
+// composed into world_to_texture, the sampling settings, colour (default 1 with an image)
+// and strength; refusals name the option.
+WorldLight environment_world(const OptionReader &reader, const WorldOptions &o,
+                             EnvironmentImage image) {
+    MappingNode node;
+    node.type = MappingType(o.mapping);
+    node.rotation = o.rotation;
+    node.scale = o.scale;
+    Expected<Mat4> mapping = mapping_node_transform(node);
+    if (!mapping) invalid("world: " + mapping.error().message);
+    EnvironmentDesc desc;
+    desc.image = std::move(image);
+    desc.world_to_texture = mapping.value() * Mat4::from_row_major(o.matrix);
+    desc.strength = o.strength;
+    desc.color = reader.has("color") ? o.color : Rgb(1.0f);
+    if (o.sampling == 1) desc.map_width = o.map_resolution;  // manual: height = width / 2
+    Expected<EnvironmentMap> map = EnvironmentMap::create(std::move(desc));
+    if (!map) invalid("world: " + map.error().message);
+    WorldLight world;
+    world.environment = std::make_shared<const EnvironmentMap>(std::move(map).value());
+    world.light_sampled = o.sampling != 2;
+    return world;
+}
+
+// Reads world options; `pixels` says whether the image comes as an array (then `image` is
+// refused).
+OptionReader read_world_options(const char *options, WorldOptions &o, bool pixels) {
+    Expected<OptionReader> parsed = OptionReader::parse(options ? options : "", "world");
+    if (!parsed) invalid(parsed.error().message);
+    OptionReader reader = std::move(parsed).value();
+    describe(reader, o);
+    ok_or_invalid(reader.finish());
+    if (pixels && reader.has("image"))
+        invalid("world: image must not be given with pixels (the pixels are the image)");
+    // Environment settings other than their defaults mean nothing without an environment
+    // (hairis_defaults("world") itself reads back).
+    const WorldOptions d;
+    const bool same_matrix = std::equal(o.matrix, o.matrix + 16, d.matrix);
+    const std::pair<const char *, bool> changed[] = {
+        {"color_space", o.color_space != d.color_space},
+        {"matrix", !same_matrix},
+        {"mapping", o.mapping != d.mapping},
+        {"rotation", !(o.rotation.x == 0.0f && o.rotation.y == 0.0f && o.rotation.z == 0.0f)},
+        {"scale", !(o.scale.x == 1.0f && o.scale.y == 1.0f && o.scale.z == 1.0f)},
+        {"sampling", o.sampling != d.sampling},
+        {"map_resolution", o.map_resolution != d.map_resolution}};
+    if (!pixels && o.image.empty())
+        for (const auto &[name, differs] : changed)
+            if (differs)
+                invalid(std::string("world: ") + name +
+                        " needs an environment (image=<path> or hairis_scene_set_world_pixels)");
+    if (o.map_resolution != d.map_resolution && o.sampling != 1)
+        invalid("world: map_resolution needs sampling=manual (auto follows the image's "
+                "resolution)");
+    return reader;
+}
 
 }  // namespace
 
@@ -172,14 +234,16 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
 HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_add_light", [&] {
         require(scene, "scene");
-        const std::string what = "light " + std::to_string(scene->desc.suns.size() + scene->desc.point_lights.size() +
-                                                           scene->desc.area_lights.size());
+        const std::string what =
+            "light " + std::to_string(scene->desc.suns.size() + scene->desc.point_lights.size() +
+                                      scene->desc.spot_lights.size() +
+                                      scene->desc.area_lights.size());
         Expected<OptionReader> parsed = OptionReader::parse(options ? options : "", what);
         if (!parsed) invalid(parsed.error().message);
         OptionReader &reader = parsed.value();
-        if (!reader.has("type")) invalid(what + ": type must be given (sun, point or area)");
+        if (!reader.has("type")) invalid(what + ": type must be given (sun, point, spot or area)");
         int type = 0;
-        reader.choice("type", type, {"sun", "point", "area"});
+        reader.choice("type", type, {"sun", "point", "area", "spot"});
         if (type == 0) {
             SunLight sun;
             describe(reader, sun);
@@ -191,7 +255,34 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
             PointLight point;
             describe(reader, point);
             ok_or_invalid(reader.finish());
+            if (point.cycles == CyclesVersion::V3_4 && !point.soft_falloff)
+                invalid(what + ": soft_falloff=0 (a sphere) needs cycles=4.5; Cycles 3.4 has "
+                               "only the disk");
             scene->desc.point_lights.push_back(point);
+        } else if (type == 3) {
+            SpotOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            SpotLight spot;
+            spot.light_to_world = Mat4::from_row_major(o.matrix);
+            if (!(length(spot.light_to_world.column(2)) > 0.0f))
+                invalid(what + ": matrix has a zero Z axis (column 2): the spot has no direction");
+            if (o.cycles == CyclesVersion::V3_4 && !o.soft_falloff)
+                invalid(what + ": soft_falloff=0 (a sphere) needs cycles=4.5; Cycles 3.4 has "
+                               "only the disk");
+            spot.color = o.color;
+            spot.power = o.power;
+            spot.radius = o.radius;
+            spot.spot_size = o.spot_size;
+            spot.spot_blend = o.spot_blend;
+            spot.cycles = o.cycles;
+            spot.soft_falloff = o.soft_falloff;
+            // Refused now rather than at render time (e.g. a singular matrix for 4.5).
+            LightsDesc check;
+            check.spots = {spot};
+            Expected<LightSet> checked = LightSet::build(check, {});
+            if (!checked) invalid(what + ": " + checked.error().message);
+            scene->desc.spot_lights.push_back(spot);
         } else {
             AreaOptions o;
             describe(reader, o);
@@ -205,6 +296,7 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
             light.size_y = o.size_y;
             light.color = o.color;
             light.power = o.power;
+            light.cycles = o.cycles;
             scene->desc.area_lights.push_back(light);
         }
         return HAIRIS_OK;
@@ -214,9 +306,46 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
 HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_set_world", [&] {
         require(scene, "scene");
-        WorldLight world;
-        read_options(options, "world", world);
-        scene->desc.world = world;
+        WorldOptions o;
+        const OptionReader reader = read_world_options(options, o, false);
+        if (o.image.empty()) {
+            WorldLight world;
+            world.color = o.color;
+            world.strength = o.strength;
+            scene->desc.world = world;
+            return HAIRIS_OK;
+        }
+        Expected<EnvironmentImage> image =
+            load_environment_image(o.image, ImageColorSpace(o.color_space));
+        if (!image) invalid("world: image: " + image.error().message);
+        scene->desc.world = environment_world(reader, o, std::move(image).value());
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *options,
+                                             const float *pixels, size_t width, size_t height,
+                                             int channels) {
+    return guard_status("hairis_scene_set_world_pixels", [&] {
+        require(scene, "scene");
+        WorldOptions o;
+        const OptionReader reader = read_world_options(options, o, true);
+        if (o.color_space == int(ImageColorSpace::Auto))
+            invalid("world: color_space must be linear or srgb with pixels (an array does not "
+                    "say what it holds)");
+        if (width < 1 || height < 1 || width > size_t(kMaxEnvironmentImageAxis) ||
+            height > size_t(kMaxEnvironmentImageAxis))
+            invalid("width and height must be in [1, " +
+                    std::to_string(kMaxEnvironmentImageAxis) + "] (got " +
+                    std::to_string(width) + " x " + std::to_string(height) + ")");
+        if (channels < 1 || channels > 4)
+            invalid("channels must be in [1, 4] (got " + std::to_string(channels) + ")");
+        const long long count = (long long)width * (long long)height * channels;
+        require_array(pixels, size_t(count), "pixels");
+        Expected<EnvironmentImage> image = EnvironmentImage::from_pixels(
+            pixels, count, int(width), int(height), channels, ImageColorSpace(o.color_space));
+        if (!image) invalid("world: pixels: " + image.error().message);
+        scene->desc.world = environment_world(reader, o, std::move(image).value());
         return HAIRIS_OK;
     });
 }

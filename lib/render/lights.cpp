@@ -26,6 +26,45 @@ Status check_position(const std::string &name, Vec3 p) {
                  std::to_string(p.y) + ", " + std::to_string(p.z) + "))"};
 }
 
+Status check_version(const std::string &name, CyclesVersion v, bool soft_falloff) {
+    if (v != CyclesVersion::V3_4 && v != CyclesVersion::V4_5)
+        return Error{name + ": cycles must be 3.4 or 4.5 (got " + std::to_string(int(v)) + ")"};
+    if (v == CyclesVersion::V3_4 && !soft_falloff)
+        return Error{name + ": soft_falloff = 0 (a sphere light) needs cycles = 4.5; Cycles 3.4 "
+                            "has only the disk"};
+    return std::nullopt;
+}
+
+// 1 − cos α for sin²α = s2, without cancellation.
+float one_minus_cos_from_sin2(float s2) { return s2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - s2))); }
+
+// A unit vector at angle acos(cos_theta) from the unit axis, at azimuth 2π·u.
+Vec3 cone_direction(Vec3 axis, float cos_theta, float u) {
+    Vec3 a, b;
+    orthonormal_basis(axis, a, b);
+    const float sin_theta = std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta));
+    const float phi = 2.0f * kPiF * u;
+    return safe_normalize(axis * cos_theta + (a * std::cos(phi) + b * std::sin(phi)) * sin_theta);
+}
+
+// The inverse of the 3×3 part of m; false when it is singular.
+bool invert_linear(const Mat4 &m, float out[3][3]) {
+    const double a[3][3] = {{m.m[0][0], m.m[0][1], m.m[0][2]},
+                            {m.m[1][0], m.m[1][1], m.m[1][2]},
+                            {m.m[2][0], m.m[2][1], m.m[2][2]}};
+    const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                       a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(std::isfinite(det) && det != 0.0)) return false;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) {
+            // Cofactor of (k, i) over det.
+            const int r0 = (k + 1) % 3, r1 = (k + 2) % 3, c0 = (i + 1) % 3, c1 = (i + 2) % 3;
+            out[i][k] = float((a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]) / det);
+        }
+    return true;
+}
+
 }  // namespace
 
 void concentric_disk(float u0, float u1, float &x, float &y) {
@@ -126,8 +165,9 @@ float area_light_area(const AreaLight &light) {
     return area;
 }
 
-Rgb area_radiance(Rgb color, float power, float area) {
-    return strength(color, power) * (0.25f / area);
+Rgb area_radiance(Rgb color, float power, float area, CyclesVersion version) {
+    const float factor = version == CyclesVersion::V4_5 ? float(kInvPi) : 0.25f;
+    return strength(color, power) * (factor / area);
 }
 
 float sun_invarea(float angle) {
@@ -141,6 +181,24 @@ Rgb sun_radiance(Rgb color, float strength_w_m2, float angle, float cos_theta) {
            (sun_invarea(angle) / (cos_theta * cos_theta * cos_theta));
 }
 
+Rgb sun_radiance_cycles45(Rgb color, float strength_w_m2, float angle) {
+    const float s = std::sin(0.5f * angle);
+    return strength(color, strength_w_m2) * (1.0f / (kPiF * s * s));
+}
+
+float spot_attenuation(float c, float cos_half, float smooth) {
+    if (!(c > cos_half)) return 0.0f;
+    const float t = c - cos_half;
+    return t < smooth && smooth != 0.0f ? c * smoothstep(t / smooth) : c;
+}
+
+float spot_attenuation_cycles45(float z, float cos_half, float smooth) {
+    if (!(z > cos_half)) return 0.0f;
+    if (smooth == 0.0f) return 1.0f;
+    const float f = (z - cos_half) / smooth;
+    return f >= 1.0f ? 1.0f : smoothstep(f);
+}
+
 }  // namespace cycles_light
 
 Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
@@ -148,6 +206,21 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
                                    const std::vector<AreaLight> &areas, const WorldLight &world,
                                    std::vector<EmissiveTriangle> emissive,
                                    std::vector<std::string> *warnings) {
+    LightsDesc lights;
+    lights.suns = suns;
+    lights.points = points;
+    lights.areas = areas;
+    lights.world = world;
+    return build(lights, std::move(emissive), warnings);
+}
+
+Expected<LightSet> LightSet::build(const LightsDesc &lights,
+                                   std::vector<EmissiveTriangle> emissive,
+                                   std::vector<std::string> *warnings) {
+    const std::vector<SunLight> &suns = lights.suns;
+    const std::vector<PointLight> &points = lights.points;
+    const std::vector<AreaLight> &areas = lights.areas;
+    const WorldLight &world = lights.world;
     LightSet set;
 
     for (std::size_t i = 0; i < suns.size(); ++i) {
@@ -161,14 +234,22 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
         if (!(s.angle >= 0.0f && s.angle < kPiF))
             return Error{name + ": angle must be in [0, pi) radians (got " +
                          std::to_string(s.angle) + ")"};
+        if (auto e = check_version(name, s.cycles, true)) return *e;
         if (s.strength == 0.0f || is_black(s.color)) continue;
         Lamp lamp;
         lamp.type = LampType::Sun;
+        lamp.cycles = s.cycles;
         lamp.value = cycles_light::strength(s.color, s.strength);
         lamp.direction = safe_normalize(s.to_sun);
         lamp.radius = std::tan(0.5f * s.angle);
         lamp.cos_half = std::cos(0.5f * s.angle);
         lamp.invarea = cycles_light::sun_invarea(s.angle);
+        if (s.cycles == CyclesVersion::V4_5) {
+            lamp.radius = 0.5f * s.angle;
+            const float h = std::sin(0.25f * s.angle);
+            lamp.one_minus_cos_half = 2.0f * h * h;
+            if (s.angle > 0.0f) lamp.value = cycles_light::sun_radiance_cycles45(s.color, s.strength, s.angle);
+        }
         set.lamps_.push_back(lamp);
     }
 
@@ -179,14 +260,54 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
         if (auto e = check_color(name + ":", p.color)) return *e;
         if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
         if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
+        if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
         if (p.power == 0.0f || is_black(p.color)) continue;
         Lamp lamp;
         lamp.type = LampType::Point;
+        lamp.cycles = p.cycles;
         lamp.position = p.position;
         lamp.radius = p.radius;
+        lamp.sphere = !p.soft_falloff && p.radius > 0.0f;
         lamp.invarea = cycles_light::point_invarea(p.radius);
         lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
                                      : cycles_light::point_intensity(p.color, p.power);
+        set.lamps_.push_back(lamp);
+    }
+
+    for (std::size_t i = 0; i < lights.spots.size(); ++i) {
+        const SpotLight &p = lights.spots[i];
+        const std::string name = "spot light " + std::to_string(i);
+        if (!p.light_to_world.finite())
+            return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
+        const Vec3 z = p.light_to_world.column(2);
+        if (!(length(z) > 0.0f))
+            return Error{name + ": light_to_world has a zero Z axis (no direction to shine in)"};
+        if (auto e = check_color(name + ":", p.color)) return *e;
+        if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
+        if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
+        if (!(p.spot_size > 0.0f && p.spot_size <= kPiF))
+            return Error{name + ": spot_size must be in (0, pi] radians (got " +
+                         std::to_string(p.spot_size) + ")"};
+        if (!(p.spot_blend >= 0.0f && p.spot_blend <= 1.0f))
+            return Error{name + ": spot_blend must be in [0, 1] (got " +
+                         std::to_string(p.spot_blend) + ")"};
+        if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
+        Lamp lamp;
+        lamp.type = LampType::Spot;
+        lamp.cycles = p.cycles;
+        if (p.cycles == CyclesVersion::V4_5 && !invert_linear(p.light_to_world, lamp.world_to_light))
+            return Error{name + ": light_to_world is singular (Cycles 4.5 shapes the cone in the "
+                                "light's own frame)"};
+        if (p.power == 0.0f || is_black(p.color)) continue;
+        lamp.position = p.light_to_world.column(3);
+        lamp.direction = safe_normalize(-z);
+        lamp.radius = p.radius;
+        lamp.sphere = !p.soft_falloff && p.radius > 0.0f;
+        lamp.invarea = cycles_light::point_invarea(p.radius);
+        lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
+                                     : cycles_light::point_intensity(p.color, p.power);
+        lamp.cos_half = std::cos(0.5f * p.spot_size);
+        lamp.smooth = (1.0f - lamp.cos_half) * p.spot_blend;
         set.lamps_.push_back(lamp);
     }
 
@@ -203,6 +324,7 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
         if (auto e = check::non_negative((name + ": size_y").c_str(), a.size_y)) return *e;
         if (auto e = check_color(name + ":", a.color)) return *e;
         if (auto e = check::non_negative((name + ": power").c_str(), a.power)) return *e;
+        if (auto e = check_version(name, a.cycles, true)) return *e;
         const Vec3 z = a.light_to_world.column(2);
         if (!(length(z) > 0.0f))
             return Error{name + ": light_to_world has a zero Z axis (no emitting direction)"};
@@ -216,6 +338,7 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
         const bool two_sizes = a.shape == AreaShape::Rectangle || a.shape == AreaShape::Ellipse;
         Lamp lamp;
         lamp.type = LampType::Area;
+        lamp.cycles = a.cycles;
         lamp.position = a.light_to_world.column(3);
         lamp.axis_u = a.light_to_world.column(0) * a.size_x;
         lamp.axis_v = a.light_to_world.column(1) * (two_sizes ? a.size_y : a.size_x);
@@ -226,7 +349,7 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
             !lamp.round && std::fabs(dot(lamp.axis_u, lamp.axis_v)) <=
                                1e-5f * length(lamp.axis_u) * length(lamp.axis_v);
         lamp.invarea = 1.0f / area;
-        lamp.value = cycles_light::area_radiance(a.color, a.power, area);
+        lamp.value = cycles_light::area_radiance(a.color, a.power, area, a.cycles);
         set.lamps_.push_back(lamp);
     }
 
@@ -235,7 +358,19 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
     // A constant world is not light-sampled (as in Cycles 3.4): BSDF sampling alone finds it,
     // and sampling it uniformly would take a share of the light samples from the lamps that
     // need them (measured: ~16% more variance at one bounce in the Cycles-comparison scene).
-    set.world_ = world.color * world.strength;
+    if (world.environment) {
+        // An environment is a lamp (Cycles' background light) unless its Sampling is None or
+        // it is black: then BSDF sampling alone finds it.
+        set.environment_ = world.environment;
+        set.environment_sampled_ = world.light_sampled && !world.environment->black();
+        if (set.environment_sampled_) {
+            Lamp lamp;
+            lamp.type = LampType::Environment;
+            set.lamps_.push_back(lamp);
+        }
+    } else {
+        set.world_ = world.color * world.strength;
+    }
 
     // Emissive triangles, by area.
     set.triangle_cdf_.push_back(0.0f);
@@ -278,34 +413,15 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
                                                  float u1) const {
     LightSample s;
     switch (lamp.type) {
-        case LampType::Point: {
-            if (lamp.radius == 0.0f) {
-                const Vec3 d = lamp.position - p;
-                const float t2 = dot(d, d);
-                if (!(t2 > 0.0f)) return std::nullopt;
-                s.distance = std::sqrt(t2);
-                s.wi = d / s.distance;
-                s.value = lamp.value / t2;
-                s.pdf = lamp_pick_;
-                s.delta = true;
-                return s;
-            }
-            const Vec3 n = safe_normalize(p - lamp.position);
-            if (dot(n, n) == 0.0f) return std::nullopt;
-            Vec3 a, b;
-            orthonormal_basis(n, a, b);
-            float x, y;
-            concentric_disk(u0, u1, x, y);
-            const Vec3 q = lamp.position + (a * x + b * y) * lamp.radius;
-            const Vec3 d = q - p;
-            const float t = length(d);
-            if (!(t > 0.0f)) return std::nullopt;
-            s.wi = d / t;
-            const float cos_light = -dot(n, s.wi);
-            if (!(cos_light > 0.0f)) return std::nullopt;
-            s.distance = t;
-            s.value = lamp.value;
-            s.pdf = lamp_pick_ * lamp.invarea * t * t / cos_light;
+        case LampType::Point:
+        case LampType::Spot: return sample_point_like(lamp, p, u0, u1);
+        case LampType::Environment: {
+            const EnvironmentSample e = environment_->sample(u0, u1);
+            if (!(e.pdf > 0.0f) || is_black(e.radiance)) return std::nullopt;
+            s.wi = e.wi;
+            s.distance = INFINITY;
+            s.value = e.radiance;
+            s.pdf = lamp_pick_ * e.pdf;
             return s;
         }
         case LampType::Area: {
@@ -353,6 +469,14 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
                 s.delta = true;
                 return s;
             }
+            if (lamp.cycles == CyclesVersion::V4_5) {
+                // Uniform in the cone: cos θ uniform in [cos(a/2), 1].
+                s.wi = cone_direction(lamp.direction, 1.0f - u0 * lamp.one_minus_cos_half, u1);
+                if (!(dot(s.wi, lamp.direction) >= lamp.cos_half)) return std::nullopt;
+                s.value = lamp.value;
+                s.pdf = lamp_pick_ / (2.0f * kPiF * lamp.one_minus_cos_half);
+                return s;
+            }
             Vec3 a, b;
             orthonormal_basis(lamp.direction, a, b);
             float x, y;
@@ -367,6 +491,87 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
         }
     }
     return std::nullopt;
+}
+
+float LightSet::spot_factor(const Lamp &lamp, Vec3 n) {
+    if (lamp.type != LampType::Spot) return 1.0f;
+    if (lamp.cycles == CyclesVersion::V3_4)
+        return cycles_light::spot_attenuation(dot(lamp.direction, n), lamp.cos_half, lamp.smooth);
+    const float(&m)[3][3] = lamp.world_to_light;
+    const Vec3 local = safe_normalize(Vec3{m[0][0] * n.x + m[0][1] * n.y + m[0][2] * n.z,
+                                           m[1][0] * n.x + m[1][1] * n.y + m[1][2] * n.z,
+                                           m[2][0] * n.x + m[2][1] * n.y + m[2][2] * n.z});
+    return cycles_light::spot_attenuation_cycles45(-local.z, lamp.cos_half, lamp.smooth);
+}
+
+float LightSet::sphere_pdf(float d2, float r2) {
+    if (d2 > r2) return 1.0f / (2.0f * kPiF * one_minus_cos_from_sin2(r2 / d2));
+    return 0.25f / kPiF;  // from inside: the uniform sphere of directions
+}
+
+Rgb LightSet::point_like_value(const Lamp &lamp, Vec3 p, Vec3 wi) const {
+    if (lamp.type != LampType::Spot) return lamp.value;
+    // A sphere spot does not attenuate the light of a point inside it.
+    if (lamp.sphere) {
+        const Vec3 d = p - lamp.position;
+        if (!(dot(d, d) > lamp.radius * lamp.radius)) return lamp.value;
+    }
+    return lamp.value * spot_factor(lamp, -wi);
+}
+
+std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p, float u0,
+                                                       float u1) const {
+    LightSample s;
+    const Vec3 to_p = p - lamp.position;
+    const float d2 = dot(to_p, to_p);
+    if (!(d2 > 0.0f)) return std::nullopt;
+    if (lamp.radius == 0.0f) {
+        s.distance = std::sqrt(d2);
+        s.wi = -to_p / s.distance;
+        s.value = point_like_value(lamp, p, s.wi) / d2;
+        if (is_black(s.value)) return std::nullopt;
+        s.pdf = lamp_pick_;
+        s.delta = true;
+        return s;
+    }
+    const float d = std::sqrt(d2);
+    const Vec3 n = to_p / d;  // from the light towards p
+    if (lamp.sphere) {
+        const float r2 = lamp.radius * lamp.radius;
+        float cos_theta;  // between wi and the direction to the centre
+        if (d2 > r2) {
+            cos_theta = 1.0f - u0 * one_minus_cos_from_sin2(r2 / d2);
+            s.wi = cone_direction(-n, cos_theta, u1);
+        } else {
+            const float z = 1.0f - 2.0f * u0;
+            s.wi = cone_direction(-n, z, u1);
+            cos_theta = z;
+        }
+        // Law of cosines: the near intersection from outside, the far one from inside.
+        const float disc = std::sqrt(std::max(0.0f, r2 - d2 + d2 * cos_theta * cos_theta));
+        s.distance = d2 > r2 ? d * cos_theta - disc : d * cos_theta + disc;
+        if (!(s.distance > 0.0f)) return std::nullopt;
+        s.value = point_like_value(lamp, p, s.wi);
+        if (is_black(s.value)) return std::nullopt;
+        s.pdf = lamp_pick_ * sphere_pdf(d2, r2);
+        return s;
+    }
+    Vec3 a, b;
+    orthonormal_basis(n, a, b);
+    float x, y;
+    concentric_disk(u0, u1, x, y);
+    const Vec3 q = lamp.position + (a * x + b * y) * lamp.radius;
+    const Vec3 w = q - p;
+    const float t = length(w);
+    if (!(t > 0.0f)) return std::nullopt;
+    s.wi = w / t;
+    const float cos_light = -dot(n, s.wi);
+    if (!(cos_light > 0.0f)) return std::nullopt;
+    s.distance = t;
+    s.value = point_like_value(lamp, p, s.wi);
+    if (is_black(s.value)) return std::nullopt;
+    s.pdf = lamp_pick_ * lamp.invarea * t * t / cos_light;
+    return s;
 }
 
 std::optional<LightSample> LightSet::sample_triangle(Vec3 p, float u_select, float u0,
@@ -402,23 +607,38 @@ float LightSet::emissive_triangle_pdf(float t, float abs_cos) const {
     return triangle_pick_ / triangle_area_ * t * t / abs_cos;
 }
 
-Rgb LightSet::lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, float bsdf_pdf,
-                              bool use_mis) const {
-    Rgb sum;
+template <typename Visit>
+void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                     Visit &&visit) const {
     for (const Lamp &lamp : lamps_) {
-        if (lamp.type == LampType::Point) {
+        if (lamp.type == LampType::Point || lamp.type == LampType::Spot) {
             if (lamp.radius == 0.0f) continue;
-            const Vec3 n = safe_normalize(origin - lamp.position);
+            const Vec3 to_origin = origin - lamp.position;
+            if (lamp.sphere) {
+                // Every direction from inside sees the sphere, also for spots (Cycles 4.5's
+                // spot_light_intersect ignores rays leaving the centre there, while its light
+                // samples cover them: hairis keeps the two consistent).
+                const float d2 = dot(to_origin, to_origin), r2 = lamp.radius * lamp.radius;
+                const float b = -dot(to_origin, dir);  // distance along dir to the closest point
+                const Vec3 closest = to_origin + dir * b;
+                const float h2 = dot(closest, closest);
+                if ((d2 > r2 && b < 0.0f) || h2 > r2) continue;
+                const float half_chord = std::sqrt(r2 - h2);
+                const float t = d2 > r2 ? b - half_chord : b + half_chord;
+                if (!(t > tmin && t < tmax)) continue;
+                const Rgb value = point_like_value(lamp, origin, dir);
+                if (!is_black(value)) visit(value, lamp_pick_ * sphere_pdf(d2, r2));
+                continue;
+            }
+            const Vec3 n = safe_normalize(to_origin);
             const float denom = dot(dir, n);
             if (!(denom < 0.0f)) continue;
             const float t = dot(lamp.position - origin, n) / denom;
             if (!(t > tmin && t < tmax)) continue;
             const Vec3 q = origin + dir * t - lamp.position;
             if (dot(q, q) > lamp.radius * lamp.radius) continue;
-            const float w =
-                use_mis ? power_heuristic(bsdf_pdf, lamp_pick_ * lamp.invarea * t * t / -denom)
-                        : 1.0f;
-            sum += lamp.value * w;
+            const Rgb value = point_like_value(lamp, origin, dir);
+            if (!is_black(value)) visit(value, lamp_pick_ * lamp.invarea * t * t / -denom);
         } else if (lamp.type == LampType::Area) {
             const float denom = dot(dir, lamp.direction);
             if (!(denom < 0.0f)) continue;  // one-sided
@@ -430,45 +650,89 @@ Rgb LightSet::lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, flo
             const bool inside = lamp.round ? (4.0f * (s * s + v * v) <= 1.0f)
                                            : (std::fabs(s) <= 0.5f && std::fabs(v) <= 0.5f);
             if (!inside) continue;
-            float w = 1.0f;
-            if (use_mis) {
-                float light_pdf;
-                if (lamp.solid_angle) {
-                    const SphericalRectangle rect(
-                        origin, lamp.position - (lamp.axis_u + lamp.axis_v) * 0.5f, lamp.axis_u,
-                        lamp.axis_v);
-                    light_pdf = rect.solid_angle() > 0.0f ? lamp_pick_ / rect.solid_angle() : 0.0f;
-                } else {
-                    light_pdf = lamp_pick_ * lamp.invarea * t * t / -denom;
-                }
-                w = power_heuristic(bsdf_pdf, light_pdf);
+            float light_pdf;
+            if (lamp.solid_angle) {
+                const SphericalRectangle rect(origin,
+                                              lamp.position - (lamp.axis_u + lamp.axis_v) * 0.5f,
+                                              lamp.axis_u, lamp.axis_v);
+                light_pdf = rect.solid_angle() > 0.0f ? lamp_pick_ / rect.solid_angle() : 0.0f;
+            } else {
+                light_pdf = lamp_pick_ * lamp.invarea * t * t / -denom;
             }
-            sum += lamp.value * w;
+            visit(lamp.value, light_pdf);
         }
     }
+}
+
+template <typename Visit>
+void LightSet::visit_escaped(Vec3 dir, Visit &&visit) const {
+    for (const Lamp &lamp : lamps_) {
+        if (lamp.type != LampType::Sun || lamp.radius == 0.0f) continue;
+        if (lamp.cycles == CyclesVersion::V4_5) {
+            if (!(dot(dir, lamp.direction) >= lamp.cos_half)) continue;
+            visit(lamp.value, lamp_pick_ / (2.0f * kPiF * lamp.one_minus_cos_half));
+            continue;
+        }
+        const float c = dot(dir, lamp.direction);
+        if (!(c >= lamp.cos_half) || !(c > 0.0f)) continue;
+        const float pdf = lamp.invarea / (c * c * c);
+        visit(lamp.value * pdf, lamp_pick_ * pdf);
+    }
+}
+
+Rgb LightSet::lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, float bsdf_pdf,
+                              bool use_mis) const {
+    Rgb sum;
+    visit_lamps_along_ray(origin, dir, tmin, tmax, [&](Rgb value, float light_pdf) {
+        sum += value * (use_mis ? power_heuristic(bsdf_pdf, light_pdf) : 1.0f);
+    });
     return sum;
 }
 
 Rgb LightSet::escaped(Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world) const {
     Rgb sum;
-    for (const Lamp &lamp : lamps_) {
-        if (lamp.type == LampType::Sun) {
-            if (lamp.radius == 0.0f) continue;
-            const float c = dot(dir, lamp.direction);
-            if (!(c >= lamp.cos_half) || !(c > 0.0f)) continue;
-            const float pdf = lamp.invarea / (c * c * c);
-            const float w = use_mis ? power_heuristic(bsdf_pdf, lamp_pick_ * pdf) : 1.0f;
-            sum += lamp.value * (pdf * w);
-        }
+    visit_escaped(dir, [&](Rgb value, float light_pdf) {
+        sum += value * (use_mis ? power_heuristic(bsdf_pdf, light_pdf) : 1.0f);
+    });
+    if (!include_world) return sum;
+    if (!environment_) return sum + world_;  // a constant world is never light-sampled
+    const Rgb radiance = environment_->eval(dir);
+    if (is_black(radiance)) return sum;
+    const float w = use_mis && environment_sampled_
+                        ? power_heuristic(bsdf_pdf, lamp_pick_ * environment_->pdf(dir))
+                        : 1.0f;
+    return sum + radiance * w;
+}
+
+float LightSet::pdf(Vec3 p, Vec3 wi) const {
+    float total = 0.0f;
+    auto add = [&](Rgb, float light_pdf) { total += light_pdf; };
+    visit_lamps_along_ray(p, wi, 0.0f, INFINITY, add);
+    visit_escaped(wi, add);
+    if (environment_sampled_) total += lamp_pick_ * environment_->pdf(wi);
+    // Emissive triangles that the ray crosses (Möller and Trumbore).
+    for (const EmissiveTriangle &tri : triangles_) {
+        const Vec3 e1 = tri.p1 - tri.p0, e2 = tri.p2 - tri.p0;
+        const Vec3 h = cross(wi, e2);
+        const float det = dot(e1, h);
+        if (det == 0.0f) continue;
+        const Vec3 o = p - tri.p0;
+        const float u = dot(o, h) / det;
+        const Vec3 q = cross(o, e1);
+        const float v = dot(wi, q) / det;
+        const float t = dot(e2, q) / det;
+        if (!(u >= 0.0f && v >= 0.0f && u + v <= 1.0f && t > 0.0f)) continue;
+        const float abs_cos = std::fabs(dot(safe_normalize(cross(e1, e2)), wi));
+        total += emissive_triangle_pdf(t, abs_cos);
     }
-    if (include_world) sum += world_;  // never light-sampled: full weight
-    return sum;
+    return total;
 }
 
 std::size_t LightSet::memory_bytes() const {
     return sizeof(*this) + lamps_.capacity() * sizeof(Lamp) +
            triangles_.capacity() * sizeof(EmissiveTriangle) +
-           triangle_cdf_.capacity() * sizeof(float);
+           triangle_cdf_.capacity() * sizeof(float) +
+           (environment_ ? environment_->memory_bytes() : 0);
 }
 
 }  // namespace hairis

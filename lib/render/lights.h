@@ -30,30 +30,68 @@
 //      L = strength · invarea / cos³θ and is drawn with pdf invarea / cos³θ, so the irradiance
 //      on a surface facing the sun is exactly strength (W/m²). Angle 0: a delta light of
 //      irradiance strength.
-//    * World: constant radiance color × strength from every direction.
+//    * Spot (Blender's Spot; a point light with a cone): position = column 3, axis dir =
+//      −column 2 normalised; radius = Radius (shadow_soft_size); spot_angle = Size (spot_size,
+//      the full cone angle), spot_smooth = Blend (spot_blend). scene/light.cpp stores
+//      cos_half = cos(spot_angle/2) and smooth = (1 − cos_half)·blend; the disk, invarea and
+//      L = strength·invarea/(4π) are the point light's, times kernel/light/common.h's
+//      spot_light_attenuation(dir, cos_half, smooth, N) with N the unit direction from the
+//      light's sampled point to the shading point: c = dot(dir, N); 0 when c ≤ cos_half, else
+//      c · smoothstep((c − cos_half)/smooth) when c − cos_half < smooth (and smooth ≠ 0), else
+//      c. The factor c is Cycles 3.4's: a spot's intensity on its axis is P/(4π) and falls
+//      with the cosine inside the cone.
+//    * World: constant radiance color × strength from every direction, or an Environment
+//      Texture (environment_map.h) that is light-sampled unless its Sampling is None.
+//
+//  - Cycles 4.x (cycles = CyclesVersion::V4_5, for Blender 4.1 to 5.0; kernel/light/point.h,
+//    spot.h, area.h, distant.h and scene/light.cpp of v4.5.0 and v5.0.0):
+//    * Area: L = strength/(π·area) (commit a21af93e6, "Fix wrong conversion from power to
+//      radiance of area lights", in 4.0): 4/π times 3.4's radiance; a Lambertian emitter of
+//      Power P now radiates P.
+//    * Sun: a cone of half-angle a/2 of constant radiance strength/(π sin²(a/2)), sampled
+//      uniformly (pdf 1/(2π(1 − cos(a/2)))); a surface facing it receives exactly strength.
+//    * Point and spot with Soft Falloff (use_soft_falloff, Blender's default since 4.1): the
+//      disk of 3.4, same radiance P/(4π²r²) (invarea = 1/(4πr²), eval_fac = invarea/π). Without
+//      Soft Falloff: a sphere of radius r of that radiance, sampled uniformly in the cone it
+//      subtends (from inside it: uniformly over the sphere of directions, where Cycles uses a
+//      cosine hemisphere around the shading normal; a density, not a result, differs).
+//    * Spot attenuation: smoothstep((z − cos_half)/smooth) clamped to [0, 1], without 3.4's
+//      factor c, z being the local −Z component of normalize(M⁻¹·N) (the object's scale makes
+//      the cone elliptical); from inside a sphere spot there is no attenuation, and every
+//      direction sees it (Cycles' hit test skips rays leaving the centre there but its light
+//      samples do not, which hairis does not copy: the estimate would be biased).
 //    * Emissive triangles (a mesh material with emission): radiance = the emission colour,
 //      on both sides (Cycles' emissive closure uses |cos|).
 //
 // Light selection: like Cycles 3.4's light distribution (scene/light.cpp,
-// device_update_distribution): emissive triangles as a group get probability 1/2 when there
-// are also lamps (sun, point, area), otherwise all of it; a triangle
-// within the group is chosen in proportion to its area; lamps share the rest uniformly (not by
-// power). Like Cycles 3.4, which disables the background light when the world shader is not
-// spatially varying, hairis does not sample a constant world as a light: paths find it by BSDF
+// device_update_distribution), which Cycles 4.x uses too with the Light Tree off: emissive
+// triangles as a group get probability 1/2 when there are also lamps (sun, point, spot, area,
+// environment world), otherwise all of it; a triangle within the group is chosen in proportion
+// to its area; lamps share the rest uniformly (not by power). The world is one lamp among them
+// when it is an Environment Texture whose Sampling is not None (Cycles' background light):
+// directions from its importance map (environment_map.h) with their exact density, and rays
+// that escape weighted against it by the power heuristic. Like Cycles, which disables the
+// background light when the world shader is not spatially varying, hairis does not sample a
+// constant world as a light, nor a world whose Sampling is None: paths find them by BSDF
 // sampling alone, at full weight.
 #pragma once
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "render/camera.h"
 #include "core/expected.h"
 #include "core/math.h"
+#include "render/camera.h"
+#include "render/environment_map.h"
 
 namespace hairis {
+
+/// Which Cycles a light follows (see the file comment): 3.4, or 4.5 (Blender 4.1 to 5.0).
+enum class CyclesVersion { V3_4 = 0, V4_5 = 1 };
 
 /// A sun light (Blender's Sun): parallel light from a small disc.
 struct SunLight {
@@ -65,6 +103,7 @@ struct SunLight {
     float strength = 1.0f;
     /// Angular diameter of the sun's disc in radians, in [0, π).
     float angle = 0.0f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
 };
 
 /// A point light (Blender's Point): power in W, radius in metres.
@@ -73,6 +112,26 @@ struct PointLight {
     Rgb color{1.0f};
     float power = 10.0f;
     float radius = 0.0f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
+    /// Blender 4.1+'s Soft Falloff (default on): a disk facing the shading point; off, a
+    /// sphere (only with cycles = V4_5; Cycles 3.4 has the disk alone).
+    bool soft_falloff = true;
+};
+
+/// A spot light (Blender's Spot): the object's matrix (row-major, with its scale; the light
+/// shines along its local −Z), power in W, radius in metres, Size = the full cone angle in
+/// radians, Blend in [0, 1].
+struct SpotLight {
+    Mat4 light_to_world;
+    Rgb color{1.0f};
+    float power = 10.0f;
+    float radius = 0.0f;
+    /// Blender's spot_size, in [1°, 180°] (radians).
+    float spot_size = float(kPi / 4.0);
+    /// Blender's spot_blend, in [0, 1].
+    float spot_blend = 0.15f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
+    bool soft_falloff = true;  ///< as PointLight's
 };
 
 /// Blender's area light shapes.
@@ -87,12 +146,27 @@ struct AreaLight {
     float size_y = 1.0f;
     Rgb color{1.0f};
     float power = 10.0f;
+    CyclesVersion cycles = CyclesVersion::V3_4;
 };
 
-/// The world: a constant background of radiance color × strength.
+/// The world: a constant background of radiance color × strength, or an Environment Texture.
 struct WorldLight {
     Rgb color{0.0f};
     float strength = 1.0f;
+    /// When set, the world's radiance is environment->eval(direction) (its own colour and
+    /// strength included) and color and strength above are not used.
+    std::shared_ptr<const EnvironmentMap> environment{};
+    /// Cycles' World > Settings > Sampling other than None: the environment is light-sampled.
+    bool light_sampled = true;
+};
+
+/// Every light of a scene but its emissive triangles.
+struct LightsDesc {
+    std::vector<SunLight> suns;
+    std::vector<PointLight> points;
+    std::vector<SpotLight> spots;
+    std::vector<AreaLight> areas;
+    WorldLight world;
 };
 
 /// An emissive triangle handed to the light set by the scene (world space).
@@ -116,12 +190,24 @@ Rgb point_radiance(Rgb color, float power, float radius);
 Rgb point_intensity(Rgb color, float power);
 /// Area of an area light: |axis_u|·size_u · |axis_v|·size_v, × π/4 for Disk and Ellipse.
 float area_light_area(const AreaLight &light);
-/// Radiance of an area light: color·P·0.25/area.
-Rgb area_radiance(Rgb color, float power, float area);
+/// Radiance of an area light: color·P·0.25/area (3.4), color·P/(π·area) (4.5).
+Rgb area_radiance(Rgb color, float power, float area,
+                  CyclesVersion version = CyclesVersion::V3_4);
 /// invarea of a sun of angular diameter `angle`: 1/(π tan²(angle/2)), or 1 for angle 0.
 float sun_invarea(float angle);
-/// Radiance of a sun at angle θ from its centre (cos θ ≥ cos(angle/2)): E·invarea/cos³θ.
+/// Radiance of a sun at angle θ from its centre (cos θ ≥ cos(angle/2)): E·invarea/cos³θ (3.4).
 Rgb sun_radiance(Rgb color, float strength, float angle, float cos_theta);
+/// Radiance of a sun in Cycles 4.5: E/(π sin²(angle/2)) inside its cone (angle > 0).
+Rgb sun_radiance_cycles45(Rgb color, float strength, float angle);
+/// Cycles 3.4's spot_light_attenuation: c = dot(axis, n) for the unit axis and the unit
+/// direction n from the light to the shading point; 0 for c ≤ cos_half, c·smoothstep((c −
+/// cos_half)/smooth) for c − cos_half < smooth (smooth ≠ 0), else c.
+float spot_attenuation(float c, float cos_half, float smooth);
+/// Cycles 4.5's: smoothstep((z − cos_half)/smooth) clamped to [0, 1], z the local −Z
+/// component; a hard edge (1 inside, 0 at or outside) for smooth = 0.
+float spot_attenuation_cycles45(float z, float cos_half, float smooth);
+/// smoothstep(f) = 3f² − 2f³ (Cycles' smoothstepf), not clamped.
+inline float smoothstep(float f) { return f * f * (3.0f - 2.0f * f); }
 
 }  // namespace cycles_light
 
@@ -153,9 +239,13 @@ struct LightSample {
 class LightSet {
   public:
     /// Validates the lights and converts them. Lights that cannot contribute (zero power or
-    /// colour) are left out silently; an area light of zero size is left out with a warning
-    /// appended to `warnings`. Errors name the light (e.g. "point light 2: power must be
-    /// finite and >= 0 (got nan)").
+    /// colour, an all-black environment) are left out silently; an area light of zero size is
+    /// left out with a warning appended to `warnings`. Errors name the light (e.g. "point
+    /// light 2: power must be finite and >= 0 (got nan)").
+    static Expected<LightSet> build(const LightsDesc &lights,
+                                    std::vector<EmissiveTriangle> emissive,
+                                    std::vector<std::string> *warnings = nullptr);
+    /// The same without spot lights.
     static Expected<LightSet> build(const std::vector<SunLight> &suns,
                                     const std::vector<PointLight> &points,
                                     const std::vector<AreaLight> &areas, const WorldLight &world,
@@ -164,14 +254,23 @@ class LightSet {
 
     LightSet() = default;
 
-    /// Number of lamps (suns, points and areas; the world is not one).
+    /// Number of lamps: suns, points, spots, areas and a light-sampled environment world.
     int lamp_count() const { return int(lamps_.size()); }
     /// Number of emissive triangles.
     int emissive_triangle_count() const { return int(triangles_.size()); }
     /// True when there is nothing to sample.
     bool empty() const { return lamps_.empty() && triangles_.empty(); }
-    /// The world's radiance (black without a world).
+    /// The constant world's radiance (black without a world or with an environment).
     Rgb world_radiance() const { return world_; }
+    /// The world's radiance in direction dir (unit): the environment's, or the constant.
+    Rgb world_radiance(Vec3 dir) const { return environment_ ? environment_->eval(dir) : world_; }
+    /// True when the world is an environment sampled as a lamp.
+    bool world_light_sampled() const { return environment_sampled_; }
+    /// The light-sampling density (solid angle, with selection) of the world in direction
+    /// dir: 0 unless world_light_sampled().
+    float world_pdf(Vec3 dir) const {
+        return environment_sampled_ ? lamp_pick_ * environment_->pdf(dir) : 0.0f;
+    }
     /// The probability of choosing lamp i, and of choosing the emissive-triangle group.
     float lamp_selection_probability() const { return lamp_pick_; }
     float triangle_group_probability() const { return triangle_pick_; }
@@ -188,9 +287,15 @@ class LightSet {
     Rgb lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, float bsdf_pdf,
                         bool use_mis) const;
     /// Radiance reaching a ray that escapes the scene in direction dir: suns whose disc
-    /// contains dir and the world, each weighted by MIS against bsdf_pdf (when use_mis).
+    /// contains dir and the world, each weighted by MIS against bsdf_pdf (when use_mis; a
+    /// world that is not light-sampled takes weight 1).
     /// include_world false leaves the world out (transparent film for camera rays).
     Rgb escaped(Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world = true) const;
+    /// The density with which sample() draws the unit direction wi from p (solid angle, with
+    /// the selection probabilities): the sum over every lamp and emissive triangle that wi
+    /// reaches, as if nothing blocked it; delta lights have none. Directions that sample()
+    /// refuses (a spot's attenuation is 0 there) have none either.
+    float pdf(Vec3 p, Vec3 wi) const;
     /// The light-sampling density (solid angle, with selection) of an emissive triangle point
     /// seen at distance t with |cos| abs_cos between the ray and the triangle's normal.
     float emissive_triangle_pdf(float t, float abs_cos) const;
@@ -199,22 +304,43 @@ class LightSet {
     std::size_t memory_bytes() const;
 
   private:
-    enum class LampType : std::uint8_t { Point, Area, Sun };
+    enum class LampType : std::uint8_t { Point, Spot, Area, Sun, Environment };
     struct Lamp {
         LampType type = LampType::Point;
-        Rgb value;          // point: radiance (r > 0) or intensity (r = 0); area: radiance;
-                            // sun: strength (irradiance); world: radiance
-        Vec3 position;      // point and area centre
+        CyclesVersion cycles = CyclesVersion::V3_4;
+        Rgb value;          // point, spot: radiance (r > 0) or intensity (r = 0); area:
+                            // radiance; sun: strength (irradiance) in 3.4, radiance in 4.5
+        Vec3 position;      // point, spot and area centre
         Vec3 axis_u, axis_v;// area: full extents
-        Vec3 direction;     // area: emitting normal; sun: towards the sun
-        float radius = 0;   // point radius; sun: tan(angle/2)
+        Vec3 direction;     // area: emitting normal; sun: towards the sun; spot: its axis
+        float radius = 0;   // point and spot radius; sun: tan(angle/2) (3.4), angle/2 (4.5)
         float invarea = 1;  // 1/area of the disk, rectangle or ellipse
-        float cos_half = 1; // sun: cos(angle/2)
+        float cos_half = 1; // sun: cos(angle/2); spot: cos(spot_size/2)
+        float one_minus_cos_half = 0;  // sun (4.5): 1 − cos(angle/2), computed stably
+        float smooth = 0;   // spot: (1 − cos_half)·blend
+        float world_to_light[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // spot (4.5): M⁻¹
+        bool sphere = false;// point, spot (4.5 without soft falloff): a sphere of radius r
         bool round = false; // area: disk or ellipse
         bool solid_angle = false;  // area: rectangle with orthogonal axes, sampled by solid angle
     };
 
+    // The spot's attenuation for light leaving it in unit direction n (towards the receiver).
+    static float spot_factor(const Lamp &lamp, Vec3 n);
+    // Point and spot: the sphere's light-sampling density (without selection) seen from a
+    // point at squared distance d2 from its centre.
+    static float sphere_pdf(float d2, float r2);
+    // Point and spot radiance towards a receiver at p along unit direction wi that reaches the
+    // light (before selection); 0 where a spot's cone does not reach.
+    Rgb point_like_value(const Lamp &lamp, Vec3 p, Vec3 wi) const;
+    // Calls visit(radiance, light-sampling density with selection) for every lamp the ray
+    // crosses in (tmin, tmax), and for every sun whose disc an escaping ray meets.
+    template <typename Visit>
+    void visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, Visit &&visit) const;
+    template <typename Visit>
+    void visit_escaped(Vec3 dir, Visit &&visit) const;
     std::optional<LightSample> sample_lamp(const Lamp &lamp, Vec3 p, float u0, float u1) const;
+    std::optional<LightSample> sample_point_like(const Lamp &lamp, Vec3 p, float u0,
+                                                 float u1) const;
     std::optional<LightSample> sample_triangle(Vec3 p, float u_select, float u0, float u1) const;
 
     std::vector<Lamp> lamps_;
@@ -224,6 +350,8 @@ class LightSet {
     float lamp_pick_ = 0;      // probability of each lamp
     float triangle_pick_ = 0;  // probability of the triangle group
     Rgb world_;
+    std::shared_ptr<const EnvironmentMap> environment_;
+    bool environment_sampled_ = false;  // environment_ is one of lamps_
 };
 
 /// A rectangle as seen from a point, for sampling it uniformly by solid angle (Ureña, Fajardo

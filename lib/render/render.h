@@ -3,10 +3,11 @@
 //
 // Integrator (per camera sample; the vertex where the camera ray lands has depth 0):
 //  - Emission: a ray that reaches an emitter adds throughput × radiance, weighted by the power
-//    heuristic against light sampling when the emitter can be light-sampled (point-light
-//    disks, area lights, suns with a disc, emissive mesh triangles); camera rays and emitters
-//    that are never light-sampled (a constant world, as in Cycles 3.4; emissive curves) take
-//    weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in Cycles (kernel/integrator/
+//    heuristic against light sampling when the emitter can be light-sampled (point and spot
+//    disks or spheres, area lights, suns with a disc, an Environment Texture world whose
+//    Sampling is not None, emissive mesh triangles); camera rays and emitters that are never
+//    light-sampled (a constant world, as in Cycles; a world with Sampling None; emissive
+//    curves) take weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in Cycles (kernel/integrator/
 //    shade_light.h): every lamp crossed before the next surface contributes.
 //  - Diffuse and transmission limits the same way, per kind of bounce (see RenderSettings).
 //    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
@@ -17,7 +18,8 @@
 //    continuation); the continuation ray of the last shaded vertex still collects MIS-weighted
 //    emission, then the path ends. max_bounces = 0 is direct lighting only.
 //  - Next-event estimation at every shaded vertex: one light chosen as LightSet::sample
-//    documents (uniformly among lamps, Cycles 3.4's choice; emissive triangles by area),
+//    documents (uniformly among lamps, the environment world being one, Cycles 3.4's choice;
+//    emissive triangles by area),
 //    a shadow ray (hair, like everything, is opaque to it), MIS with the BSDF's density.
 //  - BSDF sampling: diffuse surfaces sample the cosine-weighted hemisphere around the normal
 //    facing ω_o. Hair uses its material's DirectionSampler: in the fiber frame of frame.h

@@ -14,6 +14,16 @@ namespace hairis {
 
 namespace {
 
+LightsDesc lights_of(const SceneDesc &desc) {
+    LightsDesc lights;
+    lights.suns = desc.suns;
+    lights.points = desc.point_lights;
+    lights.spots = desc.spot_lights;
+    lights.areas = desc.area_lights;
+    lights.world = desc.world;
+    return lights;
+}
+
 struct alignas(16) Float4 {
     float x, y, z, w;
 };
@@ -197,8 +207,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     // Lights: validated now (cheap) so that a bad light fails before the BVH is built; the
     // light set itself is built at the end, with the emissive triangles.
     {
-        auto lights = LightSet::build(desc.suns, desc.point_lights, desc.area_lights, desc.world,
-                                      {}, nullptr);
+        auto lights = LightSet::build(lights_of(desc), {}, nullptr);
         if (!lights) return lights.error();
     }
 
@@ -421,8 +430,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     // Lights.
     stats.emissive_triangles = emissive.size();
     {
-        auto lights = LightSet::build(desc.suns, desc.point_lights, desc.area_lights, desc.world,
-                                      std::move(emissive), &stats.warnings);
+        auto lights = LightSet::build(lights_of(desc), std::move(emissive), &stats.warnings);
         if (!lights) return lights.error();
         impl->lights = std::move(lights).value();
     }

@@ -82,6 +82,7 @@ struct SceneDesc {
     std::vector<TriangleMesh> meshes;
     std::vector<SunLight> suns;
     std::vector<PointLight> point_lights;
+    std::vector<SpotLight> spot_lights;
     std::vector<AreaLight> area_lights;
     WorldLight world;
     CameraDesc camera;
@@ -96,7 +97,7 @@ struct SceneStats {
     std::size_t triangles = 0;        ///< triangles kept
     std::size_t skipped_triangles = 0;///< degenerate triangles left out
     std::size_t emissive_triangles = 0;
-    std::size_t lamps = 0;            ///< lights sampled (suns, points, areas, world)
+    std::size_t lamps = 0;            ///< lamps sampled (suns, points, spots, areas, world)
     std::vector<std::string> warnings;///< one line per kind of skipped item
     std::size_t scene_bytes = 0;      ///< hairis' own copies (curve and mesh buffers, lights)
     std::size_t embree_peak_bytes = 0;///< Embree's peak allocation during the build

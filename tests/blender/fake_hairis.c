@@ -73,11 +73,15 @@ static const char *const kinds[][2] = {
              "threads=0"},
     {"sampler", "strategy=table;multiple_weight=0;n_h=2"},
     {"diffuse", "type=diffuse;color=0.800000012,0.800000012,0.800000012;emission=0,0,0"},
-    {"sun", "type=sun;direction=0,0,1;color=1,1,1;strength=1;angle=0"},
-    {"point", "type=point;position=0,0,0;color=1,1,1;power=10;radius=0"},
+    {"sun", "type=sun;direction=0,0,1;color=1,1,1;strength=1;angle=0;cycles=3.4"},
+    {"point", "type=point;position=0,0,0;color=1,1,1;power=10;radius=0;cycles=3.4;soft_falloff=1"},
+    {"spot", "type=spot;matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;color=1,1,1;power=10;radius=0;"
+             "spot_size=0.785398185;spot_blend=0.150000006;cycles=3.4;soft_falloff=1"},
     {"area", "type=area;matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;shape=square;size=1;size_y=1;"
-             "color=1,1,1;power=10"},
-    {"world", "color=0,0,0;strength=1"},
+             "color=1,1,1;power=10;cycles=3.4"},
+    {"world", "color=0,0,0;strength=1;image=;color_space=auto;"
+              "matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;mapping=point;rotation=0,0,0;scale=1,1,1;"
+              "sampling=auto;map_resolution=1024"},
     {"camera", "matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;orthographic=0;"
                "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
                "clip_start=0;clip_end=3.40282347e+38"},
@@ -883,13 +887,13 @@ int hairis_scene_add_light(hairis_scene *s, const char *text)
     /* The type picks the names. */
     char type[32];
     find_value(text, "type", type, sizeof type);
-    const char *types[3] = {"sun", "point", "area"};
+    const char *types[4] = {"sun", "point", "area", "spot"};
     int kind = -1;
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 4; ++k)
         if (strcmp(type, types[k]) == 0) kind = k;
     if (kind < 0)
-        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "light: type must be given: sun, point or area (got \"%s\")",
-                    type);
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "light: type must be given: sun, point, spot or area (got \"%s\")", type);
     options o;
     double v[16];
     if (read_options(text, types[kind], "light", NULL, &o) != HAIRIS_OK ||
@@ -907,6 +911,14 @@ int hairis_scene_add_light(hairis_scene *s, const char *text)
         if (numbers(&o, "position", v, 3) != HAIRIS_OK ||
             number_in(&o, "power", 0, 3.4e38, v) != HAIRIS_OK ||
             number_in(&o, "radius", 0, 3.4e38, v) != HAIRIS_OK)
+            return HAIRIS_ERROR_INVALID_ARGUMENT;
+        s->points++;
+    } else if (kind == 3) {
+        if (numbers(&o, "matrix", v, 16) != HAIRIS_OK ||
+            number_in(&o, "power", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "radius", 0, 3.4e38, v) != HAIRIS_OK ||
+            number_in(&o, "spot_size", 0.0174532925, 3.14159266, v) != HAIRIS_OK ||
+            number_in(&o, "spot_blend", 0, 1, v) != HAIRIS_OK)
             return HAIRIS_ERROR_INVALID_ARGUMENT;
         s->points++;
     } else {
@@ -934,6 +946,28 @@ int hairis_scene_set_world(hairis_scene *s, const char *text)
         number_in(&o, "strength", 0, 3.4e38, &strength) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
     for (int k = 0; k < 3; ++k) s->world[k] = (float)(color[k] * strength);
+    clear_error();
+    return HAIRIS_OK;
+}
+
+int hairis_scene_set_world_pixels(hairis_scene *s, const char *text, const float *pixels,
+                                  size_t width, size_t height, int channels)
+{
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    if (!pixels || width == 0 || height == 0)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "world: pixels must not be NULL or empty");
+    if (channels < 1 || channels > 4)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "world: channels must be 1 to 4, not %d", channels);
+    options o;
+    double color[3] = {1, 1, 1}, strength;
+    if (read_options(text, "world", "world", NULL, &o) != HAIRIS_OK ||
+        number_in(&o, "strength", 0, 3.4e38, &strength) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    /* The fake renders the environment as its mean times the multiplier. */
+    double mean = 0;
+    for (size_t i = 0; i < width * height; ++i) mean += pixels[i * (size_t)channels];
+    mean /= (double)(width * height);
+    for (int k = 0; k < 3; ++k) s->world[k] = (float)(color[k] * strength * mean);
     clear_error();
     return HAIRIS_OK;
 }

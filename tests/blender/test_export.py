@@ -149,12 +149,22 @@ def test_curves_without_radius():
 
 
 def test_lights_world_camera():
-    """Sun direction/strength/angle, point, area, spot warning, world, camera frame."""
+    """Sun direction/strength/angle, point, area, spot, world, camera frame."""
     scene = helpers.make_test_scene()
     data = export.export_context()
     kinds = sorted(light.kind for light in data.lights)
-    assert kinds == ["AREA", "POINT", "SUN"], kinds
-    assert any("spot" in w for w in data.warnings), data.warnings
+    assert kinds == ["AREA", "POINT", "SPOT", "SUN"], kinds
+    assert not any("spot" in w for w in data.warnings), data.warnings
+
+    spot = next(light for light in data.lights if light.kind == "SPOT")
+    spot_data = bpy.data.lights["Spot"]
+    np.testing.assert_allclose(spot.matrix, np.array(bpy.data.objects["Spot"].matrix_world),
+                               atol=1e-6)
+    assert math.isclose(spot.strength, 10.0)
+    assert math.isclose(spot.spot_size, spot_data.spot_size, rel_tol=1e-6)
+    assert math.isclose(spot.spot_blend, spot_data.spot_blend, rel_tol=1e-6)
+    assert math.isclose(spot.radius, spot_data.shadow_soft_size, rel_tol=1e-6)
+    assert spot.cycles == ("3.4" if bpy.app.version < (4, 0, 0) else "4.5"), spot.cycles
 
     sun = next(light for light in data.lights if light.kind == "SUN")
     sun_object = bpy.data.objects["Sun"]
@@ -231,7 +241,8 @@ def test_mesh():
 
 
 def test_unsupported_things_warn():
-    """Linked hair inputs, environment textures, unknown shaders: warnings, no crash."""
+    """Linked hair inputs, an environment texture without image, unknown shaders: warnings,
+    no crash."""
     scene = helpers.make_test_scene(with_curves=False)
     hair = bpy.data.materials["Hair"]
     tree = hair.node_tree
@@ -249,7 +260,7 @@ def test_unsupported_things_warn():
     data = export.export_context()
     text = "\n".join(data.warnings)
     assert "'Random'" in text and "linked" in text, text
-    assert "environment textures are not supported" in text, text
+    assert "Environment Texture 'Environment Texture' has no image" in text, text
     assert "Glass BSDF is not supported" in text, text
 
 
@@ -376,6 +387,78 @@ def test_render_mode_export_through_engine():
     assert tuple(arrays["camera_size"]) == (32, 24)
 
 
+def _environment_world(scene, image, rotation=(0.0, 0.0, 0.0), coordinates="Generated"):
+    """A world: Texture Coordinate → Mapping (rotation) → Environment Texture → Background."""
+    world = helpers.make_world(scene, color=(0.3, 0.2, 0.1), strength=2.5)
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    background = nodes["Background"]
+    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture.image = image
+    mapping = nodes.new("ShaderNodeMapping")
+    helpers.socket(mapping, "Rotation").default_value = rotation
+    coords = nodes.new("ShaderNodeTexCoord")
+    links.new(coords.outputs[coordinates], helpers.socket(mapping, "Vector"))
+    links.new(mapping.outputs["Vector"], helpers.socket(texture, "Vector"))
+    links.new(texture.outputs["Color"], helpers.socket(background, "Color"))
+    return world
+
+
+def test_environment_world():
+    """An Environment Texture world: a file by path, a generated image by pixels, the Mapping
+    rotation, the Strength, the Sampling settings; unsupported nodes are named."""
+    import hdri  # noqa: E402 (beside this file)
+    scene = helpers.make_test_scene(with_curves=False)
+    path = os.path.join(ARGS.workdir, "sky.hdr")
+    hdri.write_hdr(path, 16, 8, hdri.spot_world(16, 8, spot=(4, 2), spot_value=20.0))
+    image = bpy.data.images.load(path)
+    world = _environment_world(scene, image, rotation=(0.1, 0.2, 0.3))
+    world.cycles.sampling_method = "MANUAL"
+    world.cycles.sample_map_resolution = 256
+    data = export.export_context()
+    env = data.world_environment
+    assert env is not None, data.warnings
+    assert env.path == os.path.abspath(path) and env.pixels is None
+    np.testing.assert_allclose(env.rotation, (0.1, 0.2, 0.3), atol=1e-6)
+    assert env.mapping == "point" and math.isclose(env.strength, 2.5)
+    assert env.sampling == "manual" and env.map_resolution == 256
+    assert env.color_space == "linear"
+    np.testing.assert_allclose(env.matrix, np.eye(4))
+
+    # A generated image goes as pixels (bottom row first, as Blender stores them).
+    generated = bpy.data.images.new("Generated", 8, 4, float_buffer=True)
+    generated.colorspace_settings.name = "sRGB"  # before the pixels: it regenerates them
+    values = np.linspace(0.0, 1.0, 8 * 4 * 4, dtype=np.float32)
+    generated.pixels.foreach_set(values)
+    _environment_world(scene, generated)
+    scene.world.cycles.sampling_method = "NONE"
+    env = export.export_context().world_environment
+    assert env.path is None and env.pixels.shape == (4, 8, 4)
+    np.testing.assert_allclose(env.pixels.reshape(-1), values, atol=1e-6)
+    assert env.color_space == "srgb" and env.sampling == "none"
+
+    # Something else between the texture and the Background: named, the colour used.
+    world = _environment_world(scene, image)
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    gamma = nodes.new("ShaderNodeGamma")
+    links.new(nodes["Environment Texture"].outputs["Color"], helpers.socket(gamma, "Color"))
+    links.new(gamma.outputs["Color"], helpers.socket(nodes["Background"], "Color"))
+    data = export.export_context()
+    assert data.world_environment is None
+    assert any("Gamma" in w and "not supported" in w for w in data.warnings), data.warnings
+    np.testing.assert_allclose(data.world_color, (0.3, 0.2, 0.1), atol=1e-6)
+
+    # A Texture Coordinate's Object output: the object's inverse rotation and scale.
+    empty = bpy.data.objects.new("Frame", None)
+    scene.collection.objects.link(empty)
+    empty.rotation_euler = (0.0, 0.0, 0.5)
+    bpy.context.view_layer.update()
+    world = _environment_world(scene, image, coordinates="Object")
+    world.node_tree.nodes["Texture Coordinate"].object = empty
+    env = export.export_context().world_environment
+    np.testing.assert_allclose(env.matrix[:3, :3],
+                               np.linalg.inv(np.array(empty.matrix_world)[:3, :3]), atol=1e-6)
+
+
 helpers.run([
     test_particle_hair_viewport,
     test_curves_object,
@@ -389,4 +472,5 @@ helpers.run([
     test_disabled_modifier_and_strands,
     test_no_camera,
     test_render_mode_export_through_engine,
+    test_environment_world,
 ])

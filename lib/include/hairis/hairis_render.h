@@ -3,7 +3,8 @@
  * Conventions as hairis.h: options strings, status codes, hairis_last_error().
  *
  * Lights, materials, the world, the camera and the render settings are option strings
- * (hairis_defaults("sun"), ... list every name with its default); geometry is arrays.
+ * (hairis_defaults("sun"), "point", "spot", "area", "world", ... list every name with its
+ * default); geometry and world pixels are arrays.
  * Matrices are 16 numbers, row-major, object-to-world, as Blender's matrix_world.
  */
 #ifndef HAIRIS_RENDER_H
@@ -46,11 +47,44 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
 /**
  * Adds a light from options, in Blender's units and names: "type=sun" (direction towards the
  * sun, color, strength W/m², angle), "type=point" (position, color, power W, radius),
+ * "type=spot" (matrix: the light object's, shining along its -Z; color, power W, radius =
+ * shadow_soft_size, spot_size = the full cone angle in radians [1°, 180°], spot_blend [0, 1]),
  * "type=area" (matrix, shape square | rectangle | disk | ellipse, size, size_y, color, power).
+ * Every light takes cycles=3.4 (default) | 4.5: the Cycles whose conversion it follows (4.5
+ * for Blender 4.1 to 5.0: area lights 4/pi brighter, suns a cone of constant radiance, spots
+ * without 3.4's cosine and shaped in the light's scaled frame); points and spots also take
+ * soft_falloff=1 (default; Blender 4.1+'s Soft Falloff) | 0 (a sphere; needs cycles=4.5).
  */
 HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options);
-/** The world from options: color, strength (a constant background). */
+/**
+ * The world from options. Without an image: a constant background of radiance color ×
+ * strength (color default 0,0,0), never light-sampled. With image=<path> (a file OpenImageIO
+ * reads, e.g. EXR or Radiance HDR; the path may not hold ';' nor start or end with a space:
+ * use hairis_scene_set_world_pixels then): Cycles' Background fed by an Environment Texture
+ * (equirectangular, linear interpolation), radiance = color × strength × texture, color then
+ * defaulting to 1,1,1. color_space = auto (float files linear, 8-bit files sRGB) | linear |
+ * srgb. The lookup direction is Mapping(matrix · d): matrix (16 numbers, row-major, default
+ * identity) maps world directions first (e.g. a Texture Coordinate Object output: the
+ * object's inverse matrix, without translation), then the Mapping node: mapping = point |
+ * texture | vector | normal, rotation (XYZ Euler, radians), scale (its Location must be 0 and
+ * is not taken). sampling = auto (default: light-sampled with an importance map at the
+ * image's resolution, at most 8192 x 4096) | manual (map_resolution x map_resolution/2,
+ * map_resolution in [1, 8192], default 1024) | none (not light-sampled: found by BSDF rays
+ * alone), as World > Settings > Sampling. Environment options other than their defaults are
+ * refused without an environment. The image is read and its importance map built here.
+ */
 HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const char *options);
+/**
+ * The world as hairis_scene_set_world with an environment whose image is `pixels`: width ×
+ * height pixels of `channels` (1 grey, 2 grey + alpha, 3 RGB, 4 RGBA; alpha is ignored)
+ * floats, the BOTTOM row first (Blender's Image.pixels). Options as hairis_scene_set_world's,
+ * without image; color_space must be linear or srgb (srgb: the stored values are sRGB-encoded
+ * and decoded after interpolation, as Cycles does). Every value must be finite and >= 0. The
+ * pixels are copied.
+ */
+HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *options,
+                                             const float *pixels, size_t width, size_t height,
+                                             int channels);
 /**
  * The camera from options: matrix (camera-to-world; Blender's camera looks down -Z, +Y up),
  * orthographic (0 | 1), frame (Camera.view_frame's 4 corners in camera space, 12 numbers: top
