@@ -84,6 +84,7 @@ PROTOTYPES = {
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, F, c_size_t, c_size_t, c_int]),
     "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
     "hairis_render": (c_int, [c_void_p, c_char_p, F, PROGRESS_FN, c_void_p]),
     "hairis_last_render_stats": (c_char_p, []),

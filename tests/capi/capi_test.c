@@ -463,8 +463,8 @@ static void test_option_strings(void)
     }
     CHECK(hairis_fiber_create("model=hair") == NULL, "an unknown model");
     CHECK_ERROR_MENTIONS("marschner");
-    CHECK(hairis_scene_add_light(g_option_scene, "type=spot") != HAIRIS_OK, "a spot light");
-    CHECK_ERROR_MENTIONS("area");
+    CHECK(hairis_scene_add_light(g_option_scene, "type=tube") != HAIRIS_OK, "a tube light");
+    CHECK_ERROR_MENTIONS("spot");
     CHECK(hairis_scene_add_light(g_option_scene, "strength=2") != HAIRIS_OK, "a light without type");
     CHECK_ERROR_MENTIONS("type");
     CHECK(hairis_scene_add_surface_material(g_option_scene, "type=glossy") < 0, "glossy");
@@ -1934,6 +1934,50 @@ static void test_scene_refusals(void)
     CHECK_ERROR_MENTIONS("color");
     CHECK(hairis_scene_set_world(NULL, "") == HAIRIS_ERROR_INVALID_ARGUMENT, "world: NULL scene");
     CHECK_ERROR_MENTIONS("scene");
+    CHECK(hairis_scene_set_world(scene, "image=/nonexistent/sky.exr") != HAIRIS_OK,
+          "world: a missing image");
+    CHECK_ERROR_MENTIONS("sky.exr");
+    CHECK(hairis_scene_set_world(scene, "sampling=manual") == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "world: environment options without an environment");
+    CHECK_ERROR_MENTIONS("sampling");
+
+    /* World pixels: a valid 4 x 2 RGB image, then each bad argument named. */
+    float sky[4 * 2 * 3];
+    for (int i = 0; i < 24; ++i) sky[i] = 0.1f * (float)(i % 5);
+    CHECK(hairis_scene_set_world_pixels(scene, "color_space=linear", sky, 4, 2, 3) == HAIRIS_OK,
+          "world pixels (%s)", hairis_last_error());
+    CHECK(hairis_scene_set_world_pixels(scene, "color_space=linear", NULL, 4, 2, 3) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "world pixels: NULL");
+    CHECK_ERROR_MENTIONS("pixels");
+    CHECK(hairis_scene_set_world_pixels(scene, "color_space=linear", sky, 4, 2, 5) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "world pixels: 5 channels");
+    CHECK_ERROR_MENTIONS("channels");
+    CHECK(hairis_scene_set_world_pixels(scene, "color_space=linear", sky, 0, 2, 3) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "world pixels: zero width");
+    CHECK_ERROR_MENTIONS("width");
+    sky[7] = -1.0f;
+    CHECK(hairis_scene_set_world_pixels(scene, "color_space=linear", sky, 4, 2, 3) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "world pixels: a negative value");
+    CHECK_ERROR_MENTIONS("pixel");
+    sky[7] = 0.0f;
+    CHECK(hairis_scene_set_world_pixels(scene, "image=a.exr", sky, 4, 2, 3) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "world pixels: with an image path");
+    CHECK_ERROR_MENTIONS("image");
+
+    const char *spots[][2] = {
+        {"type=spot;spot_size=0", "spot_size"},
+        {"type=spot;spot_blend=1.5", "spot_blend"},
+        {"type=spot;radius=-1", "radius"},
+        {"type=spot;cycles=4.0", "cycles"},
+        {"type=point;soft_falloff=0", "soft_falloff"},
+    };
+    for (size_t i = 0; i < sizeof spots / sizeof spots[0]; ++i) {
+        CHECK(hairis_scene_add_light(scene, spots[i][0]) == HAIRIS_ERROR_INVALID_ARGUMENT,
+              "light \"%s\" refused", spots[i][0]);
+        CHECK_ERROR_MENTIONS(spots[i][1]);
+    }
+    CHECK(hairis_scene_add_light(scene, "type=spot;cycles=4.5;soft_falloff=0;spot_size=0.5") ==
+              HAIRIS_OK, "a 4.5 sphere spot (%s)", hairis_last_error());
 
     const char *bad_cameras[][2] = {
         {"width=0", "width"},
