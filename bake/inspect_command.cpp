@@ -1,5 +1,7 @@
 // hairis-bake inspect: print a table file's metadata and validate it.
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "commands.h"
@@ -29,7 +31,30 @@ int run_inspect(const std::string &path) {
     std::printf("phi cells:       %d\n", s.phi_count);
     std::printf("n_h values:     ");
     for (int n : s.n_h_values) std::printf(" %d", n);
-    std::printf("\nimage:           %d x %d RGBA float\n", s.phi_count, s.theta_r_count() * s.theta_i_count);
+    std::printf("\nparts:\n");
+    const int far_rows = s.theta_r_count() * s.theta_i_count;
+    int width = s.phi_count, rows = far_rows;
+    std::printf("  far    rows %d-%d: %d theta_r nodes x %d theta_i cells, %d phi cells "
+                "(R direct density, G multiple density in %zu n_h bands)\n",
+                0, far_rows - 1, s.theta_r_count(), s.theta_i_count, s.phi_count, s.n_h_values.size());
+    if (s.near_field) {
+        const NearFieldData &n = *s.near_field;
+        static const char *const kLobes[4] = {"R", "TT", "TRT", "TRRT+"};
+        int cones[4] = {};
+        for (int row = 0; row < n.rows(); ++row) cones[row % 4] += n.cone[std::size_t(row)] ? 1 : 0;
+        std::printf("  near   rows %d-%d: %d theta_o nodes (-90 .. 90 deg) x 4 lobes, %d theta_i cells "
+                    "(R cell mass, G edge value, B lobe integral, A cone flag)\n",
+                    rows, rows + n.rows() - 1, n.theta_o_nodes, n.theta_i_cells);
+        std::printf("         nodes drawing theta_i from the fiber's cone:");
+        for (int p = 0; p < 4; ++p) std::printf(" %s %d", kLobes[p], cones[p]);
+        std::printf("\n");
+        rows += n.rows();
+        width = std::max(width, n.theta_i_cells + 1);
+    }
+    std::error_code size_error;
+    const auto bytes = std::filesystem::file_size(path, size_error);
+    std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", width, rows,
+                double(width) * rows * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
     std::printf("valid:           yes (metadata, sizes, values and pixel hash checked)\n");
     return 0;
 }

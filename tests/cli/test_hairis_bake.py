@@ -52,7 +52,8 @@ class HairisBakeTest(unittest.TestCase):
         r = run("inspect", out)
         self.assertEqual(r.returncode, 0, r.stderr)
         for text in ["chiang2016", "theta_r nodes:   5", "theta_i cells:   16", "n_h values:      1 2",
-                     "valid:           yes"]:
+                     "far    rows 0-79: 5 theta_r nodes x 16 theta_i cells",
+                     "near   rows 80-", "x 4 lobes", "valid:           yes"]:
             self.assertIn(text, r.stdout)
 
     def test_bake_is_deterministic_whatever_the_thread_count(self):
@@ -76,7 +77,9 @@ class HairisBakeTest(unittest.TestCase):
             r = run("bake", "--preset", preset, "--theta-r", "3", "--theta-i", "8", "--phi", "8",
                     "--quadrature", "1", "--n-h", "1", "-q", "-o", out)
             self.assertEqual(r.returncode, 0, r.stderr)
-            self.assertIn(model, run("inspect", out).stdout)
+            described = run("inspect", out).stdout
+            self.assertIn(model, described)
+            self.assertNotIn("near   rows", described, "a Marschner table has no near part")
 
     def test_gaussian_source(self):
         out = self.path("g.exr")
