@@ -10,6 +10,7 @@
 #include "npy.h"
 #include "seed_fits.h"
 #include "seed_tables.h"
+#include "tables/table_file.h"
 
 namespace hairis::cli {
 
@@ -17,6 +18,7 @@ namespace {
 
 struct FiguresFlags {
     std::string output;
+    std::string table;  // draw this table file's parts instead of the seed's figures
     FiberOptions fiber;
     int theta_count = 90;
     int phi_count = 180;
@@ -34,11 +36,73 @@ std::string quoted(const std::string &s) {
     return out + "'";
 }
 
+// Runs a plotting script on `dir`; `what` names the PNGs for the message.
+int plot(const char *script_env_name, const std::string &default_script, const std::string &dir,
+         const std::string &label, const std::string &what) {
+    const char *script_env = std::getenv(script_env_name);
+    const std::string script = script_env ? script_env : default_script;
+    if (!std::filesystem::exists(script))
+        return fail("the plotting script \"" + script + "\" is missing (set " + script_env_name + ")");
+    // Debian's python3 has Debian's matplotlib; a python3 earlier on PATH (pyenv, venv) may not.
+    const char *python_env = std::getenv("HAIRIS_PYTHON");
+    const std::string python = python_env ? python_env
+                               : std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string command = quoted(python) + " " + quoted(script) + " " + quoted(dir) + " --model " + quoted(label);
+    const int status = std::system(command.c_str());
+    if (status != 0)
+        return fail("the plotting script failed (exit status " + std::to_string(status) +
+                    "); it needs python3 with numpy and matplotlib (scripts/setup installs them)");
+    std::cerr << "hairis-bake figures: wrote " << what << " to " << dir << "\n";
+    return 0;
+}
+
+// The parts of a table file as arrays: far direct [θ_r][θ_i][φ], multiple [θ_r][n_h][θ_i],
+// theta_r nodes; near (Chiang) cell densities [θ_o][lobe][θ_i] (mass / cell width, each row
+// normalised to integrate to 1) and the cone flags [θ_o][lobe].
+int run_table_figures(const FiguresFlags &flags, const std::filesystem::path &dir) {
+    Expected<TableSet> t = read_table_file(flags.table);
+    if (!t) return fail(t.error().message);
+    const TableSet &s = t.value();
+    const size_t nr = size_t(s.theta_r_count()), ni = size_t(s.theta_i_count), np = size_t(s.phi_count);
+    std::vector<float> nodes(s.theta_r_nodes.begin(), s.theta_r_nodes.end());
+    std::vector<float> n_h(s.n_h_values.begin(), s.n_h_values.end());
+    std::vector<std::pair<std::string, Status>> writes = {
+        {"table_far.npy", write_npy((dir / "table_far.npy").string(), s.direct, {nr, ni, np})},
+        {"table_multiple.npy",
+         write_npy((dir / "table_multiple.npy").string(), s.multiple, {nr, s.n_h_values.size(), ni})},
+        {"table_theta_r.npy", write_npy((dir / "table_theta_r.npy").string(), nodes, {nr})},
+        {"table_n_h.npy", write_npy((dir / "table_n_h.npy").string(), n_h, {n_h.size()})}};
+    if (s.near_field) {
+        const NearFieldData &n = *s.near_field;
+        const size_t cells = size_t(n.theta_i_cells), rows = size_t(n.rows());
+        std::vector<float> density(rows * cells), cone(rows);
+        const double width = kPi / double(cells);
+        for (size_t row = 0; row < rows; ++row) {
+            double total = 0;
+            for (size_t k = 0; k < cells; ++k) total += n.mass[row * cells + k];
+            for (size_t k = 0; k < cells; ++k)
+                density[row * cells + k] = total > 0 ? float(n.mass[row * cells + k] / (total * width)) : 0.0f;
+            cone[row] = float(n.cone[row]);
+        }
+        writes.push_back({"table_near.npy", write_npy((dir / "table_near.npy").string(), density,
+                                                      {size_t(n.theta_o_nodes), 4, cells})});
+        writes.push_back({"table_near_cone.npy",
+                          write_npy((dir / "table_near_cone.npy").string(), cone, {size_t(n.theta_o_nodes), 4})});
+    }
+    for (const auto &[name, status] : writes)
+        if (status) return fail(status->message);
+    if (flags.data_only) return 0;
+    return plot("HAIRIS_TABLE_FIGURES_SCRIPT", HAIRIS_TABLE_FIGURES_SCRIPT, flags.output,
+                s.model + " table " + std::filesystem::path(flags.table).filename().string(),
+                "the table's part PNGs");
+}
+
 int run_figures(const FiguresFlags &flags) {
     std::error_code ec;
     std::filesystem::create_directories(flags.output, ec);
     if (ec) return fail("cannot create \"" + flags.output + "\": " + ec.message());
     const std::filesystem::path dir(flags.output);
+    if (!flags.table.empty()) return run_table_figures(flags, dir);
     Expected<FiberSpec> spec = flags.fiber.resolve();
     if (!spec) return fail(spec.error().message);
     auto model = spec.value().create_model();
@@ -96,22 +160,8 @@ int run_figures(const FiguresFlags &flags) {
     if (fits != 0) return fits;
     if (flags.data_only) return 0;
 
-    const char *script_env = std::getenv("HAIRIS_FIGURES_SCRIPT");
-    const std::string script = script_env ? script_env : HAIRIS_FIGURES_SCRIPT;
-    if (!std::filesystem::exists(script))
-        return fail("the plotting script \"" + script + "\" is missing (set HAIRIS_FIGURES_SCRIPT)");
-    // Debian's python3 has Debian's matplotlib; a python3 earlier on PATH (pyenv, venv) may not.
-    const char *python_env = std::getenv("HAIRIS_PYTHON");
-    const std::string python = python_env ? python_env
-                               : std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    const std::string command = quoted(python) + " " + quoted(script) + " " + quoted(flags.output) + " --model " +
-                                quoted(model.value()->name() + " (" + flags.fiber.preset + ")");
-    const int status = std::system(command.c_str());
-    if (status != 0)
-        return fail("the plotting script failed (exit status " + std::to_string(status) +
-                    "); it needs python3 with numpy and matplotlib (scripts/setup installs them)");
-    std::cerr << "hairis-bake figures: wrote figure1..4 PNGs and fit tables to " << flags.output << "\n";
-    return 0;
+    return plot("HAIRIS_FIGURES_SCRIPT", HAIRIS_FIGURES_SCRIPT, flags.output,
+                model.value()->name() + " (" + flags.fiber.preset + ")", "figure1..4 PNGs and fit tables");
 }
 
 }  // namespace
@@ -127,6 +177,10 @@ void add_figures_command(CLI::App &app, int &exit_code) {
     cmd->add_option("--phi", flags->phi_count, "phi cells per panel")
         ->check(CLI::Range(8, 2048))->capture_default_str();
     cmd->add_flag("--data-only", flags->data_only, "write the .npy data and fit tables but no PNGs");
+    cmd->add_option("--table", flags->table,
+                    "draw this table file's parts (far direct and multiple, Chiang's near field) "
+                    "instead of the seed's figures")
+        ->check(CLI::ExistingFile);
     cmd->callback([flags, &exit_code] { exit_code = run_figures(*flags); });
 }
 

@@ -66,8 +66,10 @@ def write_benchmarks(folder, data):
                 "otherwise.\n\n| benchmark | what | time | per second |\n|---|---|---|---|\n"
                 % machine())
         for name, label, ns, items in rows:
-            time = "%.0f ns" % ns if ns < 1e5 else ("%.1f ms" % (ns / 1e6) if ns < 1e9
-                                                     else "%.2f s" % (ns / 1e9))
+            if ns < 1e5:
+                time = "%.0f ns" % ns
+            else:
+                time = "%.1f ms" % (ns / 1e6) if ns < 1e9 else "%.2f s" % (ns / 1e9)
             rate = "%.2f M" % (items / 1e6) if items else ""
             f.write("| %s | %s | %s | %s |\n" % (name, label, time, rate))
     return rows
@@ -128,7 +130,8 @@ def find(rows, prefix):
 
 
 def write_summary(folder, rows, study, export, render):
-    lines = ["# Issue 6 targets, measured", "", "Machine: %s. Reproduce: `scripts/bench`." % machine(),
+    lines = ["# Issue 6 targets, measured", "",
+             "Machine: %s. Reproduce: `scripts/bench`." % machine(),
              "", "| target | measured | met |", "|---|---|---|"]
 
     def add(target, measured, met):
@@ -140,9 +143,11 @@ def write_summary(folder, rows, study, export, render):
         table = median.get("table, near-field (w=0)")
         analytic, uniform = median.get("analytic"), median.get("uniform")
         if table is not None and analytic and uniform:
-            add("table variance ≤ 0.5× analytic (near field, median over θ_r, median over six fibers)",
-                "%.2g vs %.2g (%.4f×)" % (table, analytic, table / analytic), table <= 0.5 * analytic)
-            add("table variance ≤ 1/50 of uniform", "%.2g vs %.2g (1/%.0f)" % (table, uniform, uniform / table),
+            add("table variance ≤ 0.5× analytic (near field, median over θ_r, median over six "
+                "fibers)", "%.2g vs %.2g (%.4f×)" % (table, analytic, table / analytic),
+                table <= 0.5 * analytic)
+            add("table variance ≤ 1/50 of uniform",
+                "%.2g vs %.2g (1/%.0f)" % (table, uniform, uniform / table),
                 table <= uniform / 50)
     if rows:
         analytic = find(rows, "sample_and_pdf/analytic")
@@ -162,7 +167,8 @@ def write_summary(folder, rows, study, export, render):
     if equal:
         # Hairis' best strategy at each of Cycles' render times.
         for k, cycles in enumerate(next(iter(equal.values()))):
-            best = min(((name, rows[k]) for name, rows in equal.items()), key=lambda e: e[1]["ratio"])
+            best = min(((name, rows[k]) for name, rows in equal.items()),
+                       key=lambda e: e[1]["ratio"])
             add("equal time (%.1f s, Cycles at %d spp): Hairis' best RMSE ≤ Cycles'"
                 % (cycles["seconds"], cycles["cycles_spp"]),
                 "%s: %.2f× Cycles' RMSE%s" % (best[0], best[1]["ratio"],
@@ -180,7 +186,8 @@ def write_summary(folder, rows, study, export, render):
 
 
 def main():
-    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "results")
+    folder = (sys.argv[1] if len(sys.argv) > 1
+              else os.path.join(os.path.dirname(__file__), "results"))
     benchmarks = load(folder, "benchmarks.json")
     study = load(folder, "strategy_study.json")
     rows = write_benchmarks(folder, benchmarks) if benchmarks else []

@@ -34,7 +34,9 @@ def grid_figure(panels, rows, cols, row_labels, col_labels, title, path, norm):
             ax = axes[r][c]
             # Rows of the data are θ_i, columns φ_i: show θ_i across, φ_i up.
             # Zeros (outside the lobes) have no logarithm: clip them to the scale's floor.
-            data = np.maximum(panels[r][c], norm.vmin) if isinstance(norm, LogNorm) else panels[r][c]
+            data = panels[r][c]
+            if isinstance(norm, LogNorm):
+                data = np.maximum(data, norm.vmin)
             image = ax.imshow(data.T, origin="lower", extent=EXTENT, aspect="auto",
                               cmap="inferno", norm=norm)
             if r == 0:
@@ -118,7 +120,8 @@ def main():
             gauss = s * np.exp(-0.5 * ((rad - mean) / sigma) ** 2) / (sigma * np.sqrt(2 * np.pi))
             ax.plot(theta, profiles[k, c], color="tab:blue", label="distribution")
             ax.plot(theta, gauss, color="tab:green", label="fitted Gaussian")
-            ax.set_title(f"n_h = {n_h}, θ_r = {theta_r}°: σ = {sigma:.2f}, μ = {np.degrees(mean):.1f}°",
+            ax.set_title(f"n_h = {n_h}, θ_r = {theta_r}°: σ = {sigma:.2f}, "
+                         f"μ = {np.degrees(mean):.1f}°",
                          fontsize=8)
             ax.tick_params(labelsize=7)
             if k == 3:

@@ -13,7 +13,8 @@ import sys
 
 import bpy
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "blender"))
 import helpers  # noqa: E402  (scene-building helpers shared with the add-on's tests)
 
 ARGS, PACKAGE = helpers.setup()

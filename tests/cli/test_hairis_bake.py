@@ -5,7 +5,6 @@ Usage: test_hairis_bake.py PATH/TO/hairis-bake
 """
 import os
 import shutil
-import signal
 import stat
 import subprocess
 import sys
@@ -51,7 +50,8 @@ class HairisBakeTest(unittest.TestCase):
         self.assertTrue(os.path.getsize(out) > 0)
         r = run("inspect", out)
         self.assertEqual(r.returncode, 0, r.stderr)
-        for text in ["chiang2016", "theta_r nodes:   5", "theta_i cells:   16", "n_h values:      1 2",
+        for text in ["chiang2016", "theta_r nodes:   5", "theta_i cells:   16",
+                     "n_h values:      1 2",
                      "far    rows 0-79: 5 theta_r nodes x 16 theta_i cells",
                      "near   rows 80-", "x 4 lobes", "valid:           yes"]:
             self.assertIn(text, r.stdout)
@@ -216,13 +216,43 @@ class HairisBakeTest(unittest.TestCase):
 
     def test_figures(self):
         out = self.path("figures")
-        r = run("figures", "--preset", "cycles-default", "--theta-i", "24", "--phi", "32", "-o", out)
+        r = run("figures", "--preset", "cycles-default", "--theta-i", "24", "--phi", "32",
+                "-o", out)
         self.assertEqual(r.returncode, 0, r.stderr)
         for name in ["figure1.png", "figure2.png", "figure3.png", "figure4.png", "fits.md"]:
             path = os.path.join(out, name)
             self.assertTrue(os.path.getsize(path) > 0, name)
         with open(os.path.join(out, "figure1.png"), "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+
+    def test_figures_of_a_table(self):
+        table = self.path("t.exr")
+        self.assertEqual(run("bake", *SMALL, "-q", "-o", table).returncode, 0)
+        out = self.path("table_figures")
+        r = run("figures", "--table", table, "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for name in ["table_far.png", "table_multiple.png", "table_near.png"]:
+            with open(os.path.join(out, name), "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", name)
+        import numpy as np
+        far = np.load(os.path.join(out, "table_far.npy"))
+        self.assertEqual(far.shape, (5, 16, 16))
+        self.assertTrue((far >= 0).all() and (far > 0).any())
+        near = np.load(os.path.join(out, "table_near.npy"))
+        self.assertEqual(near.shape[1], 4)
+        # Each near row is a density over θ_i: it integrates to 1 ...
+        width = np.pi / near.shape[2]
+        np.testing.assert_allclose(near.sum(axis=2) * width, 1.0, rtol=1e-4)
+        # ... and the R lobe follows the specular cone θ_i ≈ −θ_o (slope −1 across the nodes).
+        theta_o = np.linspace(-90, 90, near.shape[0])
+        centres = -90 + (np.arange(near.shape[2]) + 0.5) * 180 / near.shape[2]
+        rows = np.nonzero(np.abs(theta_o) < 60)[0]
+        peaks = centres[np.argmax(near[rows, 0], axis=1)]
+        slope = np.polyfit(theta_o[rows], peaks, 1)[0]
+        self.assertTrue(-1.15 < slope < -0.85, "R lobe peak slope %.3f" % slope)
+        r = run("figures", "--table", self.path("missing.exr"), "-o", out)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("missing.exr", r.stderr)
 
     def test_figures_unwritable(self):
         r = run("figures", "-o", "/proc/hairis/figures")
