@@ -1,12 +1,11 @@
 """The main job's render: a demo hair scene built by script and rendered headless with Hairis.
 
-Run by scripts/main as
-    blender -b --factory-startup --python-exit-code 1 --python scripts/render_demo.py -- \
-        --zip build/hairis-addon.zip --workdir out/demo
-with BLENDER_USER_SCRIPTS pointing to an empty folder. It installs and enables the add-on,
-builds a head of particle hair (with interpolated children) under a sun and a sky, saves the
-.blend, bakes the sampling tables next to it (bpy.ops.hairis.bake_tables), renders with the
-TABLE strategy and writes out/demo/demo.png.
+Run by scripts/main through tests/blender/run_test.py (in Blender 3.4, or bpy 4.5 / 5.0), as
+the Blender tests are, with HAIRIS_DEMO_OUT naming the output folder (default: the run's
+--workdir). It installs and enables the add-on, builds a head of particle hair (with
+interpolated children) under a sun and a sky, saves the .blend, bakes the sampling tables next
+to it (bpy.ops.hairis.bake_tables), renders with the TABLE strategy and writes demo.blend, its
+tables and demo.png to the output folder.
 """
 import os
 import sys
@@ -29,18 +28,19 @@ def main():
     settings.auto_bake = True
     bpy.context.view_layer.update()
 
-    os.makedirs(ARGS.workdir, exist_ok=True)
-    blend = os.path.join(os.path.abspath(ARGS.workdir), "demo.blend")
+    out = os.path.abspath(os.environ.get("HAIRIS_DEMO_OUT") or ARGS.workdir)
+    os.makedirs(out, exist_ok=True)
+    blend = os.path.join(out, "demo.blend")
     bpy.ops.wm.save_as_mainfile(filepath=blend)
     assert bpy.ops.hairis.bake_tables() == {"FINISHED"}, "baking the sampling tables failed"
     bpy.ops.wm.save_mainfile()
     bpy.ops.render.render()
     image = bpy.data.images["Render Result"]
-    path = os.path.join(os.path.abspath(ARGS.workdir), "demo.png")
+    path = os.path.join(out, "demo.png")
     scene.render.image_settings.file_format = "PNG"
     image.save_render(path, scene=scene)
     assert os.path.getsize(path) > 0, "no image was written"
-    print("render_demo: wrote %s" % path)
+    print("render_demo: wrote %s (Blender %s)" % (path, bpy.app.version_string))
 
 
-main()
+helpers.run([main])

@@ -36,11 +36,23 @@ double lobe_peak(const ChiangFiber &fiber, int p, double theta_o) {
     return best;
 }
 
+// Only a : b matters. Edges whose sum could overflow (a table file may hold any finite
+// value) or whose products underflow are scaled so that the larger is 1, as the sampler
+// (sample_cell_shape) scales them.
+void scale_edges(float &a, float &b) {
+    const float larger = a > b ? a : b;
+    if (larger > 0.0f && (larger < 1e-18f || larger > 1e18f)) {
+        a /= larger;
+        b /= larger;
+    }
+}
+
 // Inside a cell the density is linear in t ∈ [0, 1] between the edge values a and b:
 // g(t) = 2((1 − t)a + tb)/(a + b), uniform when both are zero. The cell's mass comes from
 // the exact integral, so a lobe narrower than a cell keeps its mass even when M_p at both
 // edges underflows.
 float cell_shape(float a, float b, float t) {
+    scale_edges(a, b);
     const float sum = a + b;
     return sum > 0.0f ? 2.0f * ((1.0f - t) * a + t * b) / sum : 1.0f;
 }
@@ -292,14 +304,9 @@ float clamp_unit(float u) { return u > 0.0f ? (u < kOneMinusEpsilon ? u : kOneMi
 
 // Inverse of g's CDF: t = u(a + b)/(a + sqrt((1 − u)a² + ub²)), stable also for a = b.
 float sample_cell_shape(float a, float b, float u) {
-    // Only a : b matters. Edges of a lobe narrower than its cell can be ~10⁻²⁹, whose square
-    // is 0 in float (which made the sampler uniform where the density was linear): such
-    // edges, and any whose square could overflow, are scaled so that the larger is 1.
-    const float larger = a > b ? a : b;
-    if (larger > 0.0f && (larger < 1e-18f || larger > 1e18f)) {
-        a /= larger;
-        b /= larger;
-    }
+    // Edges of a lobe narrower than its cell can be ~10⁻²⁹, whose square is 0 in float (which
+    // made the sampler uniform where the density was linear): scale_edges.
+    scale_edges(a, b);
     const float sum = a + b;
     if (!(sum > 0.0f)) return u;
     const float root = std::sqrt((1.0f - u) * a * a + u * b * b);

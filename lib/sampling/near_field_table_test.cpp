@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "chi2.h"
@@ -315,6 +316,60 @@ TEST(NearFieldTable, SmoothFibersSampleBetterThanWithRowsAloneAndThanTheAnalytic
         }
         EXPECT_LT(v_table, 0.5 * v_analytic) << roughness << ": table " << v_table << ", analytic " << v_analytic;
         EXPECT_LT(v_table, 0.5 * v_rows) << roughness << ": table " << v_table << ", rows alone " << v_rows;
+    }
+}
+
+TEST(NearFieldTable, EdgeValuesOfAnyScaleGiveTheSameDensity) {
+    // Only the ratio of a cell's two edge values shapes it, and a table file may scale a row's
+    // edges by anything finite: up to the largest float (their sum overflows) or down into the
+    // subnormals (their products underflow). The density must stay the unscaled table's, and
+    // its sampler exact (found by fuzzing table files: the density was NaN or infinite).
+    NearFieldTableOptions rows;
+    rows.theta_o_nodes = 13;
+    rows.theta_i_cells = 30;
+    rows.lobe_sampling = {LobeSampling::Table, LobeSampling::Table, LobeSampling::Table, LobeSampling::Table};
+    const auto f = fiber();
+    const NearFieldTable table = NearFieldTable::create(f, rows).value();
+    const NearFieldData &d = table.data();
+    for (const bool up : {true, false}) {
+        auto scaled = std::make_shared<NearFieldData>(d);
+        const size_t width = size_t(d.theta_i_cells) + 1;
+        for (int row = 0; row < d.rows(); ++row) {
+            float *e = scaled->edge.data() + size_t(row) * width;
+            const float largest = *std::max_element(e, e + width);
+            float smallest = largest;
+            for (size_t k = 0; k < width; ++k)
+                if (e[k] > 0.0f) smallest = std::min(smallest, e[k]);
+            ASSERT_GT(largest, 0.0f);
+            // Up: the largest becomes FLT_MAX; down: the smallest positive one the smallest
+            // normal float, 2^-126 (so every square is 0, and no edge loses digits).
+            const double factor = up ? double(std::numeric_limits<float>::max()) / double(largest)
+                                     : double(std::numeric_limits<float>::min()) / double(smallest);
+            for (size_t k = 0; k < width; ++k) e[k] = float(std::min(double(e[k]) * factor, double(std::numeric_limits<float>::max())));
+        }
+        const auto loaded = std::make_shared<const NearFieldTable>(NearFieldTable::from_data(f, scaled).value());
+        for (const double theta_o : {-52.0, 10.0, 71.5})
+            for (int i = 0; i < 60; ++i)
+                for (int j = 0; j < 12; ++j) {
+                    const double s = -1.0 + (i + 0.5) / 30.0;
+                    const Vec3 wi = direction_of(float(std::asin(s)), float(-kPi + kTwoPi * (j + 0.5) / 12));
+                    const float expected = table.pdf(wi, view_at(theta_o), 0.3f), got = loaded->pdf(wi, view_at(theta_o), 0.3f);
+                    ASSERT_TRUE(std::isfinite(got)) << (up ? "up" : "down") << " theta_o " << theta_o << " sin " << s;
+                    ASSERT_NEAR(got, expected, 1e-5 * expected + 1e-12)
+                        << (up ? "up" : "down") << " theta_o " << theta_o << " sin " << s;
+                }
+        Chi2Options options;
+        options.test_count = 2;
+        for (int k = 0; k <= 30; ++k) options.theta_breaks.push_back(-kHalfPi + kPi * k / 30);
+        const Vec3 wo = view_at(10.0);
+        const auto r = testing::chi2_direction_test(
+            [&](Sample3 u) -> std::optional<Vec3> {
+                auto smp = loaded->sample(wo, 0.3f, u.u0, u.u1, u.u2);
+                return smp ? std::optional<Vec3>(smp->wi) : std::nullopt;
+            },
+            [&](Vec3 wi) { return double(loaded->pdf(wi, wo, 0.3f)); }, options);
+        EXPECT_TRUE(r.passed) << (up ? "up" : "down") << ": " << r.message;
+        EXPECT_EQ(r.failed_samples, 0);
     }
 }
 

@@ -54,6 +54,15 @@ public:
     }
 };
 
+// The image of a table file: as wide as the far part's φ cells or the near part's θ_i cells
+// and their upper edge, whichever is wider, and at most kMaxTableCells pixels in all.
+constexpr long long kMaxImageWidth = kMaxTableAxisCells + 1;
+constexpr long long kMaxImagePixels = kMaxTableCells;
+
+std::string image_limits() {
+    return std::to_string(kMaxImageWidth) + " columns and " + std::to_string(kMaxImagePixels) + " pixels";
+}
+
 // Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
 int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
 
@@ -208,10 +217,9 @@ Status check_exr_header(const unsigned char *data, size_t size) {
             if (type != "box2i" || length != 16) return file_error("dataWindow must be a box2i");
             const long long width = (long long)read_int(at + 8) - read_int(at) + 1;
             const long long height = (long long)read_int(at + 12) - read_int(at + 4) + 1;
-            if (width < 1 || height < 1 || width > kMaxTableAxisCells || width * height > kMaxTableCells)
+            if (width < 1 || height < 1 || width > kMaxImageWidth || width * height > kMaxImagePixels)
                 return file_error("the image is " + std::to_string(width) + "x" + std::to_string(height) +
-                                  " pixels; a table has at most " + std::to_string(kMaxTableAxisCells) +
-                                  " columns and " + std::to_string(kMaxTableCells) + " pixels");
+                                  " pixels; a table has at most " + image_limits());
         }
         at += size_t(length);
     }
@@ -223,6 +231,11 @@ Status check_exr_header(const unsigned char *data, size_t size) {
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     if (Status s = t.validate()) return *s;
     const Layout layout = Layout::of(t);
+    // Each part is within its limits, but a narrow far part of many rows padded to a wide
+    // near part's width may not be: checked before the image is allocated.
+    if (layout.width > kMaxImageWidth || layout.width * layout.height > kMaxImagePixels)
+        return file_error("the image would be " + std::to_string(layout.width) + "x" + std::to_string(layout.height) +
+                          " pixels; a table file holds at most " + image_limits() + " (bake fewer cells)");
     const std::vector<float> px = pixels_of(t);
 
     OIIO::ImageSpec spec(int(layout.width), int(layout.height), kChannels, TypeDesc::FLOAT);
@@ -306,6 +319,12 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;
     if (parts == "far,near") {
+        const OIIO::ParamValue *near_attribute = spec.find_attribute("hairis:near");
+        if (!near_attribute)
+            return file_error("hairis:parts is \"far,near\" but there is no hairis:near attribute");
+        if (near_attribute->type() != TypeDesc::STRING)
+            return file_error("hairis:near must be a string \"row=...;theta_o=...;theta_i=...\" (got a " +
+                              std::string(near_attribute->type().c_str()) + ")");
         Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:near"), "hairis:near");
         if (!reader) return file_error(reader.error().message);
         int row = -1;

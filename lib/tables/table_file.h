@@ -23,6 +23,7 @@
 // (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far" or "far,near"),
 // hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:pixel_sha1 (hex SHA-1 of the float
 // pixels in scanline order, RGBA interleaved, little-endian). Every pixel outside the parts is 0.
+// The image has at most kMaxTableAxisCells + 1 columns and kMaxTableCells pixels.
 // Version 1 files (no near part) are refused with a message asking for a re-bake.
 #pragma once
 
