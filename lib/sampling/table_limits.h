@@ -2,6 +2,8 @@
 // options or a caller's arrays can claim any size.
 #pragma once
 
+#include <string>
+
 #include "core/expected.h"
 
 namespace hairis {
@@ -30,6 +32,23 @@ struct TableResolution {
         if (cells() > kMaxTableCells)
             return Error{"theta_r_count x theta_i_count x phi_count = " + std::to_string(cells()) + " cells; at most " +
                          std::to_string(kMaxTableCells) + " are allowed"};
+        return std::nullopt;
+    }
+};
+
+/// The image of a table file (table_file.h): as wide as its widest part, as tall as all of
+/// them; at most kMaxTableAxisCells + 1 columns (a near part's cells and their upper edge) and
+/// kMaxTableCells pixels.
+struct TableImageSize {
+    long long width = 0;
+    long long height = 0;
+
+    Status validate() const {
+        constexpr long long kMaxWidth = kMaxTableAxisCells + 1;
+        if (width > kMaxWidth || width * height > kMaxTableCells)
+            return Error{"the image would be " + std::to_string(width) + "x" + std::to_string(height) +
+                         " pixels; a table file holds at most " + std::to_string(kMaxWidth) + " columns and " +
+                         std::to_string(kMaxTableCells) + " pixels (bake fewer cells)"};
         return std::nullopt;
     }
 };

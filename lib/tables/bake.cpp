@@ -150,6 +150,16 @@ Expected<TableSet> bake_tables(const FiberModel &model,
                                const std::vector<std::pair<std::string, double>> &parameters,
                                const BakeOptions &options, const ProgressFn &progress) {
     if (Status s = options.validate()) return *s;
+    // The file's image must hold the far part and, for Chiang, the near part: refused before
+    // the bake rather than by the writer after it.
+    const long long far_rows = (long long)options.theta_r_count * options.theta_i_count;
+    TableImageSize image{options.phi_count, far_rows};
+    if (dynamic_cast<const ChiangFiber *>(&model)) {
+        const NearFieldTableOptions near;
+        image.width = std::max<long long>(image.width, near.theta_i_cells + 1);
+        image.height += 4ll * near.theta_o_nodes;
+    }
+    if (Status s = image.validate()) return *s;
     // All the parallel work, the dual-scattering precomputation included, runs in an arena of
     // options.threads slots (a local limit: a process-wide tbb::global_control would also
     // throttle, or be overridden by, whatever else the host runs at the same time).

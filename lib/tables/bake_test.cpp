@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "fiber/chiang.h"
+#include "fiber/fiber_spec.h"
 #include "fiber/marschner.h"
 #include "sampling/sampling_table.h"
 
@@ -55,8 +56,8 @@ TEST(Bake, ExactTablesAreValidAndDeterministicAcrossThreadCounts) {
 }
 
 TEST(Bake, ChiangTablesAreDeterministicAcrossThreadCounts) {
-    // Chiang's far field remembers values per thread; the bake pairs θ_i rows for it. Odd
-    // θ_i count: the middle row has no partner.
+    // The bake splits the work across threads; the bytes must not depend on how. Odd θ_i
+    // count: the rows do not split evenly.
     BakeOptions one = small_options(), two = small_options();
     one.theta_r_count = two.theta_r_count = 3;
     one.theta_i_count = two.theta_i_count = 15;
@@ -134,6 +135,23 @@ TEST(Bake, RefusesBadOptions) {
     o.theta_i_count = 4000;
     o.phi_count = 4000;
     EXPECT_NE(bake_tables(blonde(), {}, o).error().message.find("cells; at most"), std::string::npos);
+}
+
+TEST(Bake, RefusesBeforeBakingWhatNoTableFileCouldHold) {
+    // 4M far rows of two φ cells are within the table limits, but padded to the near part's
+    // 91 columns they are not an image a file holds: refused before any progress.
+    BakeOptions o = small_options();
+    o.theta_r_count = 1024;
+    o.theta_i_count = 4096;
+    o.phi_count = 2;
+    o.n_h_values = {1, 2};
+    int calls = 0;
+    const ChiangFiber fiber = ChiangFiber::create({}).value();
+    const auto t = bake_tables(fiber, chiang_parameters({}), o, [&](float) { return ++calls > 0; });
+    ASSERT_FALSE(t.ok());
+    EXPECT_NE(t.error().message.find("the image would be 91x4194788 pixels"), std::string::npos)
+        << t.error().message;
+    EXPECT_EQ(calls, 0);
 }
 
 }  // namespace

@@ -233,9 +233,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     const Layout layout = Layout::of(t);
     // Each part is within its limits, but a narrow far part of many rows padded to a wide
     // near part's width may not be: checked before the image is allocated.
-    if (layout.width > kMaxImageWidth || layout.width * layout.height > kMaxImagePixels)
-        return file_error("the image would be " + std::to_string(layout.width) + "x" + std::to_string(layout.height) +
-                          " pixels; a table file holds at most " + image_limits() + " (bake fewer cells)");
+    if (Status s = TableImageSize{layout.width, layout.height}.validate()) return file_error(s->message);
     const std::vector<float> px = pixels_of(t);
 
     OIIO::ImageSpec spec(int(layout.width), int(layout.height), kChannels, TypeDesc::FLOAT);
