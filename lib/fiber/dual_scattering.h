@@ -28,8 +28,7 @@
 //                                               as variances, which is what a mixture of
 //                                               equal-mean Gaussians has)
 //         LobeShape is read as fiber.h defines it: shift and standard deviation of a Gaussian
-//         in θ_h. (chiang.h documents its lobe_shape in θ_i + θ_o = 2θ_h, i.e. twice the θ_h
-//         values; if that stays, Chiang's ᾱ, β̄, σ_f are twice what fiber.h promises.)
+//         in θ_h = (θ_i + θ_o)/2, for every model.
 //   Ā_b = ā_b ā_f²/(1−ā_f²) + ā_b³ ā_f²/(1−ā_f²)³                                  (eq. 14)
 //   Δ̄_b = ᾱ_b (1 − 2ā_b²/(1−ā_f²)²) + ᾱ_f (2(1−ā_f²)² + 4ā_f²ā_b²)/(1−ā_f²)³     (eq. 16)
 //   σ̄_b = (1 + d_b ā_f²) (ā_b √(2β̄_f²+β̄_b²) + ā_b³ √(2β̄_f²+3β̄_b²)) / (ā_b + ā_b³)  (eq. 17)
