@@ -7,8 +7,9 @@
 //    disks or spheres, area lights, suns with a disc, an Environment Texture world whose
 //    Sampling is not None, emissive mesh triangles); camera rays and emitters that are never
 //    light-sampled (a constant world, as in Cycles; a world with Sampling None; emissive
-//    curves) take weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in Cycles (kernel/integrator/
-//    shade_light.h): every lamp crossed before the next surface contributes.
+//    curves) take weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in
+//    Cycles (kernel/integrator/shade_light.h): every lamp crossed before the next surface
+//    contributes.
 //  - Diffuse and transmission limits the same way, per kind of bounce (see RenderSettings).
 //    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
 //    glossy bounce; hairis never blurs: compare against Cycles with Filter Glossy 0.
@@ -22,11 +23,12 @@
 //    emissive triangles by area),
 //    a shadow ray (hair, like everything, is opaque to it), MIS with the BSDF's density.
 //  - BSDF sampling: diffuse surfaces sample the cosine-weighted hemisphere around the normal
-//    facing ω_o. Hair uses its material's DirectionSampler: in the fiber frame of frame.h
-//    (FiberFrame::from_tangent_and_view(tangent, ω_o), Cycles' frame) and at
-//    h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves),
-//    ω_i = frame.to_world(sample.wi), and the throughput is multiplied by
-//    f_cos_near(ω_i, ω_o, h) / pdf (ChiangFiber, Cycles-exact).
+//    facing ω_o. Hair samples through its material's HairShading: at each hit one HairBsdf
+//    (the fiber model and its strategy's sampler prepared once, lib/sampling/hair_bsdf.h) in
+//    the fiber frame of frame.h (FiberFrame::from_tangent_and_view(tangent, ω_o), Cycles'
+//    frame) at h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves);
+//    the light sample takes f and pdf from it in one call, the BSDF sample comes with f, and
+//    the throughput is multiplied by f·|cos θ_i| / pdf.
 //  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
 //    min(1, sqrt(max throughput component)) and division by it (unbiased).
 //  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never
