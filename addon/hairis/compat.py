@@ -16,7 +16,10 @@ what the running Blender has, never from socket indices), so the other modules r
 - how Cycles converts lights (``hairis_scene_add_light``'s ``cycles`` option): as 3.4 before
   4.0, as 4.5 from 4.0 on (area lights 4/π brighter, suns a cone of constant radiance, spots
   without 3.4's cosine); point and spot lights are spheres in 4.0 and disks with Soft Falloff
-  (``use_soft_falloff``, default on) from 4.1: :func:`cycles_lights`, :func:`soft_falloff`.
+  (``use_soft_falloff``, default on) from 4.1: :func:`cycles_lights`, :func:`soft_falloff`;
+- whether rays hit a hair strand from inside its tube (``hairis_render``'s
+  ``curve_backfaces``): Cycles with Embree 3 (Blender 3.4) culls those back faces, Blender's
+  builds from 3.6 use Embree 4, whose curve filter does not: :func:`curve_backfaces`.
 """
 
 import bpy
@@ -133,3 +136,16 @@ def soft_falloff(light, version=None):
     if CYCLES_4_LIGHTS <= version < SOFT_FALLOFF:
         return False
     return bool(getattr(light, "use_soft_falloff", True))
+
+
+EMBREE_4_CURVES = (3, 6, 0)
+"""From 3.6 Blender's Cycles traces curves with Embree 4 and no backface culling."""
+
+
+def curve_backfaces(version=None):
+    """``curve_backfaces`` of the running Blender's Cycles: 'hit' from 3.6, else 'ignore'.
+
+    A ray that starts inside another strand's tube (strands that overlap) meets that tube
+    from inside; Cycles with Embree 3 lets it pass, with Embree 4 it is a hit.
+    """
+    return "hit" if tuple(version or running_version()) >= EMBREE_4_CURVES else "ignore"

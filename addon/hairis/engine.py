@@ -80,11 +80,13 @@ def light_options(light):
 
 
 def render_settings(settings):
-    """The C API's render settings from ``scene.hairis``."""
+    """The C API's render settings from ``scene.hairis``, and how the running Blender's
+    Cycles traces curves (:func:`compat.curve_backfaces`)."""
     return {"samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
             "strategy": settings.strategy.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
-            "seed": int(settings.seed), "threads": int(settings.threads)}
+            "seed": int(settings.seed), "threads": int(settings.threads),
+            "curve_backfaces": compat.curve_backfaces()}
 
 
 def build_native_scene(library, data, hair_tables):

@@ -178,15 +178,20 @@ void describe(Fields &f, CameraOptions &o) {
     f.field("clip_end", o.clip_end, 0.0, kHuge);
 }
 
-/// Everything hairis_render reads: the renderer's settings and the hair sampler's.
+/// Everything hairis_render reads: the renderer's settings, the hair sampler's and how the
+/// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces).
 struct RenderOptions {
     RenderSettings render;
     SamplerOptions sampler;
+    CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
 };
 template <typename Fields>
 void describe(Fields &f, RenderOptions &o) {
     describe(f, o.render);
     describe(f, o.sampler);
+    int backfaces = int(o.curve_backfaces);
+    f.choice("curve_backfaces", backfaces, {"ignore", "hit"});
+    o.curve_backfaces = CurveBackfaces(backfaces);
 }
 
 }  // namespace hairis::capi

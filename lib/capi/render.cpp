@@ -61,6 +61,7 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         // The scene description with this render's materials. The handle keeps its own copy
         // of the geometry so that it can be rendered again with other settings.
         SceneDesc desc = scene->desc;
+        desc.curve_backfaces = o.curve_backfaces;
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]))

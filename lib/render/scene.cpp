@@ -47,10 +47,12 @@ struct GeometryInfo {
     std::uint32_t index = 0;  // into curves or meshes
 };
 
-// The context handed to Embree: the primitives a ray must ignore.
+// The context handed to Embree: the primitives a ray must ignore, and whether the inside of
+// a curve tube counts (CurveBackfaces::Hit).
 struct TraceContext {
     RTCIntersectContext rtc;
     PrimRef skip_a, skip_b;
+    bool hit_curve_backfaces = false;
 };
 
 bool skipped(const TraceContext *ctx, unsigned geom, unsigned prim) {
@@ -69,8 +71,9 @@ void triangle_filter(const RTCFilterFunctionNArguments *args) {
     }
 }
 
-// Round curves: ignore hits on the inside of the tube (Cycles' backface culling) and on any
-// segment of the curve the ray starts on (the geometry's user data maps segments to curves).
+// Round curves: ignore hits on any segment of the curve the ray starts on (the geometry's
+// user data maps segments to curves) and, unless the context says otherwise, hits on the
+// inside of the tube (the backface culling of Cycles with Embree 3).
 void curve_filter(const RTCFilterFunctionNArguments *args) {
     const auto *ctx = reinterpret_cast<const TraceContext *>(args->context);
     const auto *curve_of = static_cast<const std::uint32_t *>(args->geometryUserPtr);
@@ -79,8 +82,9 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
         const float d = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
                         RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
                         RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
-        if (d > 0.0f || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
-                                curve_of[RTCHitN_primID(args->hit, args->N, i)]))
+        const bool culled = d > 0.0f && !ctx->hit_curve_backfaces;
+        if (culled || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
+                              curve_of[RTCHitN_primID(args->hit, args->N, i)]))
             args->valid[i] = 0;
     }
 }
@@ -127,6 +131,7 @@ struct Scene::Impl {
     LightSet lights;
     std::optional<Camera> camera;
     SceneStats stats;
+    CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
 
     std::atomic<long long> embree_bytes{0};
     std::atomic<long long> embree_peak{0};
@@ -178,6 +183,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     const auto start = std::chrono::steady_clock::now();
     auto impl = std::make_unique<Impl>();
     SceneStats &stats = impl->stats;
+    if (desc.curve_backfaces != CurveBackfaces::Ignore &&
+        desc.curve_backfaces != CurveBackfaces::Hit)
+        return Error{"curve_backfaces must be ignore (0) or hit (1) (got " +
+                     std::to_string(int(desc.curve_backfaces)) + ")"};
+    impl->curve_backfaces = desc.curve_backfaces;
 
     // Materials.
     for (std::size_t m = 0; m < desc.materials.size(); ++m) {
@@ -476,6 +486,7 @@ std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tma
     TraceContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.skip_a = skip;
+    ctx.hit_curve_backfaces = impl_->curve_backfaces == CurveBackfaces::Hit;
     RTCRayHit rh;
     rh.ray.org_x = origin.x;
     rh.ray.org_y = origin.y;
@@ -508,6 +519,7 @@ bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip
     TraceContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.skip_a = skip_a;
+    ctx.hit_curve_backfaces = impl_->curve_backfaces == CurveBackfaces::Hit;
     ctx.skip_b = skip_b;
     RTCRay ray;
     ray.org_x = origin.x;

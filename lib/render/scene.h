@@ -6,10 +6,11 @@
 // points, Embree gets n + 2 control points — the first and the last point duplicated — and
 // n − 1 segments, so the curve passes through every point from the first to the last. The
 // radius is per point (Embree's 4th vertex component). Hits on the inside of a tube (ray
-// direction · Embree's Ng > 0) are ignored, as Cycles' backface-culling filter does for
-// round curves, and a ray never hits the curve it starts on — any segment of it — as Cycles'
-// self-intersection test does (kernel/device/cpu/bvh.h, kernel_embree_is_self_intersection
-// maps a hair segment to its curve before comparing), so no origin offset is needed. The
+// direction · Embree's Ng > 0: a ray that starts inside another strand's tube) follow
+// SceneDesc::curve_backfaces, and a ray never hits the curve it starts on — any segment of
+// it — as Cycles' self-intersection test does (kernel/device/cpu/bvh.h,
+// kernel_embree_is_self_intersection maps a hair segment to its curve before comparing), so
+// no origin offset is needed. The
 // Embree tessellation rate is Cycles' default: Curves > Subdivisions 2 (addon properties.py),
 // SceneParams::curve_subdivisions() = 2² = 4, rtcSetGeometryTessellationRate(4 + 1).
 //
@@ -75,6 +76,13 @@ struct TriangleMesh {
     std::vector<std::uint32_t> materials{0};
 };
 
+/// What a ray that meets a round curve from inside its tube does. Such rays start inside
+/// another strand (strands that overlap). Cycles built with Embree 3 (Blender 3.4) culls
+/// these back faces in its curve filter; with Embree 4 (Blender's own builds from 3.6, so
+/// 4.5 and 5.0) the filter only skips the ray's own curve and the back face is a hit, shaded
+/// with the outward normal like any other.
+enum class CurveBackfaces : int { Ignore = 0, Hit = 1 };
+
 /// Everything a scene is made of, as plain data.
 struct SceneDesc {
     std::vector<Material> materials;
@@ -86,6 +94,7 @@ struct SceneDesc {
     std::vector<AreaLight> area_lights;
     WorldLight world;
     CameraDesc camera;
+    CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
 };
 
 /// What the build did and what it costs.
@@ -172,7 +181,8 @@ class Scene {
     const SceneStats &stats() const;
 
     /// The closest hit with t in (tmin, tmax), ignoring `skip` (SurfacePoint::self of the
-    /// point the ray starts on) and the inside of curve tubes. dir must be unit length.
+    /// point the ray starts on) and, unless SceneDesc::curve_backfaces is Hit, the inside of
+    /// curve tubes. dir must be unit length.
     std::optional<Hit> intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                  PrimRef skip = {}) const;
     /// True when anything blocks the segment (tmin, tmax), ignoring skip_a and skip_b (as in

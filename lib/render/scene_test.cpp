@@ -147,6 +147,69 @@ TEST(Scene, RaysHitTheHairTubeWithCyclesShadingData) {
     EXPECT_FALSE(scene.occluded({0.3f, 0, 5}, {0, 0, -1}, 0.0f, 4.0f));
 }
 
+// Two parallel strands along X, radius 0.1, whose axes are 0.05 apart in y: each one's
+// surface near the other lies inside the other's tube. Rays leave strand 0 from its point
+// (x, 0.1, 0), skipping strand 0; that point is 0.05 from strand 1's axis, so going +z the ray
+// meets strand 1's tube from inside at z = sqrt(0.1² − 0.05²).
+TEST(Scene, CurveBackfacesAreCulledOrHitAsCyclesWithEmbree3Or4) {
+    auto overlapping = [](CurveBackfaces backfaces) {
+        SceneDesc d;
+        d.materials = {hair_material()};
+        HairCurves c = straight_hair();
+        for (int k = 0; k < 4; ++k) {
+            c.points.push_back(c.points[k] + Vec3{0, 0.05f, 0});
+            c.radii.push_back(0.1f);
+        }
+        c.first = {0, 4, 8};
+        d.curves = {c};
+        d.camera = small_camera();
+        d.curve_backfaces = backfaces;
+        return build_ok(std::move(d));
+    };
+    const Vec3 start{0.3f, 0.1f, 0.0f};
+    const Vec3 up{0, 0, 1};
+    const float exit_t = std::sqrt(0.1f * 0.1f - 0.05f * 0.05f);
+
+    const Scene culled = overlapping(CurveBackfaces::Ignore);
+    const PrimRef strand0{0, 0};
+    EXPECT_FALSE(culled.intersect(start, up, 0.0f, INFINITY, strand0).has_value());
+    EXPECT_FALSE(culled.occluded(start, up, 0.0f, 10.0f, strand0));
+
+    const Scene hits = overlapping(CurveBackfaces::Hit);
+    const auto hit = hits.intersect(start, up, 0.0f, INFINITY, strand0);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_NEAR(hit->t, exit_t, 1e-3f);
+    const SurfacePoint sp = hits.surface_point(start, up, *hit);
+    EXPECT_EQ(sp.self.primitive, 1u);  // strand 1
+    // The outward normal of strand 1 at the exit: (0, 0.05, exit_t) / r.
+    EXPECT_NEAR(sp.normal.y, 0.5f, 1e-2f);
+    EXPECT_NEAR(sp.normal.z, exit_t / 0.1f, 1e-2f);
+    EXPECT_GT(dot(sp.normal, up), 0.0f);
+    EXPECT_TRUE(hits.occluded(start, up, 0.0f, 10.0f, strand0));
+    EXPECT_FALSE(hits.occluded(start, up, 0.0f, 0.9f * exit_t, strand0));
+    // The ray's own strand stays skipped: from inside strand 0 only (0.06 from its axis,
+    // 0.11 from strand 1's), going −y, nothing is hit.
+    const Vec3 inside0{0.3f, -0.06f, 0.0f};
+    EXPECT_FALSE(hits.intersect(inside0, {0, -1, 0}, 0.0f, INFINITY, strand0).has_value());
+    // Without the skip, the same ray leaves strand 0 through its back face.
+    const auto own = hits.intersect(inside0, {0, -1, 0}, 0.0f, INFINITY);
+    ASSERT_TRUE(own.has_value());
+    EXPECT_NEAR(own->t, 0.04f, 1e-3f);
+    EXPECT_FALSE(culled.intersect(inside0, {0, -1, 0}, 0.0f, INFINITY).has_value());
+    // Rays from outside see the same front faces either way.
+    const auto front_culled = culled.intersect({0.3f, 0.02f, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    const auto front_hits = hits.intersect({0.3f, 0.02f, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(front_culled.has_value() && front_hits.has_value());
+    EXPECT_FLOAT_EQ(front_culled->t, front_hits->t);
+
+    SceneDesc bad;
+    bad.materials = {hair_material()};
+    bad.curves = {straight_hair()};
+    bad.camera = small_camera();
+    bad.curve_backfaces = CurveBackfaces(7);
+    EXPECT_NE(build_error(std::move(bad)).find("curve_backfaces"), std::string::npos);
+}
+
 TEST(Scene, TrianglesAndSkips) {
     SceneDesc d;
     d.materials = {DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}, DiffuseMaterial{Rgb(0.0f), Rgb(2.0f)}};

@@ -87,7 +87,7 @@ static const char *const kinds[][2] = {
                "clip_start=0;clip_end=3.40282347e+38"},
     {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_transmission_bounces=12;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
-               "strategy=table;multiple_weight=0;n_h=2"},
+               "strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
 };
 enum { KIND_COUNT = sizeof kinds / sizeof kinds[0] };
 
@@ -1002,7 +1002,7 @@ typedef struct render_settings {
     long long samples, max_bounces, max_diffuse_bounces, max_transmission_bounces, threads,
         tile_size, rr_start_bounce, n_h;
     unsigned long long seed;
-    int strategy, film_transparent;
+    int strategy, film_transparent, curve_backfaces;
     double multiple_weight;
 } render_settings;
 
@@ -1010,6 +1010,7 @@ static int read_render_settings(const char *text, render_settings *r)
 {
     options o;
     const char *flags[4] = {"0", "1", "false", "true"};
+    const char *backfaces[2] = {"ignore", "hit"};
     if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
         integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
         integer_in(&o, "max_bounces", 0, 1024, &r->max_bounces) != HAIRIS_OK ||
@@ -1019,6 +1020,7 @@ static int read_render_settings(const char *text, render_settings *r)
         integer_in(&o, "tile_size", 1, 4096, &r->tile_size) != HAIRIS_OK ||
         integer_in(&o, "rr_start_bounce", 1, 1024, &r->rr_start_bounce) != HAIRIS_OK ||
         word(&o, "film_transparent", flags, 4, &r->film_transparent) != HAIRIS_OK ||
+        word(&o, "curve_backfaces", backfaces, 2, &r->curve_backfaces) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
     r->film_transparent %= 2;
@@ -1044,10 +1046,10 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     if (!f) return;
     fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
                "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
-               "tile_size=%lld film_transparent=%d\n",
+               "tile_size=%lld film_transparent=%d curve_backfaces=%s\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_transmission_bounces, r->tile_size,
-            r->film_transparent);
+            r->film_transparent, r->curve_backfaces ? "hit" : "ignore");
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

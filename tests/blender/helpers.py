@@ -394,17 +394,26 @@ def set_samples(scene, samples):
     scene.hairis.samples = samples
 
 
-def make_compare_scene(samples, bounces, strategy, resolution=(64, 48)):
+def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_offset=None,
+                       extras=()):
     """The Hairis-against-Cycles scene: particle hair, Curves, a diffuse sphere, three kinds
-    of light and a world colour, with both engines set up alike (``match_cycles``)."""
+    of light and a world colour, with both engines set up alike (``match_cycles``).
+
+    Both hair materials are Chiang's (the node's default model); the particle hair keeps the
+    node's default Offset (2°), the Curves object's takes ``curves_offset`` (radians) when
+    given. ``extras``: functions of the scene that add more objects (other hair models)
+    before both engines are set up.
+    """
     scene = reset()
     make_camera(scene, location=(0.0, -3.2, 0.0), resolution=resolution, percentage=100)
     make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
     hair = make_hair_material("Hair", "MELANIN", **{
         "Melanin": 0.3, "Melanin Redness": 0.7, "Roughness": 0.3, "Radial Roughness": 0.4,
         "Coat": 0.1, "IOR": 1.55})
-    dyed = make_hair_material("Dyed", "COLOR", **{
-        "Color": (0.2, 0.5, 0.8, 1.0), "Roughness": 0.45})
+    dyed_inputs = {"Color": (0.2, 0.5, 0.8, 1.0), "Roughness": 0.45}
+    if curves_offset is not None:
+        dyed_inputs["Offset"] = curves_offset
+    dyed = make_hair_material("Dyed", "COLOR", **dyed_inputs)
     skin = make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
     make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0), scale=1.4)
     make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
@@ -416,6 +425,8 @@ def make_compare_scene(samples, bounces, strategy, resolution=(64, 48)):
     make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
                shape="RECTANGLE", size=0.6, size_y=0.3,
                rotation=(math.radians(60), 0.0, math.radians(-40)))
+    for extra in extras:
+        extra(scene)
     match_cycles(scene, samples, bounces)
     settings = scene.hairis
     settings.samples = samples

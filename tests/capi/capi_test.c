@@ -300,6 +300,7 @@ static void test_defaults(void)
     expect_default("render", "max_transmission_bounces", "12");
     expect_default("render", "tile_size", "16");
     expect_default("render", "film_transparent", "0");
+    expect_default("render", "curve_backfaces", "ignore");
     expect_default("render", "strategy", "table");
     expect_default("render", "seed", "0");
     expect_default("render", "threads", "0");
@@ -453,6 +454,7 @@ static void test_option_strings(void)
         {"bake", "source=2", "source", "gaussian"},
         {"area", "shape=hexagon", "shape", "ellipse"},
         {"render", "film_transparent=2", "film_transparent", "true"},
+        {"render", "curve_backfaces=cull", "curve_backfaces", "hit"},
         {"camera", "orthographic=yes", "orthographic", "false"},
     };
     for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
@@ -1474,7 +1476,8 @@ static void test_render(void)
                                 {"threads=-1", "threads"},
                                 {"rr_start_bounce=0", "rr_start_bounce"},
                                 {"samples=16777217", "samples"},
-                                {"film_transparent=maybe", "film_transparent"}};
+                                {"film_transparent=maybe", "film_transparent"},
+                                {"curve_backfaces=yes", "curve_backfaces"}};
         for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
             for (int k = 0; k < W * H * 4; ++k) rgba[k] = -7.0f;
             CHECK(hairis_render(scene, bad[i][0], rgba, NULL, NULL) ==
