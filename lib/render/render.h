@@ -26,7 +26,9 @@
 //    (FiberFrame::from_tangent_and_view(tangent, ω_o), Cycles' frame) and at
 //    h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves),
 //    ω_i = frame.to_world(sample.wi), and the throughput is multiplied by
-//    f_cos_near(ω_i, ω_o, h) / pdf (ChiangFiber, Cycles-exact).
+//    f_cos_near(ω_i, ω_o, h) / pdf (ChiangFiber, Cycles-exact). Where the curve set gives
+//    node inputs per curve or point (scene.h's CurveInput), f is the strand's own fiber at
+//    the hit's interpolated inputs (chiang_strands.h), and so is what the sampler follows.
 //  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
 //    min(1, sqrt(max throughput component)) and division by it (unbiased).
 //  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never
