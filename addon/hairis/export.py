@@ -774,16 +774,16 @@ class _Exporter:
         self._material_index[key] = index
         return index
 
-    def strand_inputs(self, material_index, first, positions_object, random_offset=0):
+    def strand_inputs(self, material_index, first, positions_object, curve_indices):
         """``CurvesData.inputs`` for one curve set of a hair material whose inputs vary per
         strand: its chains evaluated on the set's Hair Info (object-space lengths, and the
-        per-strand random of curve indices from ``random_offset``), clamped with a warning."""
+        per-strand random of each curve's index within its object, as Cycles numbers them),
+        clamped with a warning."""
         material = self.data.materials[material_index]
         if material.kind != "HAIR" or not material.hair.strand_inputs:
             return {}
-        curve_count = len(first) - 1
         strands = node_eval.strands_of(first, positions_object,
-                                       node_eval.strand_random(curve_count, random_offset))
+                                       node_eval.strand_random(curve_indices))
         labels = {name: label for name, label, _ in HAIR_INPUTS}
         inputs = {}
         for field_name, compiled in material.hair.strand_inputs.items():
@@ -1029,6 +1029,7 @@ class _Exporter:
             radius.data.foreach_get("value", radii)
         positions = positions.reshape(-1, 3).astype(np.float64)
         radii = radii.astype(np.float64) * _uniform_scale(matrix)
+        kept = np.nonzero(np.diff(offsets.astype(np.int64)) >= 2)[0]  # Cycles' curve indices
         first, local, radii, dropped = _drop_short_curves(offsets, positions, radii)
         if dropped:
             self.data.warn("object %r: %d curves with fewer than 2 points skipped"
@@ -1040,7 +1041,7 @@ class _Exporter:
         self.data.curves.append(CurvesData(
             name=obj.name, source="CURVES", material=material, first=first,
             positions=world.astype(np.float32), radii=radii.astype(np.float32),
-            inputs=self.strand_inputs(material, first, local)))
+            inputs=self.strand_inputs(material, first, local, kept)))
 
 
 def _drop_short_curves(offsets, positions, radii):
@@ -1137,6 +1138,8 @@ def export_particle_hair(exporter, obj):
         # Cycles does, and drop strands with no key at all.
         valid = np.any(points != 0.0, axis=2)
         present = valid.any(axis=1)
+        indices = exported + np.nonzero(present)[0]  # Cycles numbers the object's strands
+        exported += int(present.size)
         if not present.all():
             points, valid = points[present], valid[present]
             curve_count = points.shape[0]
@@ -1164,8 +1167,7 @@ def export_particle_hair(exporter, obj):
             name="%s/%s" % (obj.name, psys.name), source="PARTICLES", material=material,
             first=first, positions=points.reshape(-1, 3).astype(np.float32),
             radii=radii.reshape(-1).astype(np.float32),
-            inputs=exporter.strand_inputs(material, first, local.reshape(-1, 3), exported)))
-        exported += curve_count
+            inputs=exporter.strand_inputs(material, first, local.reshape(-1, 3), indices)))
 
 
 def export_scene(depsgraph, camera=None):

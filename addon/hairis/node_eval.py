@@ -19,7 +19,7 @@ Rec.709 luminance, vector → float by the average, float → colour/vector by r
 with its safe operations (division by zero gives 0, ...); Map Range clamped to its To range
 whenever Clamp is on; a ColorRamp baked to 256 entries (Blender's own evaluation at i/255) and
 interpolated linearly between them (not at all for Constant); MixRGB's factor clamped to
-[0, 1]; the per-strand random number uniform in [0, 1] per curve.
+[0, 1]; the per-strand random number Cycles' own (:func:`strand_random`).
 """
 
 import math
@@ -102,18 +102,39 @@ def strands_of(first, positions_object, random):
                    intercept=intercept, length=length)
 
 
-def strand_random(count, offset=0):
-    """Per-strand random numbers uniform in [0, 1): a hash of the curve index (offset + i),
-    like Cycles' curve random attribute (the same distribution, not the same numbers). The
-    hash is the PCG output permutation of Jarzynski and Olano's "Hash Functions for GPU
-    Rendering" (2020)."""
+_U32 = np.uint64(0xFFFFFFFF)
+
+
+def _rotate(x, k):
+    """32-bit left rotation of uint64-held words."""
+    return ((x << np.uint64(k)) | (x >> np.uint64(32 - k))) & _U32
+
+
+def _lookup3_final(a, b, c):
+    """The final mixing of Bob Jenkins' lookup3 (public domain, burtleburtle.net/bob/c/
+    lookup3.c), on uint64 arrays holding 32-bit words: each step xors one word into the next
+    and subtracts a rotation of the former."""
+    words = [a, b, c]
+    for into, source, k in ((2, 1, 14), (0, 2, 11), (1, 0, 25), (2, 1, 16), (0, 2, 4),
+                            (1, 0, 14), (2, 1, 24)):
+        words[into] = ((words[into] ^ words[source]) - _rotate(words[source], k)) & _U32
+    return words[2]
+
+
+def strand_random(curve_indices):
+    """Per-strand random numbers in [0, 1] for curves of these indices (within their object):
+    lookup3's hashword of the two words (index, 0) with initial value 13, mapped to float by
+    n · 2^−32 in single precision — Cycles' curve random attribute (hash_uint2_to_float(index,
+    0)), so a strand gets the number Cycles gives it."""
     with np.errstate(over="ignore"):
-        x = (np.arange(count, dtype=np.uint64) + np.uint64(offset)) & np.uint64(0xFFFFFFFF)
-        state = (x * np.uint64(747796405) + np.uint64(2891336453)) & np.uint64(0xFFFFFFFF)
-        word = (((state >> ((state >> np.uint64(28)) + np.uint64(4))) ^ state)
-                * np.uint64(277803737)) & np.uint64(0xFFFFFFFF)
-        word = (word >> np.uint64(22)) ^ word
-    return word.astype(np.float64) / 4294967296.0
+        index = np.asarray(curve_indices, dtype=np.uint64) & _U32
+        start = np.full(index.shape, 0xDEADBEEF + (2 << 2) + 13, dtype=np.uint64)
+        a = (start + index) & _U32
+        b = start & _U32
+        c = start & _U32
+        hashed = _lookup3_final(a, b, c)
+    # In single precision, as Cycles converts it: (float)n · (1 / (float)0xFFFFFFFF).
+    return (hashed.astype(np.float32) * np.float32(1.0 / 4294967296.0)).astype(np.float64)
 
 
 @dataclass
