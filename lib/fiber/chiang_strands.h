@@ -18,7 +18,7 @@ namespace hairis {
 /// as Cycles maps a node (to_chiang_params), as ChiangLobes made in the scratch buffer; at a
 /// hit without, the node's own fiber. Every point it prepares is a ChiangPoint, so a sampler
 /// built for it (analytic or near-field table) reads the strand's own point.
-class ChiangStrands final : public ShadingModel {
+class ChiangStrands final : public ShadingModel, public StrandInputReader {
   public:
     /// The node's own fiber must be valid (to_chiang_params and ChiangFiber::create's errors).
     static Expected<ChiangStrands> create(const PrincipledHairNode &node);
@@ -35,6 +35,8 @@ class ChiangStrands final : public ShadingModel {
     /// The closure parameters for `inputs`, refused as to_chiang_params refuses them.
     Expected<ChiangParams> params(const HairInputValues &inputs) const;
 
+    /// The inputs the node's parametrization reads (reads() in hair_inputs.h).
+    bool reads_input(HairInput input) const override { return reads(node_.parametrization, input); }
     /// The node with its own (unlinked) values.
     const PrincipledHairNode &node() const { return node_; }
     /// The node's own fiber: what the TABLE strategy's tables are baked for.

@@ -66,4 +66,14 @@ struct HairInputValues {
 /// `node` with the given inputs in place of its own.
 PrincipledHairNode with_inputs(PrincipledHairNode node, const HairInputValues &values);
 
+/// What a shading model whose inputs may vary per strand (it reads FiberHit::inputs) says
+/// about them: the scene refuses curve inputs for any other model, and inputs this one does
+/// not read.
+class StrandInputReader {
+  public:
+    virtual ~StrandInputReader() = default;
+    /// Whether the model's f depends on `input` (e.g. not on Melanin under Direct Coloring).
+    virtual bool reads_input(HairInput input) const = 0;
+};
+
 }  // namespace hairis

@@ -2,7 +2,6 @@
 
 #include <embree3/rtcore.h>
 
-#include "fiber/chiang_strands.h"
 
 #include <algorithm>
 #include <atomic>
@@ -123,10 +122,10 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
 Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
     if (hc.inputs.empty()) return std::nullopt;
     const auto *hair = std::get_if<HairMaterial>(&material);
-    const auto *strands = hair ? dynamic_cast<const ChiangStrands *>(hair->shading.model()) : nullptr;
+    const auto *strands = hair ? dynamic_cast<const StrandInputReader *>(hair->shading.model()) : nullptr;
     if (!strands)
         return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
-                     " does not vary per strand (it needs a Chiang hair material made for curve inputs)"};
+                     " does not vary per strand (it needs a hair material made for curve inputs, e.g. ChiangStrands)"};
     const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
     std::uint32_t seen = 0;
     for (const CurveInput &in : hc.inputs) {
@@ -136,7 +135,7 @@ Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Ma
         const std::string name = set + ", input " + info.name;
         if ((seen >> unsigned(in.input)) & 1u) return Error{name + ": given twice"};
         seen |= 1u << unsigned(in.input);
-        if (!reads(strands->node().parametrization, in.input))
+        if (!strands->reads_input(in.input))
             return Error{name + ": the material's parametrization does not read it"};
         const std::size_t k = std::size_t(info.components), n = in.per_point ? points : curves;
         if (in.values.size() != n * k)
