@@ -35,6 +35,11 @@
 // weights, and its density enters the same mixture. At roughness 0.02–0.1 this takes the
 // variance from 4–60× the analytic sampler's (rows alone) to 0.02–0.13× of it
 // (bench/results/strategy_study.md, section 5).
+//
+// A material whose inputs vary per strand (chiang_strands.h) keeps the tables of its node's
+// own values; at a strand's hit the lobe weights take the strand's A_p, φ the strand's N_p,
+// and a lobe whose M_p is not the table's draws θ_i from the strand's own cone, never from
+// rows baked for another roughness (bench/results/strand_study.md measures both).
 #pragma once
 
 #include <array>
