@@ -276,6 +276,17 @@ void add_curves(State &st, FuzzInput &in) {
     std::vector<uint32_t> first(curve_count + 1);
     for (uint32_t &f : first) f = in.take<uint8_t>();
     const std::vector<float> positions = floats(in, 3 * point_count), radii = floats(in, point_count);
+    if (shape & 4) {
+        // With curve inputs: an option string of them and values of any count.
+        const std::optional<std::string> o = options(in, "curve_inputs");
+        const size_t value_count = in.count(kMaxItems);
+        const std::vector<float> values = floats(in, value_count);
+        check_not_internal(hairis_scene_add_curves_with_inputs(
+                               st.scene, material, curve_count, first.data(), point_count, positions.data(),
+                               radii.data(), c_str(o), value_count, value_count ? values.data() : nullptr),
+                           "hairis_scene_add_curves_with_inputs");
+        return;
+    }
     check_not_internal(hairis_scene_add_curves(st.scene, material, curve_count, first.data(),
                                                point_count, positions.data(), radii.data()),
                        "hairis_scene_add_curves");

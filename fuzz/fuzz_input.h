@@ -129,7 +129,8 @@ inline constexpr uint8_t kLiteralName = 15;  // garbage_names()[15]
 inline const std::vector<std::string> &option_kinds() {
     static const std::vector<std::string> v = {"chiang", "marschner", "bake",  "sampler",
                                                "diffuse", "sun",      "point", "area",
-                                               "world",  "camera",   "render"};
+                                               "world",  "camera",   "render",
+                                               "curve_inputs"};
     return v;
 }
 

@@ -110,8 +110,12 @@ def build_native_scene(library, data, hair_tables):
                 indices.append(scene.add_diffuse_material(material.albedo, material.emission))
         remap = np.array(indices or [0], dtype=np.int32)
         for curves in data.curves:
-            scene.add_curves(int(remap[curves.material]), curves.first, curves.positions,
-                             curves.radii)
+            if curves.inputs:
+                scene.add_curves_with_inputs(int(remap[curves.material]), curves.first,
+                                             curves.positions, curves.radii, curves.inputs)
+            else:
+                scene.add_curves(int(remap[curves.material]), curves.first, curves.positions,
+                                 curves.radii)
         for mesh in data.meshes:
             scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
         for light in data.lights:

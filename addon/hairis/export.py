@@ -14,7 +14,11 @@ Rules follow Cycles 3.4 (``intern/cycles/blender/curves.cpp``, ``object.cpp``, `
   object-space arc-length fraction, 0 at the tip with ``use_close_tip``; material slot
   ``settings.material``;
 - Curves objects: the ``radius`` point attribute, 0.005 without it; material slot 1;
-- curve radii scale with the cube root of the object matrix's determinant (Hair::apply_transform).
+- curve radii scale with the cube root of the object matrix's determinant (Hair::apply_transform);
+- hair inputs fed by node chains (node_eval): evaluated per curve (Hair Info Random, Length)
+  or per point (Intercept: the object-space arc-length fraction) and sent as curve inputs;
+  an unlinked Random is the per-strand random number (a hash of the curve's index within its
+  object, uniform in [0, 1]) wherever Random Color or Random Roughness reads it.
 """
 
 import math
@@ -24,7 +28,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat
+from . import compat, node_eval
 
 DEFAULT_CURVES_RADIUS = 0.005
 """Cycles' radius for Curves without a ``radius`` attribute."""
@@ -55,6 +59,24 @@ HAIR_INPUTS = (
 
 HAIR_NODE_IDNAME = "ShaderNodeBsdfHairPrincipled"
 
+CURVE_INPUT_NAMES = {"absorption_coefficient": "absorption"}
+"""HairParameters fields whose C API curve-input name differs (the others are the same)."""
+
+READ_BY = {"color": {"COLOR"}, "melanin": {"MELANIN"}, "melanin_redness": {"MELANIN"},
+           "tint": {"MELANIN"}, "random_color": {"MELANIN"},
+           "absorption_coefficient": {"ABSORPTION"}}
+"""Inputs only one parametrization reads (Blender hides them under the others)."""
+
+TINY_COLOUR = 1e-30
+"""The smallest colour component hairis takes (0 would be infinite absorption)."""
+
+INPUT_RANGES = {
+    "color": (TINY_COLOUR, math.inf), "tint": (TINY_COLOUR, math.inf),
+    "absorption_coefficient": (0.0, math.inf), "ior": (1.0 + 1e-6, math.inf),
+    "offset": (-math.pi / 2, math.pi / 2),
+}
+"""Where hairis clamps an input that varies per strand; the others are clamped to [0, 1]."""
+
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
 """Object types exported as triangle meshes (through ``Object.to_mesh``)."""
 
@@ -83,10 +105,14 @@ class HairParameters:
     random: float = 0.0
     cycles: str = "3.4"
     """The Blender version whose Cycles evaluates the node (compat.cycles_version)."""
+    strand_inputs: dict = field(default_factory=dict, compare=False, repr=False)
+    """Inputs that vary per curve or point: field name → node_eval.Field (their values above
+    are what the fiber, and so the TABLE strategy's tables, take)."""
 
     def as_dict(self):
-        """The values keyed by C field name."""
-        return {name: getattr(self, name) for name in self.__dataclass_fields__}
+        """The fiber's values keyed by C field name."""
+        return {name: getattr(self, name) for name in self.__dataclass_fields__
+                if name != "strand_inputs"}
 
 
 @dataclass
@@ -115,6 +141,9 @@ class CurvesData:
     first: np.ndarray
     positions: np.ndarray
     radii: np.ndarray
+    inputs: dict = field(default_factory=dict)
+    """Node inputs varying per curve or point: C API name → ('curve' | 'point', float32 array
+    of (curves or points, components))."""
 
     @property
     def curve_count(self):
@@ -236,6 +265,8 @@ class SceneData:
         """Writes the arrays and a summary to an ``.npz`` file (debugging and tests)."""
         arrays = {}
         for i, curves in enumerate(self.curves):
+            for name, (domain, values) in curves.inputs.items():
+                arrays["curves%d_input_%s_%s" % (i, domain, name)] = values
             arrays["curves%d_first" % i] = curves.first
             arrays["curves%d_positions" % i] = curves.positions
             arrays["curves%d_radii" % i] = curves.radii
@@ -391,12 +422,31 @@ def _socket_value(socket, components):
     return values
 
 
+def _clamped(values, field_name, material_name, input_name, warnings):
+    """Values of a node chain clamped to what hairis takes for the input, with a warning
+    when any was outside."""
+    low, high = INPUT_RANGES.get(field_name, (0.0, 1.0))
+    values = np.asarray(values, dtype=np.float64)
+    finite = np.nan_to_num(values, nan=low, posinf=high, neginf=low)
+    clamped = np.clip(finite, low, high)
+    if values.size and (np.any(clamped != values)):
+        warnings.append("material %r: the node chain into the Principled Hair BSDF's %r gives "
+                        "values from %.6g to %.6g, outside [%.6g, %.6g]; hairis clamps them"
+                        % (material_name, input_name, float(np.nanmin(values)),
+                           float(np.nanmax(values)), low, high))
+    return clamped
+
+
 def read_hair_node(node, material_name="?"):
     """Reads a Principled Hair BSDF node: returns (HairParameters, warnings, error or None).
 
-    Reads every input's unlinked value by name, defensively: a linked input is a warning
-    (hairis uses its unlinked value), a missing input or a model other than Chiang (Blender
-    4.x's ``model`` setting) is an error for this material.
+    Reads every input's unlinked value, by name or identifier; a missing input or a model
+    other than Chiang (Blender 4.x's ``model`` setting) is an error for this material. A
+    linked input the parametrization reads is compiled (node_eval): a chain of one value is
+    folded into the parameters, one that reads Hair Info goes into ``strand_inputs``, and one
+    with an unsupported node is a warning naming it (the input's unlinked value is used). An
+    unlinked Random is Cycles' per-strand random number wherever Random Color or Random
+    Roughness can use it; the fiber's own Random is then 0.5 (the middle strand).
     """
     warnings = []
     model = compat.hair_model(node)
@@ -413,6 +463,7 @@ def read_hair_node(node, material_name="?"):
                                 % (material_name, parametrization))
     values = {"parametrization": PARAMETRIZATIONS[parametrization],
               "cycles": compat.cycles_version()}
+    sockets = {}
     for field_name, input_name, components in HAIR_INPUTS:
         socket = _input(node, input_name)
         if socket is None:
@@ -420,22 +471,43 @@ def read_hair_node(node, material_name="?"):
                                     "Blender %s; Hairis supports %s"
                                     % (material_name, input_name, compat.version_string(),
                                        compat.SUPPORTED_TEXT))
-        if socket.is_linked:
-            warnings.append("material %r: input %r of the Principled Hair BSDF is linked; hairis "
-                            "uses its unlinked value" % (material_name, input_name))
         try:
             values[field_name] = _socket_value(socket, components)
         except (TypeError, ValueError) as error:
             return None, warnings, "material %r: %s" % (material_name, error)
-    random = _input(node, "Random")
-    randomized = values["random_roughness"] > 0.0 or (
-        values["random_color"] > 0.0 and values["parametrization"] == PARAMETRIZATIONS["MELANIN"])
-    if randomized and not random.is_linked:
-        # Cycles feeds an unlinked Random with a per-strand random number (the socket shows
-        # "Default"); hairis_principled_hair has one value for every strand.
-        warnings.append("material %r: Cycles varies Random Color/Random Roughness per strand "
-                        "when Random is unlinked; hairis uses Random = %g for every strand"
-                        % (material_name, values["random"]))
+        sockets[field_name] = socket
+    strand_inputs = {}
+    for field_name, input_name, components in HAIR_INPUTS:
+        socket = sockets[field_name]
+        if parametrization not in READ_BY.get(field_name, {parametrization}):
+            continue  # hidden by the parametrization: Cycles does not read it either
+        if not getattr(socket, "is_linked", False):
+            continue
+        try:
+            compiled = node_eval.compile_input(socket, components)
+        except node_eval.Unsupported as error:
+            warnings.append("material %r: %s; hairis uses the unlinked value of the Principled "
+                            "Hair BSDF's %r input" % (material_name, error.describe(), input_name))
+            continue
+        if compiled.domain == "material":
+            value = _clamped(compiled.evaluate(None), field_name, material_name, input_name,
+                             warnings)[0]
+            values[field_name] = float(value[0]) if components == 1 else tuple(map(float, value))
+        else:
+            strand_inputs[field_name] = compiled
+    # Cycles feeds an unlinked Random with the curve's random number, per strand.
+    random_socket = sockets["random"]
+    randomized = values["random_roughness"] > 0.0 or "random_roughness" in strand_inputs or (
+        parametrization == "MELANIN" and (values["random_color"] > 0.0
+                                          or "random_color" in strand_inputs))
+    if randomized and "random" not in strand_inputs and not getattr(random_socket, "is_linked",
+                                                                    False):
+        strand_inputs["random"] = node_eval.Field("curve", 1, lambda s: s.random.reshape(-1, 1))
+    if "random" in strand_inputs:
+        # The fiber (what tables are baked for) is the middle strand: Random Color and Random
+        # Roughness then scale nothing.
+        values["random"] = 0.5
+    values["strand_inputs"] = strand_inputs
     return HairParameters(**values), warnings, None
 
 
@@ -702,6 +774,28 @@ class _Exporter:
         self._material_index[key] = index
         return index
 
+    def strand_inputs(self, material_index, first, positions_object, curve_indices):
+        """``CurvesData.inputs`` for one curve set of a hair material whose inputs vary per
+        strand: its chains evaluated on the set's Hair Info (object-space lengths, and the
+        per-strand random of each curve's index within its object, as Cycles numbers them),
+        clamped with a warning."""
+        material = self.data.materials[material_index]
+        if material.kind != "HAIR" or not material.hair.strand_inputs:
+            return {}
+        strands = node_eval.strands_of(first, positions_object,
+                                       node_eval.strand_random(curve_indices))
+        labels = {name: label for name, label, _ in HAIR_INPUTS}
+        inputs = {}
+        for field_name, compiled in material.hair.strand_inputs.items():
+            warnings = []
+            values = _clamped(compiled.evaluate(strands), field_name, material.name,
+                              labels[field_name], warnings)
+            for warning in warnings:
+                self.data.warn(warning)
+            inputs[CURVE_INPUT_NAMES.get(field_name, field_name)] = (
+                compiled.domain, values.astype(np.float32))
+        return inputs
+
     @staticmethod
     def slot_material(obj, slot_index):
         """The material in slot ``slot_index`` (clamped like Cycles), or None."""
@@ -934,18 +1028,20 @@ class _Exporter:
         if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
             radius.data.foreach_get("value", radii)
         positions = positions.reshape(-1, 3).astype(np.float64)
-        world = _transform_points(matrix, positions)
         radii = radii.astype(np.float64) * _uniform_scale(matrix)
-        first, world, radii, dropped = _drop_short_curves(offsets, world, radii)
+        kept = np.nonzero(np.diff(offsets.astype(np.int64)) >= 2)[0]  # Cycles' curve indices
+        first, local, radii, dropped = _drop_short_curves(offsets, positions, radii)
         if dropped:
             self.data.warn("object %r: %d curves with fewer than 2 points skipped"
                            % (obj.name, dropped))
         if first.size < 2:
             return
+        world = _transform_points(matrix, local)
         material = self.material(self.slot_material(obj, 0), for_hair=True)
         self.data.curves.append(CurvesData(
             name=obj.name, source="CURVES", material=material, first=first,
-            positions=world.astype(np.float32), radii=radii.astype(np.float32)))
+            positions=world.astype(np.float32), radii=radii.astype(np.float32),
+            inputs=self.strand_inputs(material, first, local, kept)))
 
 
 def _drop_short_curves(offsets, positions, radii):
@@ -1013,6 +1109,7 @@ def export_particle_hair(exporter, obj):
         data.warn("object %r has a singular matrix; its particle hair is skipped" % obj.name)
         return
     scale = _uniform_scale(matrix)
+    exported = 0  # strands of this object so far: Cycles numbers them across its systems
     for psys in obj.particle_systems:
         settings = psys.settings
         if settings.type != "HAIR" or settings.render_type != "PATH":
@@ -1041,6 +1138,8 @@ def export_particle_hair(exporter, obj):
         # Cycles does, and drop strands with no key at all.
         valid = np.any(points != 0.0, axis=2)
         present = valid.any(axis=1)
+        indices = exported + np.nonzero(present)[0]  # Cycles numbers the object's strands
+        exported += int(present.size)
         if not present.all():
             points, valid = points[present], valid[present]
             curve_count = points.shape[0]
@@ -1067,7 +1166,8 @@ def export_particle_hair(exporter, obj):
         data.curves.append(CurvesData(
             name="%s/%s" % (obj.name, psys.name), source="PARTICLES", material=material,
             first=first, positions=points.reshape(-1, 3).astype(np.float32),
-            radii=radii.reshape(-1).astype(np.float32)))
+            radii=radii.reshape(-1).astype(np.float32),
+            inputs=exporter.strand_inputs(material, first, local.reshape(-1, 3), indices)))
 
 
 def export_scene(depsgraph, camera=None):

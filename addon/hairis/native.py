@@ -96,6 +96,8 @@ PROTOTYPES = {
     "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32), c_size_t,
                                         _F, _F]),
+    "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32),
+                                                    c_size_t, _F, _F, c_char_p, c_size_t, _F]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, _F, c_size_t, POINTER(c_uint32),
                                       POINTER(c_int32)]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
@@ -107,6 +109,15 @@ PROTOTYPES = {
     "hairis_last_render_stats": (c_char_p, []),
 }
 """Every function of the headers: name → (restype, argtypes)."""
+
+
+CURVE_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption", "roughness",
+                "radial_roughness", "coat", "ior", "offset", "random_color", "random_roughness",
+                "random")
+"""hairis_defaults("curve_inputs")' names in its order: the order of a curve set's values."""
+
+CURVE_INPUT_COMPONENTS = {"color": 3, "tint": 3, "absorption": 3}
+"""Components of the colour inputs (the others have one)."""
 
 
 # ---- Option strings --------------------------------------------------------------------------
@@ -657,6 +668,45 @@ class Scene(_Handle):
             self, int(material), first.size - 1, _ptr(first, c_uint32), positions.shape[0],
             _ptr(positions, c_float), _ptr(radii, c_float))
         self._library._status("hairis_scene_add_curves", status)
+
+    def add_curves_with_inputs(self, material, first, positions, radii, inputs):
+        """Adds curves as :meth:`add_curves` whose hair material's node inputs vary:
+        ``inputs`` maps a name of :data:`CURVE_INPUTS` to ('curve' | 'point', values of shape
+        (curves or points, components))."""
+        first = _array(first, np.uint32, (), "first").reshape(-1)
+        positions = _array(positions, np.float32, (3,), "positions")
+        radii = _array(radii, np.float32, (), "radii").reshape(-1)
+        if first.size < 1:
+            raise ValueError("first needs curve_count + 1 entries")
+        curve_count, point_count = first.size - 1, positions.shape[0]
+        names, chunks = {}, []
+        for name in CURVE_INPUTS:
+            if name not in inputs:
+                continue
+            domain, values = inputs[name]
+            count = {"curve": curve_count, "point": point_count}.get(domain)
+            if count is None:
+                raise ValueError("input %r: domain must be 'curve' or 'point', got %r"
+                                 % (name, domain))
+            components = CURVE_INPUT_COMPONENTS.get(name, 1)
+            values = _array(values, np.float32, (), name).reshape(-1)
+            if values.size != count * components:
+                raise ValueError("input %r needs %d values (%d %ss of %d), got %d"
+                                 % (name, count * components, count, domain, components,
+                                    values.size))
+            names[name] = domain
+            chunks.append(values)
+        unknown = set(inputs) - set(CURVE_INPUTS)
+        if unknown:
+            raise ValueError("unknown curve inputs %s (known: %s)"
+                             % (sorted(unknown), ", ".join(CURVE_INPUTS)))
+        values = np.ascontiguousarray(np.concatenate(chunks) if chunks else np.zeros(0),
+                                      dtype=np.float32)
+        status = self._library.raw.hairis_scene_add_curves_with_inputs(
+            self, int(material), curve_count, _ptr(first, c_uint32), point_count,
+            _ptr(positions, c_float), _ptr(radii, c_float), options(names).encode(), values.size,
+            _ptr(values, c_float))
+        self._library._status("hairis_scene_add_curves_with_inputs", status)
 
     def add_mesh(self, positions, indices, materials):
         """Adds a world-space triangle mesh; ``materials`` holds one index per triangle."""

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "capi_internal.h"
+#include "fiber/hair_inputs.h"
 #include "fiber/principled_hair.h"
 #include "hairis/hairis_render.h"
 #include "render/render.h"
@@ -120,8 +121,20 @@ void describe(Fields &f, WorldOptions &o) {
 /// its settings.
 struct SceneHairMaterial {
     std::shared_ptr<const ChiangFiber> fiber;
+    PrincipledHairNode node;  ///< the fiber's node: what curve inputs vary
     std::optional<SamplingTables> tables;
 };
+
+/// hairis_scene_add_curves_with_inputs' `inputs`: per node input (hair_inputs.h's names and
+/// order), where its values come from: 0 material (the fiber's own value), 1 curve, 2 point.
+struct CurveInputOptions {
+    int domain[kHairInputCount] = {};
+};
+template <typename Fields>
+void describe(Fields &f, CurveInputOptions &o) {
+    for (int i = 0; i < kHairInputCount; ++i)
+        f.choice(hair_input_info(HairInput(i)).name, o.domain[i], {"material", "curve", "point"});
+}
 
 using SceneMaterial = std::variant<SceneHairMaterial, DiffuseMaterial>;
 

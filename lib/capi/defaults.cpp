@@ -25,8 +25,9 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "area") return "type=area;" + write_options(AreaOptions{});
     if (kind == "world") return write_options(WorldOptions{});
     if (kind == "camera") return write_options(CameraOptions{});
+    if (kind == "curve_inputs") return write_options(CurveInputOptions{});
     invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
-            "spot, area, world, camera (got \"" + kind + "\")");
+            "spot, area, world, camera, curve_inputs (got \"" + kind + "\")");
 }
 
 }  // namespace

@@ -18,8 +18,13 @@ thread_local std::string t_last_stats;
 HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const SamplerOptions &o) {
     const std::string name = "material " + std::to_string(index) + " (hair): ";
     const StrategyKind kind = StrategyKind(o.strategy);
+    // Every hair material shades through the strands model: curves without inputs get the
+    // node's own fiber from it, the same as the fiber itself.
+    Expected<ChiangStrands> strands = ChiangStrands::create(hair.node);
+    if (!strands) refuse(HAIRIS_ERROR_INTERNAL, name + strands.error().message);
+    auto model = std::make_shared<const ChiangStrands>(std::move(strands).value());
     StrategyInputs inputs;
-    inputs.chiang = hair.fiber;
+    inputs.strands = model;
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
     if (kind == StrategyKind::Table) {
@@ -31,7 +36,7 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     }
     Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
     if (!made) refuse(code_of(made.error().kind), name + made.error().message);
-    Expected<HairShading> shading = HairShading::create(hair.fiber, std::move(made).value());
+    Expected<HairShading> shading = HairShading::create(model, std::move(made).value());
     if (!shading) refuse(HAIRIS_ERROR_INTERNAL, name + shading.error().message);
     return std::move(shading).value();
 }

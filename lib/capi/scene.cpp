@@ -90,6 +90,68 @@ OptionReader read_world_options(const char *options, WorldOptions &o, bool pixel
     return reader;
 }
 
+const char *parametrization_name(HairParametrization p) {
+    switch (p) {
+        case HairParametrization::AbsorptionCoefficient: return "absorption";
+        case HairParametrization::Melanin: return "melanin";
+        case HairParametrization::Color: return "color";
+    }
+    return "unknown";
+}
+
+// The curves of hairis_scene_add_curves, checked (the arguments named); empty when
+// curve_count is 0.
+HairCurves checked_curves(const hairis_scene *scene, int material, size_t curve_count, const uint32_t *first,
+                          size_t point_count, const float *positions, const float *radii) {
+    require(scene, "scene");
+    require(first, "first");
+    require_array(positions, point_count, "positions");
+    require_array(radii, point_count, "radii");
+    if (material < 0 || size_t(material) >= scene->materials.size())
+        invalid("material must be the index of a material added to the scene, in [0, " +
+                std::to_string(scene->materials.size()) + ") (got " +
+                std::to_string(material) + ")");
+    if (point_count > kMaxCurvePoints)
+        invalid("point_count must be at most 2^31 per call (got " +
+                std::to_string(point_count) + ")");
+    if (curve_count > point_count / 2)
+        invalid("curve_count (" + std::to_string(curve_count) +
+                ") needs at least 2 points per curve, but point_count is " +
+                std::to_string(point_count));
+    if (first[0] != 0) invalid("first[0] must be 0 (got " + std::to_string(first[0]) + ")");
+    for (size_t c = 0; c < curve_count; ++c)
+        if (!(first[c + 1] >= first[c] && first[c + 1] - first[c] >= 2))
+            invalid("curve " + std::to_string(c) + ": first[" + std::to_string(c + 1) + "] = " +
+                    std::to_string(first[c + 1]) + " must be at least first[" +
+                    std::to_string(c) + "] + 2 = " + std::to_string(size_t(first[c]) + 2) +
+                    " (a curve has at least 2 points)");
+    if (first[curve_count] != point_count)
+        invalid("first[curve_count] must equal point_count (" + std::to_string(point_count) +
+                "; got " + std::to_string(first[curve_count]) + ")");
+    for (size_t i = 0; i < point_count; ++i) {
+        for (size_t k = 0; k < 3; ++k)
+            require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
+        require_non_negative(radii[i], indexed("radii", i));
+    }
+    HairCurves curves;
+    if (curve_count == 0) return curves;  // nothing to add
+    curves.material = std::uint32_t(material);
+    curves.first.assign(first, first + curve_count + 1);
+    curves.points.resize(point_count);
+    for (size_t i = 0; i < point_count; ++i) curves.points[i] = vec3(positions + 3 * i);
+    curves.radii.assign(radii, radii + point_count);
+    return curves;
+}
+
+void add(hairis_scene &scene, HairCurves curves) {
+    size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
+                   curves.points.size() * (sizeof(Vec3) + sizeof(float));
+    for (const CurveInput &in : curves.inputs) bytes += in.values.size() * sizeof(float);
+    scene.curve_count += curves.first.size() - 1;
+    scene.desc.curves.push_back(std::move(curves));
+    scene.geometry_bytes += bytes;
+}
+
 }  // namespace
 
 }  // namespace hairis::capi
@@ -116,6 +178,7 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
             invalid("fiber must be a chiang2016 fiber (the renderer shades Principled Hair), got " + fiber->model_name);
         SceneHairMaterial hair;
         hair.fiber = fiber->chiang;
+        hair.node = fiber->spec.node;
         if (tables) hair.tables = tables->sampling;
         return add_material(*scene, std::move(hair));
     });
@@ -139,48 +202,56 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
                                        const uint32_t *first, size_t point_count,
                                        const float *positions, const float *radii) {
     return guard_status("hairis_scene_add_curves", [&] {
-        require(scene, "scene");
-        require(first, "first");
-        require_array(positions, point_count, "positions");
-        require_array(radii, point_count, "radii");
-        if (material < 0 || size_t(material) >= scene->materials.size())
-            invalid("material must be the index of a material added to the scene, in [0, " +
-                    std::to_string(scene->materials.size()) + ") (got " +
-                    std::to_string(material) + ")");
-        if (point_count > kMaxCurvePoints)
-            invalid("point_count must be at most 2^31 per call (got " +
-                    std::to_string(point_count) + ")");
-        if (curve_count > point_count / 2)
-            invalid("curve_count (" + std::to_string(curve_count) +
-                    ") needs at least 2 points per curve, but point_count is " +
-                    std::to_string(point_count));
-        if (first[0] != 0) invalid("first[0] must be 0 (got " + std::to_string(first[0]) + ")");
-        for (size_t c = 0; c < curve_count; ++c)
-            if (!(first[c + 1] >= first[c] && first[c + 1] - first[c] >= 2))
-                invalid("curve " + std::to_string(c) + ": first[" + std::to_string(c + 1) + "] = " +
-                        std::to_string(first[c + 1]) + " must be at least first[" +
-                        std::to_string(c) + "] + 2 = " + std::to_string(size_t(first[c]) + 2) +
-                        " (a curve has at least 2 points)");
-        if (first[curve_count] != point_count)
-            invalid("first[curve_count] must equal point_count (" + std::to_string(point_count) +
-                    "; got " + std::to_string(first[curve_count]) + ")");
-        for (size_t i = 0; i < point_count; ++i) {
-            for (size_t k = 0; k < 3; ++k)
-                require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
-            require_non_negative(radii[i], indexed("radii", i));
+        HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
+        if (curve_count > 0) add(*scene, std::move(curves));
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int material, size_t curve_count,
+                                                   const uint32_t *first, size_t point_count,
+                                                   const float *positions, const float *radii,
+                                                   const char *inputs, size_t value_count,
+                                                   const float *values) {
+    return guard_status("hairis_scene_add_curves_with_inputs", [&] {
+        HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
+        CurveInputOptions o;
+        read_options(inputs, "curve inputs", o);
+        const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[size_t(material)]);
+        size_t needed = 0;
+        for (int i = 0; i < kHairInputCount; ++i) {
+            if (o.domain[i] == 0) continue;
+            const HairInputInfo &info = hair_input_info(HairInput(i));
+            if (!hair)
+                invalid(std::string("curve inputs: ") + info.name + " needs a hair material; material " +
+                        std::to_string(material) + " is a surface material");
+            if (!reads(hair->node.parametrization, HairInput(i)))
+                invalid(std::string("curve inputs: ") + info.name + " is not read by material " +
+                        std::to_string(material) + "'s parametrization (" +
+                        parametrization_name(hair->node.parametrization) + ")");
+            needed += size_t(info.components) * (o.domain[i] == 2 ? point_count : curve_count);
         }
-        if (curve_count == 0) return HAIRIS_OK;  // nothing to add
-        HairCurves curves;
-        curves.material = std::uint32_t(material);
-        curves.first.assign(first, first + curve_count + 1);
-        curves.points.resize(point_count);
-        for (size_t i = 0; i < point_count; ++i) curves.points[i] = vec3(positions + 3 * i);
-        curves.radii.assign(radii, radii + point_count);
-        const size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
-                             point_count * (sizeof(Vec3) + sizeof(float));
-        scene->desc.curves.push_back(std::move(curves));
-        scene->curve_count += curve_count;
-        scene->geometry_bytes += bytes;
+        if (value_count != needed)
+            invalid("value_count must be " + std::to_string(needed) + " (the inputs' components for each of " +
+                    std::to_string(curve_count) + " curves or " + std::to_string(point_count) +
+                    " points, in hairis_defaults(\"curve_inputs\")'s order), got " + std::to_string(value_count));
+        require_array(values, value_count, "values");
+        size_t at = 0;
+        for (int i = 0; i < kHairInputCount; ++i) {
+            if (o.domain[i] == 0) continue;
+            const HairInput input = HairInput(i);
+            const size_t k = size_t(hair_input_info(input).components);
+            const bool per_point = o.domain[i] == 2;
+            const size_t n = per_point ? point_count : curve_count;
+            for (size_t j = 0; j < n; ++j) {
+                const std::string where =
+                    std::string("values: ") + (per_point ? "point " : "curve ") + std::to_string(j) + ": ";
+                ok_or_invalid(check_hair_input(input, values + at + j * k, where));
+            }
+            curves.inputs.push_back({input, per_point, std::vector<float>(values + at, values + at + n * k)});
+            at += n * k;
+        }
+        if (curve_count > 0) add(*scene, std::move(curves));
         return HAIRIS_OK;
     });
 }

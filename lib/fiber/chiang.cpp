@@ -171,7 +171,19 @@ const char *chiang_tilt_name(ChiangTilt tilt) {
 // ---------------------------------------------------------------------------------------
 // The fiber.
 
-Expected<ChiangFiber> ChiangFiber::create(const ChiangParams &p) {
+namespace {
+
+// Cycles' setup: clamp β_m, reduce it by the coat for R only, clamp again, then map.
+void set_longitudinal(const ChiangParams &p, double &v, double &v_m0) {
+    const double beta_m = std::clamp(double(p.roughness), 0.001, 1.0);
+    const double beta_m0 = std::clamp((1.0 - double(p.coat)) * beta_m, 0.001, 1.0);
+    v = chiang::longitudinal_variance(beta_m);
+    v_m0 = chiang::longitudinal_variance(beta_m0);
+}
+
+}  // namespace
+
+Expected<ChiangLobes> ChiangLobes::create(const ChiangParams &p) {
     const double max_offset = double(float(kHalfPi));  // the float nearest π/2 is accepted
     if (Status error = first_error(
             check::non_negative("sigma_a.r", p.sigma_a.r),
@@ -187,29 +199,67 @@ Expected<ChiangFiber> ChiangFiber::create(const ChiangParams &p) {
     if (p.tilt != ChiangTilt::Incident && p.tilt != ChiangTilt::Outgoing)
         return Error{"tilt must be Cycles 3.4's (incident) or 4.2's (outgoing)"};
 
+    ChiangLobes lobes;
+    lobes.params_ = p;
+    set_longitudinal(p, lobes.v_, lobes.v_m0_);
+    lobes.s_ = chiang::logistic_scale(p.radial_roughness);
+    lobes.eta_ = p.ior;
+    lobes.alpha_ = p.offset;
+    const double tilts[3] = {2.0 * lobes.alpha_, -lobes.alpha_, -4.0 * lobes.alpha_};
+    for (int i = 0; i < 3; ++i) lobes.tilt_[std::size_t(i)] = {std::sin(tilts[i]), std::cos(tilts[i])};
+    lobes.sigma_ = {p.sigma_a.r, p.sigma_a.g, p.sigma_a.b};
+    lobes.azimuthal_ = chiang::TrimmedLogistic(lobes.s_);
+    lobes.set_longitudinal_constants();
+    return lobes;
+}
+
+void ChiangLobes::set_longitudinal_constants() {
+    for (int lobe = 0; lobe < 3; ++lobe)
+        longitudinal_[std::size_t(lobe)] = chiang::longitudinal_constants(lobe_variance(lobe));
+    longitudinal_[kLobeResidual] = longitudinal_[kLobeTRT];  // both 4v
+}
+
+ChiangLobes ChiangLobes::derive(const ChiangLobes &base, const ChiangParams &p) {
+    ChiangLobes lobes = base;
+    const ChiangParams &b = base.params_;
+    lobes.params_ = p;
+    lobes.sigma_ = {p.sigma_a.r, p.sigma_a.g, p.sigma_a.b};
+    lobes.eta_ = p.ior;
+    if (p.roughness != b.roughness || p.coat != b.coat) {
+        set_longitudinal(p, lobes.v_, lobes.v_m0_);
+        lobes.set_longitudinal_constants();
+    }
+    if (p.radial_roughness != b.radial_roughness) {
+        lobes.s_ = chiang::logistic_scale(p.radial_roughness);
+        lobes.azimuthal_ = chiang::TrimmedLogistic(lobes.s_);
+    }
+    if (p.offset != b.offset) {
+        lobes.alpha_ = p.offset;
+        const double tilts[3] = {2.0 * lobes.alpha_, -lobes.alpha_, -4.0 * lobes.alpha_};
+        for (int i = 0; i < 3; ++i) lobes.tilt_[std::size_t(i)] = {std::sin(tilts[i]), std::cos(tilts[i])};
+    }
+    return lobes;
+}
+
+bool ChiangLobes::same_longitudinal(int p, const ChiangLobes &other) const {
+    if (p < 0 || p > 3) return false;
+    if (lobe_variance(p) != other.lobe_variance(p)) return false;
+    if (p == kLobeResidual) return true;  // never tilted
+    return params_.tilt == other.params_.tilt && alpha_ == other.alpha_;
+}
+
+Expected<ChiangFiber> ChiangFiber::create(const ChiangParams &p) {
+    Expected<ChiangLobes> lobes = ChiangLobes::create(p);
+    if (!lobes) return lobes.error();
     ChiangFiber fiber;
-    fiber.params_ = p;
-    // Cycles' setup: clamp β_m, reduce it by the coat for R only, clamp again, then map.
-    const double beta_m = std::clamp(double(p.roughness), 0.001, 1.0);
-    const double beta_m0 = std::clamp((1.0 - double(p.coat)) * beta_m, 0.001, 1.0);
-    fiber.v_ = chiang::longitudinal_variance(beta_m);
-    fiber.v_m0_ = chiang::longitudinal_variance(beta_m0);
-    fiber.s_ = chiang::logistic_scale(p.radial_roughness);
-    fiber.eta_ = p.ior;
-    fiber.alpha_ = p.offset;
-    const double tilts[3] = {2.0 * fiber.alpha_, -fiber.alpha_, -4.0 * fiber.alpha_};
-    for (int i = 0; i < 3; ++i) fiber.tilt_[std::size_t(i)] = {std::sin(tilts[i]), std::cos(tilts[i])};
-    fiber.sigma_ = {p.sigma_a.r, p.sigma_a.g, p.sigma_a.b};
-    fiber.azimuthal_ = chiang::TrimmedLogistic(fiber.s_);
-    for (int lobe = 0; lobe < 4; ++lobe)
-        fiber.longitudinal_[std::size_t(lobe)] = chiang::longitudinal_constants(fiber.lobe_variance(lobe));
-    const double panel = std::min(kFixedPanelPerScale * fiber.s_, kFixedMaxPanel);
+    fiber.lobes_ = std::move(lobes).value();
+    const double panel = std::min(kFixedPanelPerScale * fiber.lobes_.s_, kFixedMaxPanel);
     const int panels = int(std::ceil(kPi / panel));
     fiber.fixed_panels_ = kPanelPoints * panels <= kMaxFixedNodes ? panels : 0;
     return fiber;
 }
 
-double ChiangFiber::lobe_variance(int p) const {
+double ChiangLobes::lobe_variance(int p) const {
     switch (p) {
         case kLobeR: return v_m0_;
         case kLobeTT: return 0.25 * v_;
@@ -220,18 +270,19 @@ double ChiangFiber::lobe_variance(int p) const {
 }
 
 LobeShape ChiangFiber::lobe_shape(int p) const {
+    const double alpha_ = lobes_.alpha_;
     // M_p peaks where its two angles are opposite: θ_i + θ_o = −δ_p with δ = (2α, −α, −4α),
     // for either tilt semantics; fiber.h wants the shape in θ_h = (θ_i + θ_o)/2.
     static constexpr double kShiftPerAlpha[4] = {-2.0, 1.0, 4.0, 0.0};
     if (p < 0 || p > 3) return {};
-    return {float(0.5 * kShiftPerAlpha[p] * alpha_), float(0.5 * std::sqrt(lobe_variance(p)))};
+    return {float(0.5 * kShiftPerAlpha[p] * alpha_), float(0.5 * std::sqrt(lobes_.lobe_variance(p)))};
 }
 
-std::array<SinCos, 4> ChiangFiber::cones(SinCos o) const {
+std::array<SinCos, 4> ChiangLobes::cones(SinCos o) const {
     return {chiang::rotate(o, tilt_[0]), chiang::rotate(o, tilt_[1]), chiang::rotate(o, tilt_[2]), o};
 }
 
-double ChiangFiber::tilted_longitudinal(int p, double sin_i, double cos_i, SinCos o, SinCos cone) const {
+double ChiangLobes::tilted_longitudinal(int p, double sin_i, double cos_i, SinCos o, SinCos cone) const {
     const chiang::LongitudinalConstants &c = longitudinal_[std::size_t(p)];
     if (params_.tilt == ChiangTilt::Outgoing || p == kLobeResidual) return chiang::Cone(cone, c).density(sin_i, cos_i);
     // Cycles 3.4 rotates θ_i by δ_p.
@@ -239,18 +290,18 @@ double ChiangFiber::tilted_longitudinal(int p, double sin_i, double cos_i, SinCo
     return chiang::Cone(o, c).density(tilted.sin, tilted.cos);
 }
 
-double ChiangFiber::lobe_longitudinal(int p, double sin_theta_i, double sin_theta_o) const {
+double ChiangLobes::lobe_longitudinal(int p, double sin_theta_i, double sin_theta_o) const {
     if (p < 0 || p > 3) return 0.0;
     const SinCos o = sin_cos_of(sin_theta_o), i = sin_cos_of(sin_theta_i);
     return tilted_longitudinal(p, i.sin, i.cos, o, cones(o)[std::size_t(p)]);
 }
 
-chiang::Cone ChiangFiber::lobe_cone(int p, double sin_theta_o) const {
+chiang::Cone ChiangLobes::lobe_cone(int p, double sin_theta_o) const {
     const int q = std::clamp(p, 0, 3);
     return chiang::Cone(cones(sin_cos_of(sin_theta_o))[std::size_t(q)], longitudinal_[std::size_t(q)]);
 }
 
-void ChiangFiber::attenuation_at(double cos_theta_o, double k, double path_scale, double h,
+void ChiangLobes::attenuation_at(double cos_theta_o, double k, double path_scale, double h,
                                  std::array<Channels, 4> &a, double &gamma_o, double &gamma_t) const {
     h = std::clamp(h, -1.0, 1.0);
     const double cos_gamma_o = cos_from_sin(h);
@@ -284,20 +335,22 @@ double chord_scale(SinCos o, double eta) { return 2.0 / cos_from_sin(o.sin / eta
 
 }  // namespace
 
-ChiangPoint::ChiangPoint(const ChiangFiber &fiber, const FiberHit &hit)
-    : FiberPoint(hit), fiber_(&fiber), o_(sin_cos_of(double(hit.wo.x))) {
+ChiangPoint::ChiangPoint(const ChiangFiber &fiber, const FiberHit &hit) : ChiangPoint(fiber.lobes(), hit) {}
+
+ChiangPoint::ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit)
+    : FiberPoint(hit), lobes_(&lobes), o_(sin_cos_of(double(hit.wo.x))) {
     const double r = std::sqrt(double(hit.wo.y) * hit.wo.y + double(hit.wo.z) * hit.wo.z);
     cos_phi_o_ = r > 0 ? hit.wo.y / r : 0.0;
     sin_phi_o_ = r > 0 ? hit.wo.z / r : -1.0;
     double gamma_o = 0, gamma_t = 0;
-    fiber.attenuation_at(o_.cos, bravais_ratio(o_, fiber.eta_), chord_scale(o_, fiber.eta_), double(hit.h), a_,
+    lobes.attenuation_at(o_.cos, bravais_ratio(o_, lobes.eta_), chord_scale(o_, lobes.eta_), double(hit.h), a_,
                          gamma_o, gamma_t);
     for (int p = 0; p < 3; ++p) shift_[std::size_t(p)] = chiang::azimuthal_shift(p, gamma_o, gamma_t);
     double total = 0;
     for (int p = 0; p < 4; ++p) total += (weight_[std::size_t(p)] = luminance(a_[std::size_t(p)]));
     // A_0 = F > 0 for every η > 1, so the total is positive.
     for (double &w : weight_) w /= total;
-    cone_ = fiber.cones(o_);
+    cone_ = lobes.cones(o_);
 }
 
 double ChiangPoint::relative_azimuth(Vec3 wi) const {
@@ -312,11 +365,11 @@ Vec3 ChiangPoint::direction(double sin_theta_i, double cos_theta_i, double phi) 
 }
 
 double ChiangPoint::longitudinal(int p, double sin_i, double cos_i) const {
-    return fiber_->tilted_longitudinal(p, sin_i, cos_i, o_, cone_[std::size_t(p)]);
+    return lobes_->tilted_longitudinal(p, sin_i, cos_i, o_, cone_[std::size_t(p)]);
 }
 
 chiang::Cone ChiangPoint::cone(int p) const {
-    return chiang::Cone(cone_[std::size_t(p)], fiber_->longitudinal_[std::size_t(p)]);
+    return chiang::Cone(cone_[std::size_t(p)], lobes_->longitudinal_[std::size_t(p)]);
 }
 
 Rgb ChiangPoint::attenuation(int p) const { return p >= 0 && p < 4 ? to_rgb(a_[std::size_t(p)]) : Rgb{}; }
@@ -324,7 +377,7 @@ Rgb ChiangPoint::attenuation(int p) const { return p >= 0 && p < 4 ? to_rgb(a_[s
 Rgb ChiangPoint::lobe_f(int p, Vec3 wi) const {
     if (p < 0 || p > 3) return {};
     const SinCos i = sin_cos_of(double(wi.x));
-    const double azimuthal = p < 3 ? fiber_->azimuthal_.density(wrap_angle(relative_azimuth(wi) - shift_[std::size_t(p)]))
+    const double azimuthal = p < 3 ? lobes_->azimuthal_.density(wrap_angle(relative_azimuth(wi) - shift_[std::size_t(p)]))
                                    : kInvTwoPi;
     return to_rgb(scaled(a_[std::size_t(p)], longitudinal(p, i.sin, i.cos) * azimuthal));
 }
@@ -335,7 +388,7 @@ Rgb ChiangPoint::f(Vec3 wi) const {
     Channels sum{};
     for (int p = 0; p < 4; ++p) {
         double weight = longitudinal(p, i.sin, i.cos);
-        weight *= p < 3 ? fiber_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
+        weight *= p < 3 ? lobes_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
         for (int c = 0; c < 3; ++c) sum[std::size_t(c)] += a_[std::size_t(p)][std::size_t(c)] * weight;
     }
     return to_rgb(sum);
@@ -349,7 +402,7 @@ float ChiangPoint::pdf(Vec3 wi) const {
         const double w = weight_[std::size_t(p)];
         if (w <= 0) continue;
         double term = w * cone(p).density(i.sin, i.cos);
-        term *= p < 3 ? fiber_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
+        term *= p < 3 ? lobes_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
         density += term;
     }
     return float(density);
@@ -358,12 +411,12 @@ float ChiangPoint::pdf(Vec3 wi) const {
 Rgb ChiangPoint::f_and_pdf(Vec3 wi, float &pdf) const {
     const SinCos i = sin_cos_of(double(wi.x));
     const double phi = relative_azimuth(wi);
-    const bool cones_tilted = fiber_->params_.tilt == ChiangTilt::Outgoing;
+    const bool cones_tilted = lobes_->params_.tilt == ChiangTilt::Outgoing;
     Channels sum{};
     double density = 0;
     for (int p = 0; p < 4; ++p) {
         const double azimuthal =
-            p < 3 ? fiber_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
+            p < 3 ? lobes_->azimuthal_.density(wrap_angle(phi - shift_[std::size_t(p)])) : kInvTwoPi;
         const double w = weight_[std::size_t(p)];
         // tilted_longitudinal is the cone's density where the tilt is on θ_o, and for p = 3.
         const bool shared = cones_tilted || p == kLobeResidual;
@@ -389,7 +442,7 @@ Vec3 ChiangPoint::draw(float u0, float u1, float u2, int &lobe) const {
     while (p < last && u >= weight_[std::size_t(p)]) u -= weight_[std::size_t(p++)];
     const double u_longitudinal = std::clamp(u / weight_[std::size_t(p)], 0.0, 1.0);
     const double sin_theta_i = off_axis(float(cone(p).sample(u_longitudinal, u1)));
-    const double phi = p < 3 ? shift_[std::size_t(p)] + fiber_->azimuthal_.sample(u0) : kTwoPi * double(u0);
+    const double phi = p < 3 ? shift_[std::size_t(p)] + lobes_->azimuthal_.sample(u0) : kTwoPi * double(u0);
     lobe = p;
     return direction(sin_theta_i, cos_from_sin(sin_theta_i), phi);
 }
@@ -483,8 +536,8 @@ int monotone_pieces(int p, double k, double cuts[4]) {
 }  // namespace
 
 ChiangFarField::ChiangFarField(const ChiangFiber &fiber, Vec3 wo)
-    : fiber_(&fiber), o_(sin_cos_of(double(wo.x))), k_(bravais_ratio(o_, fiber.eta_)),
-      path_scale_(chord_scale(o_, fiber.eta_)) {
+    : fiber_(&fiber), o_(sin_cos_of(double(wo.x))), k_(bravais_ratio(o_, fiber.lobes_.eta_)),
+      path_scale_(chord_scale(o_, fiber.lobes_.eta_)) {
     const double r = std::sqrt(double(wo.y) * wo.y + double(wo.z) * wo.z);
     cos_phi_o_ = r > 0 ? wo.y / r : 0.0;
     sin_phi_o_ = r > 0 ? wo.z / r : -1.0;
@@ -501,7 +554,7 @@ ChiangFarField::ChiangFarField(const ChiangFiber &fiber, Vec3 wo)
     for (int panel = 0; panel < panels; ++panel) {
         gl.for_each(-kHalfPi + panel * panel_width, -kHalfPi + (panel + 1) * panel_width, [&](double gamma, double w) {
             const double weight = 0.5 * w * std::cos(gamma);
-            fiber.attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), a, gamma_o, gamma_t);
+            fiber.lobes_.attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), a, gamma_o, gamma_t);
             for (int c = 0; c < 3; ++c) residual_[std::size_t(c)] += weight * a[3][std::size_t(c)];
             if (node_count_ > 0) {
                 for (int p = 0; p < 3; ++p) {
@@ -543,7 +596,7 @@ std::array<double, 3> ChiangFarField::azimuthal_fixed(int p, double phi) const {
     const int n = node_count_;
     const double *shift = shift_.data() + std::size_t(p * n);
     const double *weight = weight_.data() + std::size_t(3 * p * n);
-    const double inv_s = 1.0 / fiber.s_;
+    const double inv_s = 1.0 / fiber.lobes_.s_;
     double sum[3] = {0, 0, 0};
     for (int j = 0; j < n; ++j) {
         double x = phi - shift[j];  // both in [−π, π]: one turn of wrapping at most
@@ -555,7 +608,7 @@ std::array<double, 3> ChiangFarField::azimuthal_fixed(int p, double phi) const {
         sum[1] += weight[3 * j + 1] * bump;
         sum[2] += weight[3 * j + 2] * bump;
     }
-    const double scale = fiber.azimuthal_.norm() * inv_s;
+    const double scale = fiber.lobes_.azimuthal_.norm() * inv_s;
     Channels result{sum[0] * scale, sum[1] * scale, sum[2] * scale};
 
     // N has a kink where φ − Φ wraps through ±π, which the fixed nodes straddle: its slope
@@ -566,7 +619,7 @@ std::array<double, 3> ChiangFarField::azimuthal_fixed(int p, double phi) const {
     const int panels = fiber.fixed_panels_;
     const double panel_width = kPi / panels;
     const double kink_slope_jump =
-        4.0 * logistic(kPi, fiber.s_) * fiber.azimuthal_.norm() * std::tanh(kHalfPi / fiber.s_) * inv_s;
+        4.0 * logistic(kPi, fiber.lobes_.s_) * fiber.lobes_.azimuthal_.norm() * std::tanh(kHalfPi / fiber.lobes_.s_) * inv_s;
     bool negligible = true;
     for (int c = 0; c < 3; ++c) {
         const double kink_error = kink_slope_jump * panel_width * panel_width * total_weight_[std::size_t(p)][std::size_t(c)];
@@ -603,7 +656,7 @@ std::array<double, 3> ChiangFarField::fixed_panel(int p, double phi, int panel) 
     Channels sum{};
     for (int j = kPanelPoints * panel; j < kPanelPoints * (panel + 1); ++j) {
         const std::size_t index = std::size_t(p * n + j);
-        const double bump = fiber_->azimuthal_.density(wrap_angle(phi - shift_[index]));
+        const double bump = fiber_->lobes_.azimuthal_.density(wrap_angle(phi - shift_[index]));
         for (int c = 0; c < 3; ++c) sum[std::size_t(c)] += weight_[3 * index + std::size_t(c)] * bump;
     }
     return sum;
@@ -615,9 +668,9 @@ std::array<double, 3> ChiangFarField::exact_panel(int p, double phi, double a, d
     std::array<Channels, 4> att;
     double gamma_o = 0, gamma_t = 0;
     GaussLegendre::rule(kPanelPoints).for_each(a, b, [&](double gamma, double w) {
-        fiber_->attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), att, gamma_o, gamma_t);
+        fiber_->lobes_.attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), att, gamma_o, gamma_t);
         const double shift = chiang::azimuthal_shift(p, gamma_o, gamma_t);
-        const double weight = 0.5 * w * std::cos(gamma) * fiber_->azimuthal_.density(wrap_angle(phi - shift));
+        const double weight = 0.5 * w * std::cos(gamma) * fiber_->lobes_.azimuthal_.density(wrap_angle(phi - shift));
         for (int c = 0; c < 3; ++c) sum[std::size_t(c)] += weight * att[std::size_t(p)][std::size_t(c)];
     });
     return sum;
@@ -630,20 +683,20 @@ std::array<double, 3> ChiangFarField::exact_panel(int p, double phi, double a, d
 std::array<double, 3> ChiangFarField::azimuthal_graded(int p, double phi) const {
     const ChiangFiber &fiber = *fiber_;
     const Deflection deflection{p, k_};
-    const double s = fiber.s_;
+    const double s = fiber.lobes_.s_;
     const GaussLegendre &gl = GaussLegendre::rule(kPanelPoints);
     std::array<Channels, 4> att;
     double gamma_o = 0, gamma_t = 0;
 
     // A_p(γ) cos γ N(φ − Φ(γ)) per channel.
     auto integrand = [&](double gamma, Channels &out) {
-        fiber.attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), att, gamma_o, gamma_t);
+        fiber.lobes_.attenuation_at(o_.cos, k_, path_scale_, std::sin(gamma), att, gamma_o, gamma_t);
         const double shift = chiang::azimuthal_shift(p, gamma_o, gamma_t);
-        const double common = std::cos(gamma) * logistic(wrap_angle(phi - shift), s) * fiber.azimuthal_.norm();
+        const double common = std::cos(gamma) * logistic(wrap_angle(phi - shift), s) * fiber.lobes_.azimuthal_.norm();
         for (int c = 0; c < 3; ++c) out[std::size_t(c)] = att[std::size_t(p)][std::size_t(c)] * common;
     };
     auto logistic_at = [&](double gamma) {
-        return logistic(wrap_angle(phi - deflection.value(gamma)), s) * fiber.azimuthal_.norm();
+        return logistic(wrap_angle(phi - deflection.value(gamma)), s) * fiber.lobes_.azimuthal_.norm();
     };
 
     double cuts[4];

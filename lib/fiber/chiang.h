@@ -146,11 +146,72 @@ struct ChiangParams {
 
 class ChiangFiber;
 
+/// The constants of one parameter set that f and the samplers read: the mapped variances and
+/// logistic, the cuticle tilts, σ_a and η. Trivially destructible, so that the parameters of
+/// one hit (a strand's own, chiang_strands.h) can live in a ScratchBuffer.
+class ChiangLobes {
+  public:
+    /// Validates every parameter (finite, in range) and applies Cycles' clamps and roughness
+    /// mappings. Errors name the parameter and its allowed range.
+    static Expected<ChiangLobes> create(const ChiangParams &params);
+    /// The lobes of `params`, which must be valid (as create() accepts them; not checked):
+    /// the constants of the parameters that equal `base`'s are copied from it, the others
+    /// computed, so the result equals create(params)'s.
+    static ChiangLobes derive(const ChiangLobes &base, const ChiangParams &params);
+
+    const ChiangParams &params() const { return params_; }
+    /// The mapped longitudinal variance of lobe p (R: coat-reduced v_m0, TT: v/4, TRT and
+    /// residual: 4v); 0 for p outside [0, 3].
+    double lobe_variance(int p) const;
+    /// The mapped logistic scale s.
+    double logistic_scale() const { return s_; }
+    /// N_p of R, TT and TRT: the trimmed logistic of scale s.
+    const chiang::TrimmedLogistic &azimuthal() const { return azimuthal_; }
+    /// True when lobe p's M_p is the same function as in `other` (same variance, tilt and
+    /// tilt semantics), p in [0, 3].
+    bool same_longitudinal(int p, const ChiangLobes &other) const;
+    /// M_p as f evaluates it (tilt per params().tilt), per unit sin θ_i; 0 for p outside [0, 3].
+    double lobe_longitudinal(int p, double sin_theta_i, double sin_theta_o) const;
+    /// Lobe p's cone for a view at sin θ_o: d'Eon's M about θ_o + δ_p.
+    chiang::Cone lobe_cone(int p, double sin_theta_o) const;
+
+  private:
+    friend class ChiangFiber;
+    friend class ChiangPoint;
+    friend class ChiangFarField;
+    ChiangLobes() = default;
+    /// longitudinal_ of lobe_variance(p), once the variances are set.
+    void set_longitudinal_constants();
+
+    /// The cone axes θ_o + δ_p of R, TT, TRT and θ_o for the residual.
+    std::array<chiang::SinCos, 4> cones(chiang::SinCos o) const;
+    /// M_p per params().tilt, with the cone axes already known.
+    double tilted_longitudinal(int p, double sin_i, double cos_i, chiang::SinCos o,
+                               chiang::SinCos cone) const;
+    /// A_p and Φ_p at h for a view with Bravais ratio k and chord scale path_scale.
+    void attenuation_at(double cos_theta_o, double k, double path_scale, double h,
+                        std::array<std::array<double, 3>, 4> &a, double &gamma_o,
+                        double &gamma_t) const;
+
+    ChiangParams params_;
+    double v_ = 0;      // mapped longitudinal variance
+    double v_m0_ = 0;   // mapped variance of the (coated) R lobe
+    double s_ = 0;      // mapped logistic scale
+    double eta_ = 1.55;
+    double alpha_ = 0;
+    std::array<chiang::SinCos, 3> tilt_{};  // δ_p = (2α, −α, −4α)
+    std::array<double, 3> sigma_{};
+    chiang::TrimmedLogistic azimuthal_;  // N_p (R, TT, TRT)
+    std::array<chiang::LongitudinalConstants, 4> longitudinal_{};  // of lobe_variance(p)
+};
+
 /// The Chiang fiber at one hit (ω_o, h): the attenuations, azimuthal centres, lobe weights and
 /// cones computed once; f, the analytic sampler and its density read them.
 class ChiangPoint final : public FiberPoint {
   public:
     ChiangPoint(const ChiangFiber &fiber, const FiberHit &hit);
+    /// The fiber of `lobes` at the hit; `lobes` must outlive the point.
+    ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit);
 
     /// f·|cos θ_i| (near field, as Cycles' bsdf_principled_hair_eval).
     Rgb f(Vec3 wi) const override;
@@ -184,14 +245,15 @@ class ChiangPoint final : public FiberPoint {
     Vec3 direction(double sin_theta_i, double cos_theta_i, double phi) const;
     double sin_theta_o() const { return o_.sin; }
     double cos_theta_o() const { return o_.cos; }
-    const ChiangFiber &fiber() const { return *fiber_; }
+    /// The parameters' constants this point reads.
+    const ChiangLobes &lobes() const { return *lobes_; }
 
   private:
     double longitudinal(int p, double sin_i, double cos_i) const;
     // The analytic sampler's direction for (u0, u1, u2) and the lobe it came from.
     Vec3 draw(float u0, float u1, float u2, int &lobe) const;
 
-    const ChiangFiber *fiber_;
+    const ChiangLobes *lobes_;
     chiang::SinCos o_;
     double cos_phi_o_ = 0, sin_phi_o_ = -1;
     std::array<std::array<double, 3>, 4> a_{};
@@ -259,46 +321,30 @@ class ChiangFiber final : public FiberModel, public ShadingModel {
     LobeShape lobe_shape(int p) const override;
 
     /// M_p as f evaluates it (tilt per params().tilt), per unit sin θ_i; 0 for p outside [0, 3].
-    double lobe_longitudinal(int p, double sin_theta_i, double sin_theta_o) const;
+    double lobe_longitudinal(int p, double sin_theta_i, double sin_theta_o) const {
+        return lobes_.lobe_longitudinal(p, sin_theta_i, sin_theta_o);
+    }
     /// Lobe p's cone for a view at sin θ_o: d'Eon's M about θ_o + δ_p, the analytic sampler's
     /// M_p (and, with ChiangTilt::Outgoing, f's).
-    chiang::Cone lobe_cone(int p, double sin_theta_o) const;
+    chiang::Cone lobe_cone(int p, double sin_theta_o) const { return lobes_.lobe_cone(p, sin_theta_o); }
 
     /// The validated parameters as given.
-    const ChiangParams &params() const { return params_; }
+    const ChiangParams &params() const { return lobes_.params(); }
     /// The mapped longitudinal variance of lobe p (R: coat-reduced v_m0, TT: v/4, TRT and
     /// residual: 4v); 0 for p outside [0, 3].
-    double lobe_variance(int p) const;
+    double lobe_variance(int p) const { return lobes_.lobe_variance(p); }
     /// The mapped logistic scale s.
-    double logistic_scale() const { return s_; }
+    double logistic_scale() const { return lobes_.logistic_scale(); }
     /// N_p of R, TT and TRT: the trimmed logistic of scale s.
-    const chiang::TrimmedLogistic &azimuthal() const { return azimuthal_; }
+    const chiang::TrimmedLogistic &azimuthal() const { return lobes_.azimuthal(); }
+    /// The constants every point of this fiber reads.
+    const ChiangLobes &lobes() const { return lobes_; }
 
   private:
-    friend class ChiangPoint;
     friend class ChiangFarField;
     ChiangFiber() = default;
 
-    /// The cone axes θ_o + δ_p of R, TT, TRT and θ_o for the residual.
-    std::array<chiang::SinCos, 4> cones(chiang::SinCos o) const;
-    /// M_p per params().tilt, with the cone axes already known.
-    double tilted_longitudinal(int p, double sin_i, double cos_i, chiang::SinCos o,
-                               chiang::SinCos cone) const;
-    /// A_p and Φ_p at h for a view with Bravais ratio k and chord scale path_scale.
-    void attenuation_at(double cos_theta_o, double k, double path_scale, double h,
-                        std::array<std::array<double, 3>, 4> &a, double &gamma_o,
-                        double &gamma_t) const;
-
-    ChiangParams params_;
-    double v_ = 0;      // mapped longitudinal variance
-    double v_m0_ = 0;   // mapped variance of the (coated) R lobe
-    double s_ = 0;      // mapped logistic scale
-    double eta_ = 1.55;
-    double alpha_ = 0;
-    std::array<chiang::SinCos, 3> tilt_{};  // δ_p = (2α, −α, −4α)
-    std::array<double, 3> sigma_{};
-    chiang::TrimmedLogistic azimuthal_;  // N_p (R, TT, TRT)
-    std::array<chiang::LongitudinalConstants, 4> longitudinal_{};  // of lobe_variance(p)
+    ChiangLobes lobes_;
     int fixed_panels_ = 0;  // far field: γ panels of the fixed rule, 0 = graded rule
 };
 

@@ -10,6 +10,8 @@
 
 namespace hairis {
 
+struct HairInputValues;
+
 /// Where a ray met a fiber, in the fiber frame of frame.h (x = tangent).
 struct FiberHit {
     Vec3 wo;      ///< unit direction towards the viewer
@@ -24,6 +26,9 @@ struct FiberHit {
     /// Seeds models whose f is a Monte Carlo estimate (Huang, like Cycles' per-shading-point
     /// LCG); hashed with wo and h, so 0 is a valid seed. Chiang ignores it.
     std::uint32_t seed = 0;
+    /// The material's node inputs that vary per strand, at this hit (hair_inputs.h), or null:
+    /// the material's own values. Must outlive what is prepared from the hit.
+    const HairInputValues *inputs = nullptr;
 };
 
 /// A sampled incident direction and the density it was drawn from.

@@ -57,11 +57,16 @@ struct Counters {
 // Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`.
 class Bsdf {
   public:
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, ScratchBuffer &scratch) {
+    // `inputs`: the hit's per-strand node inputs (hair), null for the material's own.
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HairInputValues *inputs,
+         ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-            const float h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
-            hair_.emplace(hair->shading.at({frame_.to_local(wo), h}, scratch));
+            FiberHit hit;
+            hit.wo = frame_.to_local(wo);
+            hit.h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
+            hit.inputs = inputs;
+            hair_.emplace(hair->shading.at(hit, scratch));
         } else {
             const auto &d = std::get<DiffuseMaterial>(material);
             albedo_ = d.albedo;
@@ -187,7 +192,12 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         }
 
         scratch.reset();  // the previous vertex's BSDF is done with
-        const Bsdf bsdf(material, sp, wo, scratch);
+        const HairInputValues *inputs = nullptr;
+        if (sp.is_curve) {
+            HairInputValues values;
+            if (scene.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
+        }
+        const Bsdf bsdf(material, sp, wo, inputs, scratch);
         if (bsdf.black()) break;
 
         // Next-event estimation.

@@ -29,6 +29,9 @@
 //    frame) at h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves);
 //    the light sample takes f and pdf from it in one call, the BSDF sample comes with f, and
 //    the throughput is multiplied by f·|cos θ_i| / pdf.
+//    Where the curve set gives node inputs per curve or point (scene.h's CurveInput), f is
+//    the strand's own fiber at the hit's interpolated inputs (chiang_strands.h), and so is
+//    what the sampler follows.
 //  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
 //    min(1, sqrt(max throughput component)) and division by it (unbiased).
 //  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never

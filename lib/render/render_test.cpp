@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include "fiber/chiang_strands.h"
 #include "sampling/analytic_sampler.h"
+#include "sampling/near_field_table.h"
 #include "sampling/strategy.h"
 #include "sampling/uniform_sampler.h"
 
@@ -546,6 +548,88 @@ TEST(Render, HairStrategiesAgree) {
         if (a.mean > 0.01) {
             EXPECT_LT(a.sigma, u.sigma * 1.05) << "row " << y;
         }
+    }
+}
+
+// Curves whose melanin input is 0.8 everywhere render as a material of melanin 0.8: the
+// strand's own fiber is that fiber, bit for bit, for f and for the analytic sampler.
+TEST(Render, StrandInputsRenderAsTheFiberOfTheirValues) {
+    auto strands_of = [](float melanin) {
+        PrincipledHairNode node;
+        node.parametrization = HairParametrization::Melanin;
+        node.melanin = melanin;
+        return std::make_shared<const ChiangStrands>(ChiangStrands::create(node).value());
+    };
+    auto make = [&](float node_melanin, std::vector<CurveInput> inputs) {
+        const auto strands = strands_of(node_melanin);
+        SceneDesc d;
+        d.materials = {HairMaterial{
+            HairShading::create(strands, std::make_shared<const AnalyticSampler>(strands)).value()}};
+        HairCurves c = parallel_hairs(3, 0.14f, 0.06f);
+        c.inputs = std::move(inputs);
+        d.curves = {c};
+        d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
+        SunLight sun;
+        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.strength = 2.0f;
+        d.suns = {sun};
+        d.camera = ortho_down(0.3f, 0.3f, 6, 6);
+        return build(std::move(d));
+    };
+    RenderSettings s;
+    s.samples = 8;
+    s.max_bounces = 3;
+    const std::vector<float> expected = render_ok(make(0.8f, {}), s);
+    const std::vector<float> per_curve = render_ok(make(0.3f, {{HairInput::Melanin, false, {0.8f, 0.8f, 0.8f}}}), s);
+    const std::vector<float> per_point =
+        render_ok(make(0.3f, {{HairInput::Melanin, true, std::vector<float>(12, 0.8f)}}), s);
+    const std::vector<float> node_value = render_ok(make(0.3f, {}), s);
+    double total = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        ASSERT_EQ(per_curve[i], expected[i]) << i;
+        ASSERT_EQ(per_point[i], expected[i]) << i;
+        total += expected[i];
+    }
+    EXPECT_GT(total, 0.0);
+    EXPECT_NE(node_value, expected);  // the inputs did change the image
+}
+
+// TABLE samples the tables of the node's own values and ANALYTIC each strand's own fiber:
+// both are unbiased, so strands far from the tables' parameters still render the same.
+TEST(Render, TableAndAnalyticAgreeOnStrandsAwayFromTheTables) {
+    PrincipledHairNode node;
+    node.parametrization = HairParametrization::Melanin;
+    node.melanin = 0.5f;
+    const auto strands = std::make_shared<const ChiangStrands>(ChiangStrands::create(node).value());
+    const auto table = std::make_shared<const NearFieldTable>(NearFieldTable::create(strands->fiber()).value());
+    auto make = [&](std::shared_ptr<const Sampler> sampler) {
+        SceneDesc d;
+        d.materials = {HairMaterial{HairShading::create(strands, std::move(sampler)).value()}};
+        HairCurves c = parallel_hairs(3, 0.14f, 0.06f);
+        // Per curve: smoother and darker, rougher and lighter, the node's own; per point coat.
+        c.inputs = {{HairInput::Roughness, false, {0.12f, 0.6f, 0.3f}},
+                    {HairInput::RadialRoughness, false, {0.15f, 0.55f, 0.3f}},
+                    {HairInput::Melanin, false, {0.9f, 0.2f, 0.5f}},
+                    {HairInput::Coat, true, {0, 0.3f, 0.6f, 0.9f, 0, 0, 0, 0, 0.2f, 0.2f, 0.2f, 0.2f}}};
+        d.curves = {c};
+        d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
+        SunLight sun;
+        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.strength = 2.0f;
+        sun.angle = 0.2f;
+        d.suns = {sun};
+        d.camera = ortho_down(0.05f, 0.25f, 1, 5);
+        return build(std::move(d));
+    };
+    const Scene analytic = make(std::make_shared<const AnalyticSampler>(strands));
+    const Scene tabled = make(std::make_shared<const NearFieldTableSampler>(table, strands));
+    RenderSettings s;
+    s.max_bounces = 4;
+    for (int y = 0; y < 5; ++y) {
+        const PixelEstimate a = estimate(analytic, s, 0, y, 3000, 1);
+        const PixelEstimate t = estimate(tabled, s, 0, y, 3000, 1);
+        const double se = std::sqrt((a.sigma * a.sigma + t.sigma * t.sigma) / 3000.0);
+        EXPECT_NEAR(a.mean, t.mean, 4.5 * se + 1e-6) << "row " << y;
     }
 }
 

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -33,6 +34,7 @@ struct CurveGeometry {
     std::vector<std::uint32_t> segments;  // first control point of each segment
     std::vector<std::uint32_t> curve_of;  // the curve of each segment
     std::uint32_t material = 0;
+    std::vector<CurveInput> inputs;       // of the kept curves and their points only
 };
 
 struct MeshGeometry {
@@ -117,6 +119,39 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
                   d0 * p0.y + d1 * p1.y + d2 * p2.y + d3 * p3.y,
                   d0 * p0.z + d1 * p1.z + d2 * p2.z + d3 * p3.z,
                   d0 * p0.w + d1 * p1.w + d2 * p2.w + d3 * p3.w};
+}
+
+// A curve set's inputs: known once each, sized for its curves or points, in range, read by
+// the material's node, on a material that varies per strand.
+Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
+    if (hc.inputs.empty()) return std::nullopt;
+    const auto *hair = std::get_if<HairMaterial>(&material);
+    const auto *strands = hair ? dynamic_cast<const StrandInputReader *>(hair->shading.model()) : nullptr;
+    if (!strands)
+        return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
+                     " does not vary per strand (it needs a hair material made for curve inputs, e.g. ChiangStrands)"};
+    const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
+    std::uint32_t seen = 0;
+    for (const CurveInput &in : hc.inputs) {
+        if (int(in.input) >= kHairInputCount)
+            return Error{set + ": a curve input is not a node input (" + std::to_string(int(in.input)) + ")"};
+        const HairInputInfo &info = hair_input_info(in.input);
+        const std::string name = set + ", input " + info.name;
+        if ((seen >> unsigned(in.input)) & 1u) return Error{name + ": given twice"};
+        seen |= 1u << unsigned(in.input);
+        if (!strands->reads_input(in.input))
+            return Error{name + ": the material's parametrization does not read it"};
+        const std::size_t k = std::size_t(info.components), n = in.per_point ? points : curves;
+        if (in.values.size() != n * k)
+            return Error{name + ": has " + std::to_string(in.values.size()) + " values; " + std::to_string(n) +
+                         (in.per_point ? " points" : " curves") + " of " + std::to_string(k) + " need " +
+                         std::to_string(n * k)};
+        for (std::size_t i = 0; i < n; ++i)
+            if (Status bad = check_hair_input(in.input, in.values.data() + i * k,
+                                              set + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": "))
+                return bad;
+    }
+    return std::nullopt;
 }
 
 }  // namespace
@@ -242,8 +277,10 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                          std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
         if (hc.points.size() > (std::size_t(1) << 31))
             return Error{set + ": too many points (at most 2^31)"};
+        if (auto e = check_curve_inputs(hc, set, desc.materials[hc.material])) return *e;
         CurveGeometry geo;
         geo.material = hc.material;
+        for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}});
         std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
         const std::size_t curve_count = hc.first.size() - 1;
         for (std::size_t c = 0; c < curve_count; ++c) {
@@ -284,6 +321,14 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
             geo.cvs.push_back(cv(e - 1));
             const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
+            for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
+                const std::size_t k = std::size_t(hair_input_info(hc.inputs[i].input).components);
+                const std::vector<float> &from = hc.inputs[i].values;
+                const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
+                const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
+                geo.inputs[i].values.insert(geo.inputs[i].values.end(), from.begin() + std::ptrdiff_t(begin),
+                                            from.begin() + std::ptrdiff_t(end));
+            }
             for (std::uint32_t k = 0; k + 1 < n; ++k) {
                 geo.segments.push_back(base + k);
                 geo.curve_of.push_back(curve_index);
@@ -303,6 +348,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         hc.points = {};
         hc.radii = {};
         hc.first = {};
+        hc.inputs = {};
         if (!geo.segments.empty()) impl->curves.push_back(std::move(geo));
     }
 
@@ -450,9 +496,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     // Memory.
     std::size_t bytes = sizeof(Impl) + impl->lights.memory_bytes() +
                         impl->geometries.capacity() * sizeof(GeometryInfo);
-    for (const auto &c : impl->curves)
+    for (const auto &c : impl->curves) {
         bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
                  c.curve_of.capacity() * 4;
+        for (const CurveInput &in : c.inputs) bytes += in.values.capacity() * sizeof(float);
+    }
     for (const auto &m : impl->meshes)
         bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
                  m.materials.capacity() * 4 + m.emissive.capacity();
@@ -559,6 +607,7 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         Vec3 dpdu;
         const Vec3 centre = curve_point(hit.prim, hit.u, &dpdu);
         sp.is_curve = true;
+        sp.curve_u = std::clamp(hit.u, 0.0f, 1.0f);
         sp.self = {hit.prim.geometry, geo.curve_of[hit.prim.primitive]};
         sp.material = geo.material;
         const Vec3 n = safe_normalize(sp.position - centre);
@@ -597,6 +646,33 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         sp.self = hit.prim;
     }
     return sp;
+}
+
+bool Scene::hair_inputs(const SurfacePoint &point, HairInputValues &values) const {
+    if (!point.is_curve) return false;
+    const GeometryInfo &info = impl_->geometries[point.prim.geometry];
+    const CurveGeometry &geo = impl_->curves[info.index];
+    if (geo.inputs.empty()) return false;
+    const std::uint32_t segment = point.prim.primitive;
+    const std::size_t curve = geo.curve_of[segment];
+    // Kept curve j's control points start at (its points' offset) + 2j: one duplicate at each end.
+    const std::size_t first_point = std::size_t(geo.segments[segment]) - 2 * curve;
+    const float u = point.curve_u;
+    for (const CurveInput &in : geo.inputs) {
+        const int k = hair_input_info(in.input).components;
+        float v[3];
+        if (in.per_point) {
+            const float *a = in.values.data() + first_point * std::size_t(k), *b = a + k;
+            // Between the two points' values, whatever the rounding: ranges stay ranges.
+            for (int c = 0; c < k; ++c)
+                v[c] = std::clamp(a[c] + u * (b[c] - a[c]), std::min(a[c], b[c]), std::max(a[c], b[c]));
+        } else {
+            const float *a = in.values.data() + curve * std::size_t(k);
+            for (int c = 0; c < k; ++c) v[c] = a[c];
+        }
+        values.set(in.input, v);
+    }
+    return true;
 }
 
 }  // namespace hairis

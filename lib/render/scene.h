@@ -21,7 +21,9 @@
 //
 // Validation (errors name the object and what is allowed):
 //  - refused: NaN/inf positions or radii, negative radii, a curve with fewer than 2 points,
-//    inconsistent curve offsets, mesh indices out of range, material indices out of range,
+//    inconsistent curve offsets, curve inputs of the wrong size, out of their range
+//    (check_hair_input), repeated, not read by the material's parametrization or on a
+//    material whose model does not vary per strand, mesh indices out of range, material indices out of range,
 //    a hair material on a mesh, a hair material without fiber or sampler, invalid lights or
 //    camera, and a scene with no geometry left (no curve and no triangle).
 //  - skipped with a counted warning: curves of zero length (all points equal) or zero radius
@@ -41,6 +43,7 @@
 #include "core/expected.h"
 #include "render/lights.h"
 #include "core/math.h"
+#include "fiber/hair_inputs.h"
 #include "sampling/hair_bsdf.h"
 
 namespace hairis {
@@ -59,13 +62,27 @@ struct DiffuseMaterial {
 
 using Material = std::variant<HairMaterial, DiffuseMaterial>;
 
+/// A node input of a hair material given per curve or per point of a curve set: `values`
+/// holds the input's components (3 for colours) for each curve or each point in turn. At a
+/// hit a per-curve value is the curve's; a per-point value is interpolated linearly in the
+/// segment's curve parameter u between its two points, as Cycles interpolates curve-key
+/// attributes (kernel/geom/curve.h).
+struct CurveInput {
+    HairInput input = HairInput::Melanin;
+    bool per_point = false;
+    std::vector<float> values;
+};
+
 /// Hair curves sharing one material. Curve c has points first[c] .. first[c + 1] − 1; first
 /// has curve count + 1 entries, starts at 0 and ends at points.size(). One radius per point.
+/// `inputs` (at most one per HairInput) vary the material's node inputs per curve or point;
+/// the material must then be one whose model reads them (ChiangStrands).
 struct HairCurves {
     std::vector<Vec3> points;
     std::vector<float> radii;
     std::vector<std::uint32_t> first;
     std::uint32_t material = 0;
+    std::vector<CurveInput> inputs;
 };
 
 /// A triangle mesh in world space. indices holds 3 vertex indices per triangle; materials
@@ -140,6 +157,8 @@ struct SurfacePoint {
     Vec3 normal;
     /// Unit curve tangent normalize(dP/du) (zero for triangles).
     Vec3 tangent;
+    /// The curve parameter of the hit in its segment, in [0, 1] (0 for triangles).
+    float curve_u = 0;
     std::uint32_t material = 0;
     bool is_curve = false;
     /// True for a mesh triangle whose emission is in the light set (MIS applies to it).
@@ -191,6 +210,9 @@ class Scene {
                   PrimRef skip_b = {}) const;
     /// Shading data of a hit of the ray (origin, dir).
     SurfacePoint surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const;
+    /// The node inputs a curve hit's curve set gives (HairCurves::inputs) at the hit, in
+    /// `values`; false (values untouched) for triangles and curves without inputs.
+    bool hair_inputs(const SurfacePoint &point, HairInputValues &values) const;
 
     /// The Catmull-Rom centre line of a curve segment at u ∈ [0, 1] (for tests): position
     /// (and radius in `radius`), and dP/du in `derivative` when not null.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "fiber/chiang.h"
+#include "fiber/chiang_strands.h"
 #include "sampling/uniform_sampler.h"
 
 #include <cmath>
@@ -350,6 +351,132 @@ TEST(Scene, InvalidScenesGiveClearErrors) {
     d.camera.width = 0;
     e = build_error(std::move(d));
     EXPECT_NE(e.find("camera: width"), std::string::npos) << e;
+}
+
+// A hair material whose inputs vary per strand (Melanin Concentration).
+HairMaterial strands_material() {
+    PrincipledHairNode node;
+    node.parametrization = HairParametrization::Melanin;
+    auto strands = std::make_shared<const ChiangStrands>(ChiangStrands::create(node).value());
+    return HairMaterial{HairShading::create(strands, std::make_shared<const UniformSampler>()).value()};
+}
+
+// Melanin linear in x along curves of evenly spaced points (x = −2.5 .. 2.5).
+float melanin_at(float x) { return 0.5f + 0.15f * x; }
+
+// Two parallel hairs along X (y = 0 and y = 3) of 6 evenly spaced points each, melanin per
+// point melanin_at(x), roughness per curve 0.2 and 0.7.
+HairCurves hairs_with_inputs() {
+    HairCurves c;
+    for (float y : {0.0f, 3.0f})
+        for (int k = 0; k < 6; ++k) {
+            c.points.push_back({-2.5f + float(k), y, 0});
+            c.radii.push_back(0.1f);
+        }
+    c.first = {0, 6, 12};
+    CurveInput melanin{HairInput::Melanin, true, {}};
+    for (const Vec3 &p : c.points) melanin.values.push_back(melanin_at(p.x));
+    c.inputs = {melanin, CurveInput{HairInput::Roughness, false, {0.2f, 0.7f}}};
+    return c;
+}
+
+// The inputs where a ray straight down at (x, y) meets the curves.
+HairInputValues inputs_at(const Scene &scene, float x, float y) {
+    const Vec3 origin{x, y, 5}, dir{0, 0, -1};
+    const auto hit = scene.intersect(origin, dir, 0.0f, INFINITY);
+    EXPECT_TRUE(hit.has_value()) << x << ", " << y;
+    HairInputValues v;
+    if (!hit) return v;
+    EXPECT_TRUE(scene.hair_inputs(scene.surface_point(origin, dir, *hit), v));
+    return v;
+}
+
+TEST(Scene, PointInputsInterpolateAlongTheCurveAndCurveInputsAreTheCurves) {
+    SceneDesc d;
+    d.materials = {strands_material()};
+    d.curves = {hairs_with_inputs()};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    // Inner segments of evenly spaced collinear points: the Catmull-Rom centre line is linear in
+    // u, so the hit's interpolated melanin is the linear function itself at the hit's x.
+    for (float y : {0.0f, 3.0f})
+        for (float x : {-1.37f, -0.5f, -0.02f, 0.61f, 1.0f, 1.44f}) {
+            const HairInputValues v = inputs_at(scene, x, y);
+            ASSERT_TRUE(v.has(HairInput::Melanin));
+            EXPECT_NEAR(*v.get(HairInput::Melanin), melanin_at(x), 2e-5f) << x << ", " << y;
+            ASSERT_TRUE(v.has(HairInput::Roughness));
+            EXPECT_EQ(*v.get(HairInput::Roughness), y == 0.0f ? 0.2f : 0.7f);
+            EXPECT_FALSE(v.has(HairInput::Coat));
+        }
+    // End segments (the end point doubled): between the two points' values.
+    for (float x : {-2.3f, 2.2f}) {
+        const float m = *inputs_at(scene, x, 0.0f).get(HairInput::Melanin);
+        const float a = melanin_at(x < 0 ? -2.5f : 1.5f), b = melanin_at(x < 0 ? -1.5f : 2.5f);
+        EXPECT_GE(m, a) << x;
+        EXPECT_LE(m, b) << x;
+    }
+    // Triangles and curves without inputs have none.
+    SceneDesc plain;
+    plain.materials = {strands_material()};
+    plain.curves = {straight_hair()};
+    plain.camera = small_camera();
+    const Scene without = build_ok(std::move(plain));
+    const auto hit = without.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    HairInputValues none;
+    EXPECT_FALSE(without.hair_inputs(without.surface_point({0.3f, 0, 5}, {0, 0, -1}, *hit), none));
+}
+
+TEST(Scene, InputsOfSkippedCurvesAreLeftOut) {
+    SceneDesc d;
+    d.materials = {strands_material()};
+    HairCurves c = hairs_with_inputs();
+    // A zero-length curve between the two: its values must not shift the second curve's.
+    c.points.insert(c.points.begin() + 6, {{9, 9, 9}, {9, 9, 9}});
+    c.radii.insert(c.radii.begin() + 6, {0.1f, 0.1f});
+    c.first = {0, 6, 8, 14};
+    c.inputs[0].values.insert(c.inputs[0].values.begin() + 6, {0.99f, 0.99f});
+    c.inputs[1].values = {0.2f, 0.99f, 0.7f};
+    d.curves = {c};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    EXPECT_EQ(scene.stats().skipped_curves, 1u);
+    const HairInputValues v = inputs_at(scene, 0.61f, 3.0f);
+    EXPECT_NEAR(*v.get(HairInput::Melanin), melanin_at(0.61f), 2e-5f);
+    EXPECT_EQ(*v.get(HairInput::Roughness), 0.7f);
+}
+
+TEST(Scene, InvalidCurveInputsAreRefusedByName) {
+    auto error_of = [](auto change, HairMaterial material) {
+        SceneDesc d;
+        d.materials = {std::move(material)};
+        HairCurves c = hairs_with_inputs();
+        change(c);
+        d.curves = {c};
+        d.camera = small_camera();
+        return build_error(std::move(d));
+    };
+    std::string e = error_of([](HairCurves &c) { c.inputs[1].values.push_back(0.5f); }, strands_material());
+    EXPECT_NE(e.find("curve set 0, input roughness: has 3 values; 2 curves of 1 need 2"), std::string::npos) << e;
+    e = error_of([](HairCurves &c) { c.inputs[0].values[7] = 1.5f; }, strands_material());
+    EXPECT_NE(e.find("curve set 0, point 7: melanin must be in [0, 1] (got 1.5)"), std::string::npos) << e;
+    e = error_of([](HairCurves &c) { c.inputs[1].values[1] = NAN; }, strands_material());
+    EXPECT_NE(e.find("curve set 0, curve 1: roughness must be in [0, 1] (got nan)"), std::string::npos) << e;
+    e = error_of([](HairCurves &c) { c.inputs.push_back(c.inputs[1]); }, strands_material());
+    EXPECT_NE(e.find("input roughness: given twice"), std::string::npos) << e;
+    e = error_of([](HairCurves &c) { c.inputs.push_back({HairInput::Color, false, {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f}}); },
+                 strands_material());
+    EXPECT_NE(e.find("input color: the material's parametrization does not read it"), std::string::npos) << e;
+    e = error_of([](HairCurves &) {}, hair_material());
+    EXPECT_NE(e.find("curve set 0: has curve inputs, but its material 0 does not vary per strand"), std::string::npos)
+        << e;
+    e = error_of([](HairCurves &) {}, hair_material());
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}};
+    d.curves = {hairs_with_inputs()};
+    d.camera = small_camera();
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("does not vary per strand"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ class AnalyticPoint final : public SamplerPoint {
 }  // namespace
 
 const SamplerPoint &AnalyticSampler::at(const FiberHit &, const FiberPoint *fiber, ScratchBuffer &scratch) const {
-    // model() is the Chiang fiber, so `fiber` is one of its ChiangPoints.
+    // model() is a ChiangFiber or ChiangStrands, so `fiber` is one of its ChiangPoints.
     return scratch.make<AnalyticPoint>(static_cast<const ChiangPoint &>(*fiber));
 }
 

@@ -316,9 +316,12 @@ float sample_cell_shape(float a, float b, float u) {
 
 }  // namespace
 
-NearFieldTable::Prepared NearFieldTable::prepare(const ChiangPoint &fiber) const {
+NearFieldTable::Prepared NearFieldTable::prepare(const ChiangPoint &fiber, bool own_cones) const {
     Prepared q;
     q.fiber = &fiber;
+    if (own_cones && &fiber.lobes() != &fiber_->lobes())
+        for (int p = 0; p < 4; ++p)
+            if (!fiber.lobes().same_longitudinal(p, fiber_->lobes())) q.own_cones |= 1u << unsigned(p);
     q.blend = nodes_.locate(safe_asin(float(fiber.sin_theta_o())));
     // Lobe weights luminance(A_p)·I_p at both nodes, normalized per node.
     double a[4];
@@ -339,7 +342,7 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
     const int k = cells_.cell_of_sin(wi.x);
     const double phi = fiber.relative_azimuth(wi);
     double azimuthal[4];
-    for (int p = 0; p < 3; ++p) azimuthal[p] = fiber_->azimuthal().density(wrap_angle(phi - fiber.shift(p)));
+    for (int p = 0; p < 3; ++p) azimuthal[p] = fiber.lobes().azimuthal().density(wrap_angle(phi - fiber.shift(p)));
     azimuthal[3] = kInvTwoPi;
     const float t_in_cell = std::clamp((wi.x - cells_.sin_edge(k)) / cells_.sin_width(k), 0.0f, 1.0f);
 
@@ -354,7 +357,7 @@ float NearFieldTable::density(const Prepared &q, Vec3 wi) const {
         for (int p = 0; p < 4; ++p) {
             if (!(q.weight[side][p] > 0.0f)) continue;
             double m = 0;
-            if (data_->cone[size_t(r) * 4 + size_t(p)]) {
+            if (((q.own_cones >> unsigned(p)) & 1u) || data_->cone[size_t(r) * 4 + size_t(p)]) {
                 if (longitudinal[p] < 0) longitudinal[p] = fiber.cone(p).density(double(wi.x), cos_from_sin(double(wi.x)));
                 m = longitudinal[p];
             } else {
@@ -394,7 +397,7 @@ std::optional<DirectionSample> NearFieldTable::sample(const Prepared &q, float u
     while (p > 0 && !(w[p] > 0.0f)) --p;  // rounding left u past the last positive lobe
 
     float sin_theta = 0, cos_theta = 1;
-    if (data_->cone[size_t(r) * 4 + size_t(p)]) {
+    if (((q.own_cones >> unsigned(p)) & 1u) || data_->cone[size_t(r) * 4 + size_t(p)]) {
         // What is left of u inside the lobe's interval picks the cone's cosine; u1 the angle.
         const double u_cone = w[p] > 0.0f ? std::clamp(double(u) / double(w[p]), 0.0, 1.0) : 0.0;
         sin_theta = off_axis(float(fiber.cone(p).sample(u_cone, double(clamp_unit(u1)))));
@@ -408,7 +411,7 @@ std::optional<DirectionSample> NearFieldTable::sample(const Prepared &q, float u
         cos_theta = point.cos_theta;
     }
     double phi = -kPi + kTwoPi * double(clamp_unit(u0));  // residual: uniform
-    if (p < 3) phi = fiber.shift(p) + fiber_->azimuthal().sample(clamp_unit(u0));
+    if (p < 3) phi = fiber.shift(p) + fiber.lobes().azimuthal().sample(clamp_unit(u0));
 
     DirectionSample s;
     s.wi = fiber.direction(sin_theta, cos_theta, phi);
@@ -446,7 +449,7 @@ class NearFieldPoint final : public SamplerPoint {
 }  // namespace
 
 const SamplerPoint &NearFieldTableSampler::at(const FiberHit &, const FiberPoint *fiber, ScratchBuffer &scratch) const {
-    // model() is the table's fiber, so `fiber` is one of its ChiangPoints.
+    // model() is the table's fiber or the strands, so `fiber` is one of their ChiangPoints.
     return scratch.make<NearFieldPoint>(*table_, static_cast<const ChiangPoint &>(*fiber));
 }
 

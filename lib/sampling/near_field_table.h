@@ -35,6 +35,11 @@
 // weights, and its density enters the same mixture. At roughness 0.02–0.1 this takes the
 // variance from 4–60× the analytic sampler's (rows alone) to 0.02–0.13× of it
 // (bench/results/strategy_study.md, section 5).
+//
+// A material whose inputs vary per strand (chiang_strands.h) keeps the tables of its node's
+// own values; at a strand's hit the lobe weights take the strand's A_p, φ the strand's N_p,
+// and a lobe whose M_p is not the table's draws θ_i from the strand's own cone, never from
+// rows baked for another roughness (bench/results/strand_study.md measures both).
 #pragma once
 
 #include <array>
@@ -44,6 +49,7 @@
 #include <vector>
 
 #include "fiber/chiang.h"
+#include "fiber/chiang_strands.h"
 #include "core/expected.h"
 #include "sampling/piecewise.h"
 #include "sampling/sampling_table.h"
@@ -99,14 +105,20 @@ class NearFieldTable {
     const std::shared_ptr<const NearFieldData> &shared_data() const { return data_; }
 
     /// What sample() and pdf() need at one hit, computed once from the fiber's point there:
-    /// the θ_o nodes and their lobe weights.
+    /// the θ_o nodes, their lobe weights, and the lobes whose M_p is not the table's.
     struct Prepared {
         const ChiangPoint *fiber = nullptr;
         NodeBlend blend;
         float weight[2][4] = {};  // lobe probabilities at the lower and upper node
+        unsigned own_cones = 0;   // bit p: lobe p draws θ_i from the hit's own cone
     };
-    /// `fiber` must be this table's fiber at the hit, and outlive the result.
-    Prepared prepare(const ChiangPoint &fiber) const;
+    /// `fiber` is the fiber at the hit, and must outlive the result: this table's fiber, or a
+    /// strand's own (chiang_strands.h) whose parameters differ from the table's. The lobe
+    /// weights luminance(A_p)·I_p take the hit's A_p, φ is drawn from the hit's N_p around its
+    /// Φ_p(h), and a lobe whose M_p differs from the table's (another roughness, coat or
+    /// offset) draws θ_i from the hit's own cone when `own_cones` is set, else from the
+    /// table's rows and cones as they are; the density is the exact one in every case.
+    Prepared prepare(const ChiangPoint &fiber, bool own_cones = true) const;
 
     /// Draws ω_i: u2 picks the θ_o node and the lobe, u1 θ_i, u0 φ. nullopt when the density
     /// there is not positive (never for a valid fiber).
@@ -144,16 +156,23 @@ class NearFieldTable {
     const float *edge(int row) const { return data_->edge.data() + size_t(row) * size_t(cells_.count() + 1); }
 };
 
-/// The near-field table as a sampler.
+/// The near-field table as a sampler: for the table's fiber, or for a material whose inputs
+/// vary per strand (then each hit's point is the strand's own, see NearFieldTable::prepare).
 class NearFieldTableSampler final : public Sampler {
   public:
     explicit NearFieldTableSampler(std::shared_ptr<const NearFieldTable> table) : table_(std::move(table)) {}
-    const ShadingModel *model() const override { return &table_->fiber(); }
+    /// `strands`' own fiber must have the table's parameters (strategy.h checks it).
+    NearFieldTableSampler(std::shared_ptr<const NearFieldTable> table, std::shared_ptr<const ChiangStrands> strands)
+        : table_(std::move(table)), strands_(std::move(strands)) {}
+    const ShadingModel *model() const override {
+        return strands_ ? static_cast<const ShadingModel *>(strands_.get()) : &table_->fiber();
+    }
     const SamplerPoint &at(const FiberHit &hit, const FiberPoint *fiber, ScratchBuffer &scratch) const override;
     const NearFieldTable &table() const { return *table_; }
 
   private:
     std::shared_ptr<const NearFieldTable> table_;
+    std::shared_ptr<const ChiangStrands> strands_;
 };
 
 }  // namespace hairis

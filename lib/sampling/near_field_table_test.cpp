@@ -373,6 +373,76 @@ TEST(NearFieldTable, EdgeValuesOfAnyScaleGiveTheSameDensity) {
     }
 }
 
+// A strand's own point (another melanin, roughness and radial roughness than the table's
+// fiber): the density is exact with the strand's own cones for the lobes whose M_p is not the
+// table's, and with the table's rows regardless; the own cones are far closer to f.
+ChiangParams strand_params(const ChiangFiber &table_fiber, float roughness) {
+    ChiangParams p = table_fiber.params();
+    p.roughness = p.radial_roughness = roughness;
+    p.sigma_a = {1.1f, 1.9f, 3.4f};
+    return p;
+}
+
+TEST(NearFieldTable, AStrandsPointIsSampledExactlyWithOrWithoutItsOwnCones) {
+    const auto f = fiber(0.3f, 2.0f);
+    const auto table = std::make_shared<const NearFieldTable>(NearFieldTable::create(f).value());
+    Chi2Options options;
+    options.test_count = 2 * 2 * 2;
+    for (int k = 0; k <= table->theta_i_cells(); ++k)
+        options.theta_breaks.push_back(-kHalfPi + kPi * k / table->theta_i_cells());
+    for (float roughness : {0.15f, 0.6f}) {
+        const ChiangLobes strand = ChiangLobes::derive(f->lobes(), strand_params(*f, roughness));
+        for (bool own : {true, false})
+            for (double theta_o : {40.2, -75.0}) {
+                const ChiangPoint point(strand, {view_at(theta_o), 0.35f});
+                const NearFieldTable::Prepared q = table->prepare(point, own);
+                EXPECT_EQ(q.own_cones, own ? 0xFu : 0u);
+                const auto r = testing::chi2_direction_test(
+                    [&](Sample3 u) -> std::optional<Vec3> {
+                        auto s = table->sample(q, u.u0, u.u1, u.u2);
+                        return s ? std::optional<Vec3>(s->wi) : std::nullopt;
+                    },
+                    [&](Vec3 wi) { return double(table->density(q, wi)); }, options);
+                EXPECT_TRUE(r.passed) << "roughness " << roughness << " own cones " << own << " theta_o " << theta_o
+                                      << ": " << r.message;
+                EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
+                EXPECT_EQ(r.failed_samples, 0);
+            }
+    }
+    // The table's own fiber (and a strand of only another melanin) keeps every row.
+    const ChiangPoint own_point = f->at({view_at(10.0), 0.1f});
+    EXPECT_EQ(table->prepare(own_point).own_cones, 0u);
+    ChiangParams darker = f->params();
+    darker.sigma_a = {2.0f, 3.0f, 4.0f};
+    const ChiangLobes dark = ChiangLobes::derive(f->lobes(), darker);
+    EXPECT_EQ(table->prepare(ChiangPoint(dark, {view_at(10.0), 0.1f})).own_cones, 0u);
+    ChiangParams coated = f->params();
+    coated.coat = 0.5f;  // only R's M_p changes
+    const ChiangLobes coat = ChiangLobes::derive(f->lobes(), coated);
+    EXPECT_EQ(table->prepare(ChiangPoint(coat, {view_at(10.0), 0.1f})).own_cones, 1u << kLobeR);
+}
+
+TEST(NearFieldTable, AStrandsOwnConesFollowItFarCloserThanTheTablesRows) {
+    const auto f = fiber(0.3f, 2.0f);
+    const NearFieldTable table = NearFieldTable::create(f).value();
+    for (float roughness : {0.15f, 0.6f}) {
+        const auto strand = std::make_shared<const ChiangFiber>(ChiangFiber::create(strand_params(*f, roughness)).value());
+        for (double theta_o : {-45.0, 30.0}) {
+            const Vec3 wo = view_at(theta_o);
+            const float h = 0.3f;
+            const ChiangPoint point = strand->at({wo, h});
+            const NearFieldTable::Prepared own = table.prepare(point, true), rows = table.prepare(point, false);
+            auto draw = [&table](const NearFieldTable::Prepared &q) {
+                return [&table, &q](float a, float b, float c) { return table.sample(q, a, b, c); };
+            };
+            const double v_own = relative_variance(*strand, wo, h, draw(own), 100000);
+            const double v_rows = relative_variance(*strand, wo, h, draw(rows), 100000);
+            EXPECT_LT(v_own, 0.1 * v_rows) << "roughness " << roughness << " theta_o " << theta_o << ": own cones "
+                                           << v_own << ", rows " << v_rows;
+        }
+    }
+}
+
 TEST(NearFieldTable, RefusesBadResolutions) {
     EXPECT_FALSE(NearFieldTable::create(fiber(), {1, 180}).ok());
     EXPECT_FALSE(NearFieldTable::create(fiber(), {61, 2}).ok());

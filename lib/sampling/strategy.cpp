@@ -57,12 +57,17 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
                           canonical_parameters(t.parameters), t.near_field};
 }
 
-Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &in) {
-    if (Status s = check::in_range("multiple_weight", in.multiple_weight, 0.0, 1.0)) return *s;
+Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &input) {
+    if (Status s = check::in_range("multiple_weight", input.multiple_weight, 0.0, 1.0)) return *s;
+    if (input.strands && input.chiang && input.chiang != input.strands->fiber())
+        return Error{"strategy inputs: chiang must be null or the strands' own fiber"};
+    StrategyInputs in = input;
+    if (in.strands) in.chiang = in.strands->fiber();
     switch (kind) {
         case StrategyKind::Uniform:
             return std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>());
         case StrategyKind::Analytic:
+            if (in.strands) return std::shared_ptr<const Sampler>(std::make_shared<const AnalyticSampler>(in.strands));
             if (!in.chiang) return Error{"the analytic strategy needs a Chiang (Principled Hair) fiber"};
             return std::shared_ptr<const Sampler>(std::make_shared<const AnalyticSampler>(in.chiang));
         case StrategyKind::Gaussian:
@@ -94,7 +99,10 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
                     if (!made) return table_error(made.error().message);
                     near_field = std::make_shared<const NearFieldTable>(std::move(made).value());
                 }
-                single = std::shared_ptr<const Sampler>(std::make_shared<const NearFieldTableSampler>(near_field));
+                single = in.strands ? std::shared_ptr<const Sampler>(
+                                          std::make_shared<const NearFieldTableSampler>(near_field, in.strands))
+                                    : std::shared_ptr<const Sampler>(
+                                          std::make_shared<const NearFieldTableSampler>(near_field));
             }
             return mixture(std::move(single), shared(MultipleTableSampler::create(t.multiple, in.n_h)),
                            in.multiple_weight);

@@ -7,6 +7,7 @@
 
 #include "core/expected.h"
 #include "fiber/chiang.h"
+#include "fiber/chiang_strands.h"
 #include "fiber/seed_pdfs.h"
 #include "sampling/near_field_table.h"
 #include "sampling/sampler.h"
@@ -55,6 +56,11 @@ void describe(Fields &f, SamplerOptions &o) {
 struct StrategyInputs {
     /// The material's fiber: ANALYTIC samples it; TABLE samples its near field from it.
     std::shared_ptr<const ChiangFiber> chiang;
+    /// A material whose inputs vary per strand (takes the place of `chiang`, which must then
+    /// be null or its own fiber): ANALYTIC samples each strand's own fiber; TABLE samples the
+    /// tables baked for the node's own values, following each strand as
+    /// NearFieldTable::prepare says. The sampler's model() is then `strands`.
+    std::shared_ptr<const ChiangStrands> strands;
     /// Baked tables (TABLE): they must have been baked for `chiang`'s parameters.
     const SamplingTables *tables = nullptr;
     /// The seed's PDFs (GAUSSIAN).

@@ -10,6 +10,7 @@
 #include "core/frame.h"
 #include "fiber/fiber_spec.h"
 #include "sampler_at.h"
+#include "fiber/chiang_strands.h"
 #include "sampling/mixture_sampler.h"
 #include "tables/bake.h"
 
@@ -57,10 +58,11 @@ StrategyInputs inputs(std::shared_ptr<const ChiangFiber> fiber, const SamplingTa
 
 Vec3 view_at(double theta_r_deg) { return direction_of(float(radians(theta_r_deg)), -float(kHalfPi)); }
 
-void expect_exact(const Sampler &sampler, double theta_r_deg, float h, const std::string &what) {
-    const SamplerAt at(sampler, view_at(theta_r_deg), h);
+void expect_exact(const Sampler &sampler, double theta_r_deg, float h, const std::string &what,
+                  const HairInputValues *strand = nullptr, int family = kFamily) {
+    const SamplerAt at(sampler, view_at(theta_r_deg), h, strand);
     Chi2Options options;
-    options.test_count = kFamily;
+    options.test_count = family;
     // The table densities are piecewise constant: split the quadrature at their cell edges.
     for (int k = 0; k <= 32; ++k) {
         options.theta_breaks.push_back(-kHalfPi + kPi * k / 32);
@@ -152,6 +154,135 @@ TEST(Strategy, AHairShadingRefusesASamplerOfAnotherFiber) {
     EXPECT_FALSE(HairShading::create(other, s).ok());
     EXPECT_FALSE(HairShading::create(nullptr, s).ok());
     EXPECT_TRUE(HairShading::create(nullptr, made(StrategyKind::Uniform, {})).ok());
+}
+
+// Materials whose inputs vary per strand: the tables are baked for the node's own values
+// (melanin 0.5, roughness 0.3); strands away from them, in roughness (their M_p is not the
+// tables': their own cones), in melanin alone (the tables' rows), or both.
+struct StrandCase {
+    const char *name;
+    float roughness, melanin;  // < 0: the node's own
+};
+const StrandCase kStrands[] = {{"smoother and darker", 0.15f, 0.9f},
+                               {"rougher and lighter", 0.6f, 0.2f},
+                               {"darker only", -1.0f, 0.95f}};
+const double kStrandThetaR[] = {30.0, -66.0};
+// per tilt, strand and θ_r: analytic, table, table mixture
+constexpr int kStrandFamily = 2 * 3 * 2 * 3;
+
+struct StrandFixture {
+    std::shared_ptr<const ChiangStrands> strands;
+    SamplingTables tables;
+};
+
+const StrandFixture &strand_fixture(ChiangTilt tilt) {
+    auto make = [](ChiangTilt t) {
+        PrincipledHairNode node;
+        node.parametrization = HairParametrization::Melanin;
+        node.melanin = 0.5f;
+        node.melanin_redness = 0.5f;
+        node.tilt = t;
+        auto strands = std::make_shared<const ChiangStrands>(ChiangStrands::create(node).value());
+        FiberSpec spec;
+        spec.node = node;
+        BakeOptions options;
+        options.theta_r_count = kNodes;
+        options.theta_i_count = 32;
+        options.phi_count = 32;
+        const TableSet set = bake_tables(*strands->fiber(), spec.parameters().value(), options).value();
+        return StrandFixture{strands, SamplingTables::from(set).value()};
+    };
+    static const StrandFixture incident = make(ChiangTilt::Incident), outgoing = make(ChiangTilt::Outgoing);
+    return tilt == ChiangTilt::Incident ? incident : outgoing;
+}
+
+HairInputValues strand_inputs(const StrandCase &c) {
+    HairInputValues v;
+    if (c.roughness >= 0.0f) {
+        v.set(HairInput::Roughness, &c.roughness);
+        v.set(HairInput::RadialRoughness, &c.roughness);
+    }
+    v.set(HairInput::Melanin, &c.melanin);
+    return v;
+}
+
+class StrandStrategy : public ::testing::TestWithParam<ChiangTilt> {};
+
+TEST_P(StrandStrategy, EachStrategyIsExactAtAStrandsOwnFiber) {
+    const StrandFixture &f = strand_fixture(GetParam());
+    StrategyInputs in;
+    in.strands = f.strands;
+    in.tables = &f.tables;
+    const auto analytic = made(StrategyKind::Analytic, in);
+    const auto table = made(StrategyKind::Table, in);
+    in.multiple_weight = 0.3f;
+    const auto mixture = made(StrategyKind::Table, in);
+    for (const auto *s : {analytic.get(), table.get(), mixture.get()}) EXPECT_EQ(s->model(), f.strands.get());
+    for (const StrandCase &c : kStrands) {
+        const HairInputValues strand = strand_inputs(c);
+        for (double theta_r : kStrandThetaR) {
+            expect_exact(*analytic, theta_r, 0.35f, std::string("analytic, ") + c.name, &strand, kStrandFamily);
+            expect_exact(*table, theta_r, 0.35f, std::string("table, ") + c.name, &strand, kStrandFamily);
+            expect_exact(*mixture, theta_r, -0.8f, std::string("table mixture, ") + c.name, &strand, kStrandFamily);
+        }
+    }
+}
+
+TEST_P(StrandStrategy, EachStrategyEvaluatesTheStrandsOwnF) {
+    const StrandFixture &f = strand_fixture(GetParam());
+    StrategyInputs in;
+    in.strands = f.strands;
+    in.tables = &f.tables;
+    const HairInputValues strand = strand_inputs(kStrands[1]);
+    PrincipledHairNode node = f.strands->node();
+    node.roughness = node.radial_roughness = kStrands[1].roughness;
+    node.melanin = kStrands[1].melanin;
+    const ChiangFiber expected = ChiangFiber::create(to_chiang_params(node).value()).value();
+    const Vec3 wo = view_at(20.0), wi = direction_of(-0.3f, 2.0f);
+    for (StrategyKind kind : {StrategyKind::Uniform, StrategyKind::Analytic, StrategyKind::Table}) {
+        const HairShading shading = HairShading::create(f.strands, made(kind, in)).value();
+        FiberHit hit{wo, 0.2f};
+        hit.inputs = &strand;
+        ScratchBuffer scratch;
+        const HairBsdf bsdf = shading.at(hit, scratch);
+        EXPECT_EQ(bsdf.f(wi).g, expected.at({wo, 0.2f}).f(wi).g) << strategy_name(kind);
+        float pdf = 0;
+        EXPECT_FLOAT_EQ(bsdf.f_and_pdf(wi, pdf).g, expected.at({wo, 0.2f}).f(wi).g) << strategy_name(kind);
+        EXPECT_FLOAT_EQ(pdf, bsdf.pdf(wi)) << strategy_name(kind);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Tilt, StrandStrategy, ::testing::Values(ChiangTilt::Incident, ChiangTilt::Outgoing),
+                         [](const ::testing::TestParamInfo<ChiangTilt> &case_info) {
+                             return std::string(case_info.param == ChiangTilt::Incident ? "Cycles34" : "Cycles42");
+                         });
+
+TEST(Strategy, ASamplerForStrandsPairsOnlyWithThoseStrands) {
+    const StrandFixture &f = strand_fixture(ChiangTilt::Incident);
+    StrategyInputs in;
+    in.strands = f.strands;
+    in.tables = &f.tables;
+    const auto table = made(StrategyKind::Table, in);
+    // The strands, not their own fiber: the fiber's points carry no strand.
+    EXPECT_TRUE(HairShading::create(f.strands, table).ok());
+    EXPECT_FALSE(HairShading::create(f.strands->fiber(), table).ok());
+    StrategyInputs fiber_only;
+    fiber_only.chiang = f.strands->fiber();
+    fiber_only.tables = &f.tables;
+    EXPECT_FALSE(HairShading::create(f.strands, made(StrategyKind::Table, fiber_only)).ok());
+    EXPECT_FALSE(HairShading::create(f.strands, made(StrategyKind::Analytic, fiber_only)).ok());
+    // Other strands of the same node are another model.
+    const auto twin = std::make_shared<const ChiangStrands>(ChiangStrands::create(f.strands->node()).value());
+    EXPECT_FALSE(HairShading::create(twin, table).ok());
+    // The tables must be the node's own fiber's, and `chiang` nothing else.
+    in.chiang = fixture().fiber;
+    EXPECT_FALSE(make_sampler(StrategyKind::Table, in).ok());
+    StrategyInputs other;
+    other.strands = f.strands;
+    other.tables = &fixture().tables;
+    auto stale = make_sampler(StrategyKind::Table, other);
+    ASSERT_FALSE(stale.ok());
+    EXPECT_EQ(stale.error().kind, ErrorKind::InvalidTable);
 }
 
 }  // namespace

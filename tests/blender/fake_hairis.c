@@ -88,6 +88,10 @@ static const char *const kinds[][2] = {
     {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_transmission_bounces=12;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
+    {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
+                     "absorption=material;roughness=material;radial_roughness=material;"
+                     "coat=material;ior=material;offset=material;random_color=material;"
+                     "random_roughness=material;random=material"},
 };
 enum { KIND_COUNT = sizeof kinds / sizeof kinds[0] };
 
@@ -326,7 +330,7 @@ const char *hairis_defaults(const char *kind)
     if (!d) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT,
              "kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
-             "area, world, camera (got \"%s\")",
+             "spot, area, world, camera, curve_inputs (got \"%s\")",
              kind);
         return NULL;
     }
@@ -755,6 +759,8 @@ struct hairis_scene {
     int material_tables_match[MAX_MATERIALS];
     char material_parameters[MAX_MATERIALS][1024];
     size_t curve_sets, curve_count, curve_points;
+    size_t input_sets, input_values;  /* hairis_scene_add_curves_with_inputs */
+    char inputs[512];                 /* the last call's inputs given per curve or point */
     double radius_sum, position_sum[3];
     size_t mesh_count, vertex_count, triangle_count;
     int suns, points, areas;
@@ -852,6 +858,61 @@ int hairis_scene_add_curves(hairis_scene *s, int material, size_t curve_count,
     s->curve_sets++;
     s->curve_count += curve_count;
     s->curve_points += point_count;
+    clear_error();
+    return HAIRIS_OK;
+}
+
+/* The curve inputs' names in hairis_defaults("curve_inputs") order, with their components. */
+static const char *const curve_input_names[] = {
+    "color", "melanin", "melanin_redness", "tint", "absorption", "roughness", "radial_roughness",
+    "coat", "ior", "offset", "random_color", "random_roughness", "random"};
+static const int curve_input_components[] = {3, 1, 1, 3, 3, 1, 1, 1, 1, 1, 1, 1, 1};
+enum { CURVE_INPUT_COUNT = sizeof curve_input_names / sizeof curve_input_names[0] };
+
+int hairis_scene_add_curves_with_inputs(hairis_scene *s, int material, size_t curve_count,
+                                        const uint32_t *first, size_t point_count,
+                                        const float *positions, const float *radii,
+                                        const char *inputs, size_t value_count,
+                                        const float *values)
+{
+    options o;
+    const char *domains[3] = {"material", "curve", "point"};
+    int domain[CURVE_INPUT_COUNT];
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    if (read_options(inputs, "curve_inputs", "curve inputs", NULL, &o) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    size_t needed = 0;
+    char list[512] = "";
+    for (int i = 0; i < CURVE_INPUT_COUNT; ++i) {
+        if (word(&o, curve_input_names[i], domains, 3, &domain[i]) != HAIRIS_OK)
+            return HAIRIS_ERROR_INVALID_ARGUMENT;
+        if (domain[i] == 0) continue;
+        if (material >= 0 && material < s->material_count && !s->material_is_hair[material])
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                        "curve inputs: %s needs a hair material; material %d is a surface material",
+                        curve_input_names[i], material);
+        needed += (size_t)curve_input_components[i] * (domain[i] == 2 ? point_count : curve_count);
+        const size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s=%s", used ? ";" : "", curve_input_names[i],
+                 domains[domain[i]]);
+    }
+    if (value_count != needed)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "value_count must be %zu (the inputs' components for each of %zu curves or %zu "
+                    "points, in hairis_defaults(\"curve_inputs\")'s order), got %zu",
+                    needed, curve_count, point_count, value_count);
+    if (value_count && !values)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "values must not be NULL when n > 0 (n = %zu)",
+                    value_count);
+    for (size_t i = 0; i < value_count; ++i)
+        if (!isfinite(values[i]))
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "values[%zu] must be finite", i);
+    const int status = hairis_scene_add_curves(s, material, curve_count, first, point_count,
+                                               positions, radii);
+    if (status != HAIRIS_OK) return status;
+    s->input_sets++;
+    s->input_values += value_count;
+    snprintf(s->inputs, sizeof s->inputs, "%s", list);
     clear_error();
     return HAIRIS_OK;
 }
@@ -1059,6 +1120,8 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
             s->mesh_count, s->vertex_count, s->triangle_count, s->suns, s->points, s->areas,
             (double)s->world[0], (double)s->world[1], (double)s->world[2]);
     fprintf(f, "camera=%dx%d orthographic=%d\n", s->width, s->height, s->orthographic);
+    fprintf(f, "curve_input_sets=%zu curve_input_values=%zu curve_inputs=%s\n", s->input_sets,
+            s->input_values, s->inputs);
     for (int i = 0; i < s->material_count; ++i)
         if (s->material_is_hair[i])
             fprintf(f, "hair %d tables=%d %s\n", i, s->material_has_tables[i],

@@ -38,20 +38,37 @@ def particle_curves(data):
     return found[0]
 
 
-def check_hair_material(material_data, material):
-    """The exported parameters equal the node's inputs, field for field."""
+def check_hair_material(material_data, material, overrides=None):
+    """The exported parameters equal the node's inputs, field for field (``overrides``: the
+    fields whose value is not the socket's, e.g. Random when it varies per strand)."""
     node = material.node_tree.nodes["Principled Hair BSDF"]
     assert material_data.kind == "HAIR", material_data.kind
     params = material_data.hair
     assert params.parametrization == PARAMETRIZATION[node.parametrization]
     for name, field in HAIR_FIELDS.items():
         expected = helpers.socket(node, name).default_value
+        if overrides and field in overrides:
+            expected = overrides[field]
         actual = getattr(params, field)
         if isinstance(actual, tuple):
             np.testing.assert_allclose(actual, tuple(expected)[:3], rtol=0, atol=1e-7,
                                        err_msg=name)
         else:
             assert actual == float(expected), (name, actual, expected)
+
+
+def check_strand_random(domain, random, count):
+    """Per-curve numbers distributed as Cycles' curve random: uniform in [0, 1] (test_cycles_
+    strands checks them against Cycles' own)."""
+    assert domain == "curve", domain
+    assert random.shape == (count, 1) and random.dtype == np.float32, (random.shape, random.dtype)
+    values = np.sort(random[:, 0].astype(np.float64))
+    assert values[0] >= 0.0 and values[-1] <= 1.0, (values[0], values[-1])
+    # Kolmogorov-Smirnov against U[0, 1]: reject at alpha = 0.001 (1.95 / sqrt(n)).
+    cdf = np.arange(1, count + 1) / count
+    distance = max(np.max(cdf - values), np.max(values - (cdf - 1.0 / count)))
+    assert distance < 1.95 / math.sqrt(count), distance
+    assert np.unique(values).size == count
 
 
 def test_particle_hair_viewport():
@@ -105,10 +122,14 @@ def test_particle_hair_viewport():
 
     material = data.materials[curves.material]
     assert material.name == "Hair", material.name
-    check_hair_material(material, bpy.data.materials["Hair"])
+    # Random Color/Roughness with Random unlinked: Cycles' per-strand random number, per
+    # curve; the fiber itself (what tables are baked for) is the middle strand, Random 0.5.
+    check_hair_material(material, bpy.data.materials["Hair"], {"random": 0.5})
     assert scene.render.engine == "HAIRIS"
-    # Random Color/Roughness with Random unlinked: Cycles randomizes per strand, hairis not.
-    assert any("per strand" in w and "'Hair'" in w for w in data.warnings), data.warnings
+    assert set(curves.inputs) == {"random"}, curves.inputs.keys()
+    domain, random = curves.inputs["random"]
+    check_strand_random(domain, random, 200)
+    assert not any("per strand" in w for w in data.warnings), data.warnings
 
 
 def test_curves_object():
@@ -241,14 +262,14 @@ def test_mesh():
 
 
 def test_unsupported_things_warn():
-    """Linked hair inputs, an environment texture without image, unknown shaders: warnings,
-    no crash."""
+    """An unsupported node feeding a hair input, an environment texture without image,
+    unknown shaders: warnings, no crash."""
     scene = helpers.make_test_scene(with_curves=False)
     hair = bpy.data.materials["Hair"]
     tree = hair.node_tree
-    info = tree.nodes.new("ShaderNodeHairInfo")
-    tree.links.new(info.outputs["Random"],
-                   helpers.socket(tree.nodes["Principled Hair BSDF"], "Random"))
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Fac"],
+                   helpers.socket(tree.nodes["Principled Hair BSDF"], "Roughness"))
     world_tree = scene.world.node_tree
     environment = world_tree.nodes.new("ShaderNodeTexEnvironment")
     world_tree.links.new(environment.outputs["Color"],
@@ -259,7 +280,11 @@ def test_unsupported_things_warn():
     skin.node_tree.links.new(glass.outputs["BSDF"], output.inputs["Surface"])
     data = export.export_context()
     text = "\n".join(data.warnings)
-    assert "'Random'" in text and "linked" in text, text
+    assert "Noise Texture 'Noise Texture' is not supported" in text and \
+        "unlinked value of the Principled Hair BSDF's 'Roughness'" in text, text
+    (curves,) = [c for c in data.curves if c.source == "PARTICLES"]
+    assert "roughness" not in curves.inputs
+    assert math.isclose(data.materials[curves.material].hair.roughness, 0.25, rel_tol=1e-6)
     assert "Environment Texture 'Environment Texture' has no image" in text, text
     assert "Glass BSDF is not supported" in text, text
 
@@ -459,6 +484,178 @@ def test_environment_world():
                                np.linalg.inv(np.array(empty.matrix_world)[:3, :3]), atol=1e-6)
 
 
+# ---- Hair inputs per strand and per point (node_eval) ---------------------------------------
+
+def _hair_tree():
+    """The test scene's particle hair material: (node tree, Principled Hair BSDF)."""
+    tree = bpy.data.materials["Hair"].node_tree
+    return tree, tree.nodes["Principled Hair BSDF"]
+
+
+def _intercepts(curves, keys):
+    """Arc-length fractions of the exported (uniformly scaled) strands, written out here."""
+    points = curves.positions.reshape(-1, keys, 3).astype(np.float64)
+    steps = np.linalg.norm(np.diff(points, axis=1), axis=2)
+    along = np.concatenate([np.zeros((points.shape[0], 1)), np.cumsum(steps, axis=1)], axis=1)
+    return (along / along[:, -1:]).reshape(-1)
+
+
+def test_color_ramp_on_intercept_into_melanin():
+    """Hair Info Intercept → ColorRamp → Melanin: per point, the ramp's luminance at each
+    point's arc-length fraction (Blender's own ColorRamp.evaluate, read here)."""
+    helpers.make_test_scene(with_curves=False)
+    tree, node = _hair_tree()
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.2, 0.2, 0.2, 1.0)
+    ramp.color_ramp.elements[1].color = (0.9, 0.9, 0.9, 1.0)
+    ramp.color_ramp.elements[1].position = 0.8
+    tree.links.new(info.outputs["Intercept"], helpers.socket(ramp, "Fac"))
+    tree.links.new(ramp.outputs["Color"], helpers.socket(node, "Melanin"))
+    data = export.export_context()
+    curves = particle_curves(data)
+    keys = curves.point_count // curves.curve_count
+    domain, melanin = curves.inputs["melanin"]
+    assert domain == "point" and melanin.shape == (curves.point_count, 1), (domain, melanin.shape)
+    expected = [0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+                for c in (ramp.color_ramp.evaluate(float(t)) for t in _intercepts(curves, keys))]
+    # Cycles' 256-entry table is exact for a linear ramp, up to the kink at 0.8.
+    np.testing.assert_allclose(melanin[:, 0], expected, atol=2e-3)
+    assert np.isclose(melanin[:, 0].min(), 0.2, atol=1e-6) and melanin[:, 0].max() > 0.85
+    params = data.materials[curves.material].hair
+    assert math.isclose(params.melanin, 0.35, rel_tol=1e-6)  # the fiber keeps the socket's value
+    assert "random" in curves.inputs  # Random Color 0.2 with Random unlinked, as before
+    # Under another parametrization Melanin is not read: nothing is exported for it (Random
+    # still is: Random Roughness reads it under every parametrization).
+    node.parametrization = "COLOR"
+    curves = particle_curves(export.export_context())
+    assert "melanin" not in curves.inputs and "random" in curves.inputs, curves.inputs.keys()
+
+
+def test_map_range_of_hair_random_into_roughness():
+    """Hair Info Random → Map Range (0..1 → 0.15..0.6) → Roughness: per curve, the Map Range
+    of the same per-strand random that feeds an unlinked Random."""
+    helpers.make_test_scene(with_curves=False)
+    tree, node = _hair_tree()
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    remap = tree.nodes.new("ShaderNodeMapRange")
+    helpers.socket(remap, "To Min").default_value = 0.15
+    helpers.socket(remap, "To Max").default_value = 0.6
+    tree.links.new(info.outputs["Random"], helpers.socket(remap, "Value"))
+    tree.links.new(remap.outputs["Result"], helpers.socket(node, "Roughness"))
+    # A constant chain folds into the fiber: Value → Coat.
+    value = tree.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = 0.45
+    tree.links.new(value.outputs[0], helpers.socket(node, "Coat"))
+    data = export.export_context()
+    curves = particle_curves(data)
+    domain, roughness = curves.inputs["roughness"]
+    assert domain == "curve" and roughness.shape == (200, 1)
+    random_domain, random = curves.inputs["random"]
+    check_strand_random(random_domain, random, 200)
+    np.testing.assert_allclose(roughness, 0.15 + 0.45 * random, atol=1e-6)
+    params = data.materials[curves.material].hair
+    assert math.isclose(params.coat, 0.45, rel_tol=1e-6) and "coat" not in curves.inputs
+    assert params.random == 0.5
+    # Clamp off and a range past 1: clamped to [0, 1] with a warning naming the input.
+    remap.clamp = False
+    helpers.socket(remap, "To Max").default_value = 1.4
+    data = export.export_context()
+    domain, roughness = particle_curves(data).inputs["roughness"]
+    assert roughness.max() == 1.0 and roughness.min() >= 0.15 - 1e-6
+    assert any("'Roughness'" in w and "hairis clamps them" in w for w in data.warnings), \
+        data.warnings
+
+
+def test_math_mix_and_separate_chains():
+    """Math (Multiply Add) on Intercept into Melanin Redness, MixRGB of two RGB nodes by
+    Intercept into Tint through Invert and Separate/Combine Color, Mix (Float) into Radial
+    Roughness: per point, as written out here."""
+    helpers.make_test_scene(with_curves=False)
+    tree, node = _hair_tree()
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    math_node = tree.nodes.new("ShaderNodeMath")
+    math_node.operation = "MULTIPLY_ADD"
+    helpers.socket(math_node, "Value_001").default_value = 0.5
+    helpers.socket(math_node, "Value_002").default_value = 0.2
+    tree.links.new(info.outputs["Intercept"], helpers.socket(math_node, "Value"))
+    tree.links.new(math_node.outputs[0], helpers.socket(node, "Melanin Redness"))
+    root, tip = tree.nodes.new("ShaderNodeRGB"), tree.nodes.new("ShaderNodeRGB")
+    root.outputs[0].default_value = (0.9, 0.8, 0.7, 1.0)
+    tip.outputs[0].default_value = (0.5, 0.6, 1.0, 1.0)
+    mix = tree.nodes.new("ShaderNodeMixRGB")  # Blender 3.4 to 5.0
+    tree.links.new(info.outputs["Intercept"], helpers.socket(mix, "Fac"))
+    tree.links.new(root.outputs[0], helpers.socket(mix, "Color1"))
+    tree.links.new(tip.outputs[0], helpers.socket(mix, "Color2"))
+    invert = tree.nodes.new("ShaderNodeInvert")
+    helpers.socket(invert, "Fac").default_value = 0.0  # passes the colour through
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    combine = tree.nodes.new("ShaderNodeCombineColor")
+    tree.links.new(mix.outputs[0], helpers.socket(invert, "Color"))
+    tree.links.new(invert.outputs[0], helpers.socket(separate, "Color"))
+    for channel in ("Red", "Green", "Blue"):
+        tree.links.new(separate.outputs[channel], helpers.socket(combine, channel))
+    tree.links.new(combine.outputs[0], helpers.socket(node, "Tint"))
+    blend = tree.nodes.new("ShaderNodeMix")  # Blender 3.4's new Mix node, data type Float
+    blend.data_type = "FLOAT"
+    helpers.socket(blend, "A_Float").default_value = 0.2
+    helpers.socket(blend, "B_Float").default_value = 0.6
+    tree.links.new(info.outputs["Intercept"], helpers.socket(blend, "Factor_Float"))
+    result = next(o for o in blend.outputs if o.identifier == "Result_Float")
+    tree.links.new(result, helpers.socket(node, "Radial Roughness"))
+    data = export.export_context()
+    curves = particle_curves(data)
+    t = _intercepts(curves, curves.point_count // curves.curve_count)
+    domain, redness = curves.inputs["melanin_redness"]
+    assert domain == "point"
+    np.testing.assert_allclose(redness[:, 0], 0.2 + 0.5 * t, atol=1e-5)
+    domain, tint = curves.inputs["tint"]
+    assert domain == "point" and tint.shape == (curves.point_count, 3)
+    expected = ((1.0 - t)[:, None] * np.array([0.9, 0.8, 0.7])
+                + t[:, None] * np.array([0.5, 0.6, 1.0]))
+    np.testing.assert_allclose(tint, expected, atol=1e-5)
+    domain, radial = curves.inputs["radial_roughness"]
+    assert domain == "point"
+    np.testing.assert_allclose(radial[:, 0], 0.2 + 0.4 * t, atol=1e-5)
+    # An HSV-based blend is not supported: named, the unlinked Tint used.
+    mix.blend_type = "HUE"
+    data = export.export_context()
+    assert "tint" not in particle_curves(data).inputs
+    assert any("blend mode HUE is not supported" in w and "'Tint'" in w for w in data.warnings), \
+        data.warnings
+
+
+def test_curves_object_intercept_and_length():
+    """A Curves object: Intercept per point and Length per curve in object space, as Cycles."""
+    scene = helpers.reset()
+    helpers.make_camera(scene)
+    material = helpers.make_hair_material("Strands", "MELANIN", Melanin=0.3)
+    tree = material.node_tree
+    node = tree.nodes["Principled Hair BSDF"]
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    tree.links.new(info.outputs["Intercept"], helpers.socket(node, "Melanin"))
+    scale = tree.nodes.new("ShaderNodeMath")
+    scale.operation = "MULTIPLY"
+    helpers.socket(scale, "Value_001").default_value = 0.25
+    tree.links.new(info.outputs["Length"], helpers.socket(scale, "Value"))
+    tree.links.new(scale.outputs[0], helpers.socket(node, "Coat"))
+    obj, positions, _radii = helpers.make_curves(scene, material)
+    data = export.export_context()
+    (curves,) = data.curves
+    first = curves.first.astype(np.int64)
+    domain, melanin = curves.inputs["melanin"]
+    assert domain == "point" and melanin.shape == (curves.point_count, 1)
+    domain, coat = curves.inputs["coat"]
+    assert domain == "curve" and coat.shape == (curves.curve_count, 1)
+    for c in (0, 3, curves.curve_count - 1):
+        local = positions[first[c]:first[c + 1]].astype(np.float64)  # object space
+        steps = np.linalg.norm(np.diff(local, axis=0), axis=1)
+        along = np.concatenate([[0.0], np.cumsum(steps)])
+        np.testing.assert_allclose(melanin[first[c]:first[c + 1], 0], along / along[-1], atol=1e-5)
+        assert math.isclose(coat[c, 0], min(0.25 * along[-1], 1.0), rel_tol=1e-5), \
+            (coat[c], along[-1])
+
+
 helpers.run([
     test_particle_hair_viewport,
     test_curves_object,
@@ -473,4 +670,8 @@ helpers.run([
     test_no_camera,
     test_render_mode_export_through_engine,
     test_environment_world,
+    test_color_ramp_on_intercept_into_melanin,
+    test_map_range_of_hair_random_into_roughness,
+    test_math_mix_and_separate_chains,
+    test_curves_object_intercept_and_length,
 ])

@@ -212,6 +212,12 @@ def test_engine_renders_scene():
     assert summary_value(summary, "points") != "0"
     assert summary_value(summary, "camera") == "32x24"
     assert summary.count("hair ") == 2 and "tables=0" in summary
+    # The particle hair's Random Color and Random Roughness read Cycles' per-strand random
+    # (Random unlinked): its curves go through hairis_scene_add_curves_with_inputs, one value
+    # per strand; the Curves object's material has nothing per strand.
+    assert summary_value(summary, "curve_input_sets") == "1", summary
+    assert summary_value(summary, "curve_input_values") == "200", summary
+    assert summary_value(summary, "curve_inputs") == "random=curve", summary
 
 
 def test_table_strategy_refuses_missing_tables():

@@ -44,7 +44,7 @@ ERROR_CANCELLED = 4
 ERROR_INTERNAL = 5
 
 KINDS = ("chiang", "marschner", "bake", "sampler", "diffuse", "sun", "point", "area", "world",
-         "camera", "render")
+         "camera", "render", "curve_inputs")
 
 # ---- The prototypes, written here by hand ---------------------------------------------------
 
@@ -81,6 +81,8 @@ PROTOTYPES = {
     "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
     "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F]),
+    "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
+                                                    c_char_p, c_size_t, F]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
@@ -290,6 +292,11 @@ def defaults(kind):
 def make_fiber(options=""):
     return lib().hairis_fiber_create(options.encode())
 
+
+CURVE_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption", "roughness",
+                "radial_roughness", "coat", "ior", "offset", "random_color", "random_roughness",
+                "random")
+"""hairis_render.h's curve inputs in their documented order."""
 
 TINY_BAKE = b"theta_r=4;theta_i=8;phi=8;n_h=1,2;threads=2"
 
@@ -723,7 +730,9 @@ class TestSampling(unittest.TestCase):
 class TestRender(unittest.TestCase):
     W, H = 16, 12
 
-    def make_scene(self, tables, fiber_options=""):
+    def make_scene(self, tables, fiber_options="", inputs=None):
+        """The test scene; ``inputs`` (an options string and a function of (curves, points)
+        giving the values) puts its curves through hairis_scene_add_curves_with_inputs."""
         fiber = make_fiber(fiber_options)
         self.assertTrue(fiber, last_error())
         scene = lib().hairis_scene_create()
@@ -737,9 +746,16 @@ class TestRender(unittest.TestCase):
         positions = np.array([[xx, -0.75 + 0.3 * c, 0.1 * np.sin(3 * xx)] for c in range(curves)
                               for xx in x], np.float32)
         radii = np.full(curves * points, 0.04, np.float32)
-        self.assertEqual(lib().hairis_scene_add_curves(scene, 0, curves, ptr(first, c_uint32),
-                                                       len(positions), ptr(positions), ptr(radii)),
-                         OK, last_error())
+        if inputs is None:
+            self.assertEqual(lib().hairis_scene_add_curves(scene, 0, curves, ptr(first, c_uint32),
+                                                           len(positions), ptr(positions),
+                                                           ptr(radii)), OK, last_error())
+        else:
+            names, make_values = inputs
+            values = np.ascontiguousarray(make_values(curves, len(positions)), np.float32)
+            self.assertEqual(lib().hairis_scene_add_curves_with_inputs(
+                scene, 0, curves, ptr(first, c_uint32), len(positions), ptr(positions),
+                ptr(radii), names, values.size, ptr(values)), OK, last_error())
         vertices = np.array([[-3, -3, -0.5], [3, -3, -0.5], [0, 3, -0.5]], np.float32)
         indices = np.array([0, 1, 2], np.uint32)
         materials = np.array([1], np.int32)
@@ -819,6 +835,95 @@ class TestRender(unittest.TestCase):
         self.assertIn("baked for", last_error())
         lib().hairis_scene_destroy(scene)
         lib().hairis_tables_destroy(tables)
+
+    def render(self, scene, strategy, samples=4):
+        rgba = np.full((self.H, self.W, 4), -1, np.float32)
+        status = lib().hairis_render(scene, self.settings(strategy, samples), ptr(rgba),
+                                     PROGRESS_FN(), None)
+        self.assertEqual(status, OK, last_error())
+        return rgba
+
+    def test_curve_inputs_render_as_the_fiber_of_their_values(self):
+        """Melanin 0.8 on every curve (or point) of a melanin-0.3 material renders as a
+        melanin-0.8 material, bit for bit, with the analytic strategy."""
+        base = "parametrization=melanin;melanin=0.3;cycles=4.5"
+        expected = self.make_scene(None, "parametrization=melanin;melanin=0.8;cycles=4.5")
+        per_curve = self.make_scene(None, base, (b"melanin=curve",
+                                                 lambda c, p: np.full(c, 0.8)))
+        per_point = self.make_scene(None, base, (b"melanin=point",
+                                                 lambda c, p: np.full(p, 0.8)))
+        plain = self.make_scene(None, base)
+        images = [self.render(s, "analytic") for s in (expected, per_curve, per_point, plain)]
+        np.testing.assert_array_equal(images[1], images[0])
+        np.testing.assert_array_equal(images[2], images[0])
+        self.assertFalse(np.array_equal(images[3], images[0]))
+        for scene in (expected, per_curve, per_point, plain):
+            lib().hairis_scene_destroy(scene)
+
+    def test_curve_inputs_with_table_strategy(self):
+        """TABLE samples the tables of the material's own fiber: strands of other roughness
+        and colour render (finite, and unlike the material alone); tables of another fiber
+        are still refused."""
+        tables = load_memory(default_table_bytes())
+        inputs = (b"roughness=curve;color=point",
+                  lambda c, p: np.concatenate([np.linspace(0.1, 0.7, c),
+                                               np.tile([0.3, 0.2, 0.1], p)]))
+        scene = self.make_scene(tables, "", inputs)
+        varied = self.render(scene, "table")
+        self.assertTrue(np.all(np.isfinite(varied)) and np.all(varied >= 0))
+        plain = self.make_scene(tables, "")
+        self.assertFalse(np.array_equal(self.render(plain, "table"), varied))
+        other = self.make_scene(tables, "roughness=0.5", inputs)
+        rgba = np.zeros((self.H, self.W, 4), np.float32)
+        self.assertEqual(lib().hairis_render(other, self.settings("table"), ptr(rgba),
+                                             PROGRESS_FN(), None), ERROR_INVALID_TABLE)
+        for s in (scene, plain, other):
+            lib().hairis_scene_destroy(s)
+        lib().hairis_tables_destroy(tables)
+
+    def test_curve_input_refusals(self):
+        """Unknown names and domains, wrong counts, values out of range, inputs the material
+        does not read and surface materials: refused, naming what is wrong."""
+        self.assertEqual(items(defaults("curve_inputs")),
+                         {name: "material" for name in CURVE_INPUTS})
+        self.assertEqual(list(items(defaults("curve_inputs"))), list(CURVE_INPUTS))
+        scene = lib().hairis_scene_create()
+        fiber = make_fiber("parametrization=melanin")
+        self.assertEqual(lib().hairis_scene_add_hair_material(scene, fiber, None), 0)
+        lib().hairis_fiber_destroy(fiber)
+        self.assertEqual(lib().hairis_scene_add_surface_material(scene, b"type=diffuse"), 1)
+        first = np.array([0, 3, 6], np.uint32)
+        positions = np.array([[x, y, 0] for y in (0, 1) for x in (0, 1, 2)], np.float32)
+        radii = np.full(6, 0.1, np.float32)
+
+        def add(names, values, material=0):
+            values = np.ascontiguousarray(values, np.float32)
+            return lib().hairis_scene_add_curves_with_inputs(
+                scene, material, 2, ptr(first, c_uint32), 6, ptr(positions), ptr(radii), names,
+                values.size, ptr(values))
+
+        cases = [
+            (b"melanine=curve", [0.5, 0.5], ["melanine", "known"]),
+            (b"melanin=strand", [0.5, 0.5], ["melanin", "strand", "point"]),
+            (b"melanin=curve", [0.5, 0.5, 0.5], ["value_count", "2", "3"]),
+            (b"melanin=point;tint=curve", [0.5] * 6 + [1] * 5, ["value_count", "12"]),
+            (b"melanin=point", [0.5, 0.5, 0.5, 1.5, 0.5, 0.5], ["point 3", "melanin", "[0, 1]"]),
+            (b"tint=curve", [1, 1, 1, 1, 0, 1], ["curve 1", "tint.g"]),
+            (b"color=curve", [0.5] * 6, ["color", "parametrization", "melanin"]),
+            (b"random=curve", [0.5, float("nan")], ["curve 1", "random"]),
+        ]
+        for names, values, words in cases:
+            with self.subTest(names=names):
+                self.assertEqual(add(names, values), ERROR_INVALID_ARGUMENT)
+                for word in words:
+                    self.assertIn(word, last_error())
+        self.assertEqual(add(b"roughness=curve", [0.5, 0.5], material=1), ERROR_INVALID_ARGUMENT)
+        self.assertIn("hair material", last_error())
+        # What is accepted: no input at all, and every domain.
+        self.assertEqual(add(b"", []), OK, last_error())
+        self.assertEqual(add(b"melanin=point;tint=curve;random=curve",
+                             [0.1] * 6 + [0.9, 0.8, 0.7] * 2 + [0.2, 0.7]), OK, last_error())
+        lib().hairis_scene_destroy(scene)
 
     def test_empty_scene(self):
         scene = lib().hairis_scene_create()

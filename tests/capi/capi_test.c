@@ -261,8 +261,8 @@ static void expect_default(const char *kind, const char *name, const char *expec
           defaults ? defaults : "(null)");
 }
 
-static const char *const g_kinds[] = {"chiang", "marschner", "bake",  "sampler", "diffuse", "sun",
-                                      "point",  "area",      "world", "camera",  "render"};
+static const char *const g_kinds[] = {"chiang", "marschner", "bake",   "sampler", "diffuse",     "sun",
+                                      "point",  "area",      "world",  "camera",  "render", "curve_inputs"};
 enum { KIND_COUNT = sizeof g_kinds / sizeof g_kinds[0] };
 
 static void test_defaults(void)
@@ -375,6 +375,13 @@ static int try_options(const char *kind, const char *options)
         /* The scene's camera stays 16 x 16 (g_option_rgba's size). */
         snprintf(text, sizeof text, "width=16;height=16;%s", options);
         return hairis_scene_set_camera(g_option_scene, text) == HAIRIS_OK;
+    }
+    if (strcmp(kind, "curve_inputs") == 0) {
+        /* Curves of material 0 with the given inputs; "material" (the default) takes no value. */
+        const float p[6] = {-1, 0.5f, 0, 1, 0.5f, 0}, r[2] = {0.05f, 0.05f};
+        const uint32_t first[2] = {0, 2};
+        return hairis_scene_add_curves_with_inputs(g_option_scene, 0, 1, first, 2, p, r, options, 0,
+                                                   NULL) == HAIRIS_OK;
     }
     CHECK(0, "no call for kind %s", kind);
     return 0;
@@ -1797,6 +1804,97 @@ static void test_defaults_round_trip(void)
     }
 }
 
+/* ---- Curve inputs -------------------------------------------------------------------------- */
+
+/* add_strands' curves through hairis_scene_add_curves_with_inputs. */
+static int add_strands_with(hairis_scene *scene, int material, const char *inputs, size_t count,
+                            const float *values)
+{
+    enum { C = 5, P = 4 };
+    uint32_t first[C + 1];
+    float positions[3 * C * P], radii[C * P];
+    for (int c = 0; c <= C; ++c) first[c] = (uint32_t)(c * P);
+    for (int c = 0; c < C; ++c)
+        for (int p = 0; p < P; ++p) {
+            const int i = c * P + p;
+            positions[3 * i] = -1.5f + 1.0f * (float)p;
+            positions[3 * i + 1] = -0.8f + 0.4f * (float)c;
+            positions[3 * i + 2] = 0.05f * (float)(p % 2);
+            radii[i] = 0.05f;
+        }
+    return hairis_scene_add_curves_with_inputs(scene, material, C, first, C * P, positions, radii,
+                                               inputs, count, values);
+}
+
+/* A sun and a sky over the strands of `fiber_options`, through add_strands_with. */
+static hairis_scene *curve_input_scene(const char *fiber_options, const char *inputs, size_t count,
+                                       const float *values)
+{
+    hairis_scene *scene = hairis_scene_create();
+    hairis_fiber *fiber = hairis_fiber_create(fiber_options);
+    CHECK(fiber != NULL, "fiber \"%s\"", fiber_options);
+    CHECK(hairis_scene_add_hair_material(scene, fiber, NULL) == 0, "hair material");
+    hairis_fiber_destroy(fiber);
+    CHECK(add_strands_with(scene, 0, inputs, count, values) == HAIRIS_OK, "curves with \"%s\": %s",
+          inputs, hairis_last_error());
+    CHECK(hairis_scene_add_light(scene, "type=sun;direction=0.3,0.2,1;strength=3") == HAIRIS_OK, "sun");
+    CHECK(hairis_scene_set_world(scene, SKY) == HAIRIS_OK, "world");
+    CHECK(hairis_scene_set_camera(scene, CAMERA) == HAIRIS_OK, "camera");
+    return scene;
+}
+
+static void test_curve_inputs(void)
+{
+    section("curve inputs");
+    expect_default("curve_inputs", "melanin", "material");
+    expect_default("curve_inputs", "absorption", "material");
+    expect_default("curve_inputs", "random", "material");
+
+    /* Melanin 0.8 per curve, or per point, on a melanin-0.3 material is a melanin-0.8
+     * material: the strand's own fiber, bit for bit (analytic strategy). */
+    static float expected[W * H * 4], per_curve[W * H * 4], per_point[W * H * 4], plain[W * H * 4];
+    float curve_values[5], point_values[20];
+    for (int i = 0; i < 5; ++i) curve_values[i] = 0.8f;
+    for (int i = 0; i < 20; ++i) point_values[i] = 0.8f;
+    const char *settings = "samples=4;max_bounces=3;strategy=analytic;seed=5";
+    hairis_scene *scenes[4] = {
+        curve_input_scene("parametrization=melanin;melanin=0.8", "", 0, NULL),
+        curve_input_scene("parametrization=melanin;melanin=0.3", "melanin=curve", 5, curve_values),
+        curve_input_scene("parametrization=melanin;melanin=0.3", "melanin=point", 20, point_values),
+        curve_input_scene("parametrization=melanin;melanin=0.3", "", 0, NULL)};
+    float *images[4] = {expected, per_curve, per_point, plain};
+    for (int k = 0; k < 4; ++k)
+        CHECK(hairis_render(scenes[k], settings, images[k], NULL, NULL) == HAIRIS_OK, "render %d: %s",
+              k, hairis_last_error());
+    const size_t bytes = sizeof(float) * W * H * 4;
+    CHECK(memcmp(expected, per_curve, bytes) == 0, "melanin=curve 0.8 renders as melanin 0.8");
+    CHECK(memcmp(expected, per_point, bytes) == 0, "melanin=point 0.8 renders as melanin 0.8");
+    CHECK(memcmp(expected, plain, bytes) != 0, "and the inputs change the image");
+    for (int k = 0; k < 4; ++k) hairis_scene_destroy(scenes[k]);
+
+    /* Refusals name the input, the item and the range. */
+    hairis_scene *scene = curve_input_scene("parametrization=melanin", "", 0, NULL);
+    point_values[7] = 1.25f;
+    CHECK(add_strands_with(scene, 0, "melanin=point", 20, point_values) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "melanin 1.25");
+    CHECK_ERROR_MENTIONS("point 7");
+    CHECK_ERROR_MENTIONS("melanin must be in [0, 1]");
+    CHECK(add_strands_with(scene, 0, "melanin=point", 19, point_values) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "19 values for 20 points");
+    CHECK_ERROR_MENTIONS("value_count must be 20");
+    CHECK(add_strands_with(scene, 0, "absorption=curve", 15, point_values) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "absorption under melanin");
+    CHECK_ERROR_MENTIONS("parametrization (melanin)");
+    CHECK(add_strands_with(scene, 0, "melanin=everywhere", 5, curve_values) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "an unknown domain");
+    CHECK_ERROR_MENTIONS("melanin");
+    CHECK(add_strands_with(scene, 0, "melanin=curve", 5, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT, "NULL values");
+    CHECK_ERROR_MENTIONS("values");
+    CHECK(add_strands_with(NULL, 0, "", 0, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT, "NULL scene");
+    CHECK_ERROR_MENTIONS("scene");
+    hairis_scene_destroy(scene);
+}
+
 /* ---- Scene refusals ----------------------------------------------------------------------- */
 
 static void test_scene_refusals(void)
@@ -2033,6 +2131,7 @@ int main(void)
     test_render_options();
     test_defaults_round_trip();
     test_scene_refusals();
+    test_curve_inputs();
     hairis_tables_destroy(g_tables);
 
     printf("%d passed, %d failed\n", g_passed, g_failed);

@@ -12,8 +12,10 @@ namespace hairis::testing {
 
 class SamplerAt {
   public:
-    SamplerAt(const Sampler &sampler, Vec3 wo, float h = 0.0f) {
-        const FiberHit hit{wo, h};
+    /// `inputs` (may be null) are the hit's per-strand node inputs; they must outlive this.
+    SamplerAt(const Sampler &sampler, Vec3 wo, float h = 0.0f, const HairInputValues *inputs = nullptr) {
+        FiberHit hit{wo, h};
+        hit.inputs = inputs;
         const FiberPoint *fiber = sampler.model() ? &sampler.model()->prepare(hit, scratch_) : nullptr;
         fiber_ = fiber;
         point_ = &sampler.at(hit, fiber, scratch_);

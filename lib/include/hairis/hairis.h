@@ -73,7 +73,7 @@ HAIRIS_API const char *hairis_last_error(void);
  * Every option name of `kind` with its default, as an option string; NULL (and the last error
  * listing the kinds) for an unknown kind. Kinds: "chiang" and "marschner" (hairis_fiber_create),
  * "bake", "sampler", and hairis_render.h's "diffuse", "sun", "point", "spot", "area", "world",
- * "camera", "render".
+ * "camera", "render", "curve_inputs".
  */
 HAIRIS_API const char *hairis_defaults(const char *kind);
 

@@ -40,6 +40,30 @@ HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char
 HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t curve_count,
                                        const uint32_t *first, size_t point_count,
                                        const float *positions, const float *radii);
+/**
+ * Adds hair curves as hairis_scene_add_curves does, with some of their hair material's node
+ * inputs given per curve or per point in place of the fiber's own values (Hair Info, Cycles'
+ * per-strand random number or attributes feeding the Principled Hair BSDF in Blender).
+ * `inputs` says where each input comes from, "name=material|curve|point;..."; every name
+ * defaults to material (hairis_defaults("curve_inputs") lists them in order): color,
+ * melanin, melanin_redness, tint, absorption, roughness, radial_roughness, coat, ior,
+ * offset (radians), random_color, random_roughness, random — the node inputs of
+ * hairis_fiber_create, in the same units and ranges (colour and tint > 0, absorption >= 0,
+ * ior > 1, offset in [-pi/2, pi/2], the others in [0, 1]), and only those the material's
+ * parametrization reads. `values` holds value_count floats: for each input given per curve
+ * or per point, in that order, its components (3 for color, tint and absorption, else 1) for
+ * each curve (curve_count items) or each point (point_count items) in turn. A renderer
+ * evaluates the fiber at a hit with the hit's values: a curve's own, or a point value
+ * interpolated linearly in the segment's curve parameter between its two points, as Cycles
+ * interpolates curve attributes, then mapped as Cycles maps the node (Random Color and
+ * Random Roughness from the hit's random, melanin, colours). The TABLE strategy samples the
+ * tables baked for the fiber's own values and stays exact for every strand.
+ */
+HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int material, size_t curve_count,
+                                                   const uint32_t *first, size_t point_count,
+                                                   const float *positions, const float *radii,
+                                                   const char *inputs, size_t value_count,
+                                                   const float *values);
 /** Adds a triangle mesh in world space; `materials` holds one material index per triangle. */
 HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                                      const float *positions, size_t triangle_count,

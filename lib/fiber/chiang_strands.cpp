@@ -1,0 +1,31 @@
+#include "fiber/chiang_strands.h"
+
+namespace hairis {
+
+Expected<ChiangStrands> ChiangStrands::create(const PrincipledHairNode &node) {
+    Expected<ChiangParams> params = to_chiang_params(node);
+    if (!params) return params.error();
+    Expected<ChiangFiber> fiber = ChiangFiber::create(params.value());
+    if (!fiber) return fiber.error();
+    ChiangStrands strands;
+    strands.node_ = node;
+    strands.fiber_ = std::make_shared<const ChiangFiber>(std::move(fiber).value());
+    return strands;
+}
+
+Expected<ChiangParams> ChiangStrands::params(const HairInputValues &inputs) const {
+    return to_chiang_params(with_inputs(node_, inputs));
+}
+
+const ChiangLobes &ChiangStrands::lobes(const HairInputValues *inputs, ScratchBuffer &scratch) const {
+    if (!inputs || inputs->given == 0) return fiber_->lobes();
+    const Expected<ChiangParams> p = params(*inputs);
+    if (!p) return fiber_->lobes();
+    return scratch.make<ChiangLobes>(ChiangLobes::derive(fiber_->lobes(), p.value()));
+}
+
+const ChiangPoint &ChiangStrands::point(const FiberHit &hit, ScratchBuffer &scratch) const {
+    return scratch.make<ChiangPoint>(lobes(hit.inputs, scratch), hit);
+}
+
+}  // namespace hairis

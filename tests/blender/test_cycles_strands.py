@@ -1,0 +1,152 @@
+"""Hairis against Cycles with hair whose parameters vary per strand and along the strand.
+
+The comparison scene of test_cycles_compare (particle hair on a diffuse sphere, a Curves
+object, sun, point and area lights, a world colour), the head of hair beside the Curves
+object, with
+  * the particle hair's Melanin fed by a root-to-tip ColorRamp on Hair Info Intercept and
+    randomized per strand by Random Color 0.6 with Random unlinked (Cycles' per-strand random
+    number), Random Roughness 0.3;
+  * the Curves object's Roughness fed by a Map Range of Hair Info Random (0.2 .. 0.6).
+Both engines render SEEDS independent images of SAMPLES samples, compared per 4×4 block by
+compare_stats.compare (channel means within 2%, mean t² and max |t| within the noise bounds).
+The per-strand random numbers are not Cycles' own (the same distribution, other values), so
+single strands differ; blocks average over enough strands for the noise bound to hold.
+"""
+
+import os
+import sys
+
+import bpy
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import compare_stats  # noqa: E402
+import helpers  # noqa: E402
+
+ARGS, PACKAGE = helpers.setup()
+if not os.path.isfile(helpers.bundled_library(PACKAGE)):
+    helpers.skip("libhairis.so is not built yet (looked for %s)"
+                 % helpers.bundled_library(PACKAGE))
+SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
+SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+BOUNCES = 4
+BLOCK = 4
+STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
+
+
+def make_scene():
+    """The comparison scene with the per-strand and per-point hair inputs."""
+    scene = helpers.make_compare_scene(SAMPLES, BOUNCES, STRATEGY)
+    # The head of hair beside the Curves object rather than behind it: most of what the camera
+    # sees is the per-strand and per-point melanin.
+    head, curls = bpy.data.objects["Head"], bpy.data.objects["Curls"]
+    head.location = (-0.45, 0.5, -0.25)
+    head.scale = (0.95, 0.95, 0.95)
+    strands = head.particle_systems[0].settings
+    strands.count = 1500
+    strands.hair_length = 0.5
+    curls.location = (0.75, 0.0, 0.1)
+    curls.scale = (0.75, 0.75, 0.75)
+    hair = bpy.data.materials["Hair"]
+    tree = hair.node_tree
+    node = tree.nodes["Principled Hair BSDF"]
+    helpers.socket(node, "Random Color").default_value = 0.6
+    helpers.socket(node, "Random Roughness").default_value = 0.3
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.75, 0.75, 0.75, 1.0)  # dark roots
+    ramp.color_ramp.elements[1].color = (0.15, 0.15, 0.15, 1.0)  # light tips
+    ramp.color_ramp.elements[1].position = 0.9
+    tree.links.new(info.outputs["Intercept"], helpers.socket(ramp, "Fac"))
+    tree.links.new(ramp.outputs["Color"], helpers.socket(node, "Melanin"))
+
+    dyed = bpy.data.materials["Dyed"]
+    tree = dyed.node_tree
+    node = tree.nodes["Principled Hair BSDF"]
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    remap = tree.nodes.new("ShaderNodeMapRange")
+    helpers.socket(remap, "To Min").default_value = 0.2
+    helpers.socket(remap, "To Max").default_value = 0.6
+    tree.links.new(info.outputs["Random"], helpers.socket(remap, "Value"))
+    tree.links.new(remap.outputs["Result"], helpers.socket(node, "Roughness"))
+    bpy.context.view_layer.update()
+    return scene
+
+
+def test_strand_random_is_cycles():
+    """Hair Info Random as Cycles renders it (an emission of it on a Curves object seen from
+    above) is node_eval.strand_random of each curve's index: every strand gets Cycles' number."""
+    scene = helpers.reset()
+    camera = helpers.make_camera(scene, location=(0.0, 0.0, 5.0), rotation=(0.0, 0.0, 0.0),
+                                 resolution=(64, 64), percentage=100)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 8.0  # 8 pixels per unit, x and y in [-4, 4]
+    material = bpy.data.materials.new("Random")
+    helpers.use_nodes(material)
+    tree = material.node_tree
+    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
+    emission = tree.nodes.new("ShaderNodeEmission")
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    tree.links.new(info.outputs["Random"], helpers.socket(emission, "Color"))
+    tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])
+    obj, _positions, _radii = helpers.make_curves(scene, material, location=(0.0, 0.0, 0.0),
+                                                  rotation=(0.0, 0.0, 0.0), scale=1.0)
+    curves = obj.data
+    count = len(curves.curves)
+    offsets = np.empty(count + 1, np.int32)
+    curves.curve_offset_data.foreach_get("value", offsets)
+    positions = np.full((len(curves.points), 3), 1000.0, np.float32)  # out of view
+    shown = min(count, 16)
+    rows = []
+    for c in range(shown):
+        column, row = divmod(c, 8)
+        y = -3.5 + row
+        x0 = -3.6 if column == 0 else 0.4
+        points = offsets[c + 1] - offsets[c]
+        positions[offsets[c]:offsets[c + 1]] = [[x0 + 3.2 * k / (points - 1), y, 0.0]
+                                                for k in range(points)]
+        rows.append((x0 + 1.6, y))
+    curves.position_data.foreach_set("vector", positions.reshape(-1))
+    curves.attributes["radius"].data.foreach_set("value", np.full(len(curves.points), 0.2,
+                                                                  np.float32))
+    helpers.match_cycles(scene, 4, 0)
+    scene.world = None
+    image, _seconds = helpers.render_pixels(scene, "CYCLES", 1, ARGS.workdir, "random")
+    node_eval = helpers.module("node_eval")
+    expected = node_eval.strand_random(np.arange(shown))
+    for c, (x, y) in enumerate(rows):
+        pixel = image[int((y + 4.0) * 8.0), int((x + 4.0) * 8.0)]
+        assert np.allclose(pixel, expected[c], atol=2e-6), (c, pixel, expected[c])
+    print("strand random: %d strands, Cycles' values %s" % (shown, np.round(expected[:4], 6)))
+
+
+def test_strands_match_cycles():
+    """Cycles and Hairis render per-strand and per-point hair to the same image within the
+    noise; the export carries the inputs (no warning about them)."""
+    scene = make_scene()
+    export = helpers.module("export")
+    data = export.export_scene(bpy.context.evaluated_depsgraph_get())
+    inputs = {c.source: c.inputs for c in data.curves}
+    assert set(inputs["PARTICLES"]) == {"melanin", "random"}, inputs["PARTICLES"].keys()
+    assert inputs["PARTICLES"]["melanin"][0] == "point"
+    assert set(inputs["CURVES"]) == {"roughness"}, inputs["CURVES"].keys()
+    assert not any("Principled Hair" in w for w in data.warnings), data.warnings
+    stacks, times = {}, {}
+    for engine in ("CYCLES", "HAIRIS"):
+        images = []
+        times[engine] = 0.0
+        for seed in range(1, SEEDS + 1):
+            image, seconds = helpers.render_pixels(scene, engine, seed, ARGS.workdir)
+            assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % engine
+            images.append(image)
+            times[engine] += seconds
+        stacks[engine] = np.stack(images)
+    print("render time for %d x %d samples: cycles %.1f s, hairis %.1f s (%s)"
+          % (SEEDS, SAMPLES, times["CYCLES"], times["HAIRIS"], STRATEGY))
+    dump = os.environ.get("HAIRIS_COMPARE_DUMP")
+    if dump:
+        np.savez(dump, cycles=stacks["CYCLES"], hairis=stacks["HAIRIS"])
+    compare_stats.compare(stacks["CYCLES"], stacks["HAIRIS"], BLOCK)
+
+
+helpers.run([test_strand_random_is_cycles, test_strands_match_cycles])
