@@ -21,8 +21,14 @@
 // Validation (errors name the object and what is allowed):
 //  - refused: NaN/inf positions or radii, negative radii, a curve with fewer than 2 points,
 //    inconsistent curve offsets, mesh indices out of range, material indices out of range,
-//    a hair material on a mesh, a hair material without fiber or sampler, invalid lights or
-//    camera, and a scene with no geometry left (no curve and no triangle).
+//    a hair material on a mesh, a hair material without fiber or sampler, corner normals or UVs that are not one per triangle corner or not finite,
+//    invalid lights or camera, and a scene with no geometry left (no curve and no triangle).
+//
+// Mesh shading data, as Cycles' triangle shader setup: Ng the face normal, N the corner normals
+// interpolated with the hit's barycentrics and normalized (Blender's corner normals: the
+// vertex normal on smooth faces, the face normal on flat ones, split or custom normals where
+// the mesh has them; the face normal when a mesh gives none), and the UV map interpolated the
+// same way ((0, 0) without one, as Cycles' missing attribute).
 //  - skipped with a counted warning: curves of zero length (all points equal) or zero radius
 //    everywhere — they would never be hit — and degenerate (zero-area) triangles.
 #pragma once
@@ -40,6 +46,7 @@
 #include "core/expected.h"
 #include "render/lights.h"
 #include "core/math.h"
+#include "render/surface_material.h"
 #include "sampling/hair_bsdf.h"
 
 namespace hairis {
@@ -56,7 +63,11 @@ struct DiffuseMaterial {
     Rgb emission{0.0f};
 };
 
-using Material = std::variant<HairMaterial, DiffuseMaterial>;
+/// A material of Blender shader nodes (surface_material.h).
+using Material = std::variant<HairMaterial, DiffuseMaterial, SurfaceMaterial>;
+
+/// The radiance a mesh material emits (0 for hair).
+Rgb material_emission(const Material &material);
 
 /// Hair curves sharing one material. Curve c has points first[c] .. first[c + 1] − 1; first
 /// has curve count + 1 entries, starts at 0 and ends at points.size(). One radius per point.
@@ -68,11 +79,15 @@ struct HairCurves {
 };
 
 /// A triangle mesh in world space. indices holds 3 vertex indices per triangle; materials
-/// holds one material index per triangle, or a single index for the whole mesh.
+/// holds one material index per triangle, or a single index for the whole mesh. normals
+/// (unit, world space) and uvs are per triangle corner, in the order of indices: 3 normals
+/// and 3 UV pairs per triangle, or empty (the face normal; UV (0, 0)).
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<std::uint32_t> indices;
     std::vector<std::uint32_t> materials{0};
+    std::vector<Vec3> normals;
+    std::vector<float> uvs;
 };
 
 /// Everything a scene is made of, as plain data.
@@ -131,6 +146,11 @@ struct SurfacePoint {
     Vec3 normal;
     /// Unit curve tangent normalize(dP/du) (zero for triangles).
     Vec3 tangent;
+    /// Triangles: the unit shading normal, on the same side as `normal` (equal to it for flat
+    /// faces); curves: equal to `normal`.
+    Vec3 shading_normal;
+    /// Triangles: the UV map at the hit ((0, 0) without one).
+    float u = 0.0f, v = 0.0f;
     std::uint32_t material = 0;
     bool is_curve = false;
     /// True for a mesh triangle whose emission is in the light set (MIS applies to it).

@@ -119,6 +119,8 @@ class SurfaceBsdf {
     /// True when nothing can be sampled (no lobe with a selection weight).
     bool black() const { return !(select_total_ > 0.0f); }
 
+    /// The shading normal of the frame (world space).
+    Vec3 normal() const { return n_; }
     /// ω_o and directions in the local frame.
     Vec3 local_wo() const { return wo_; }
     Vec3 to_local(Vec3 w) const { return {dot(w, a_), dot(w, b_), dot(w, n_)}; }
