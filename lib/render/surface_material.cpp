@@ -480,6 +480,28 @@ Expected<SurfaceMaterial> SurfaceMaterial::create(std::vector<SurfaceNode> nodes
     return m;
 }
 
+Expected<SurfaceMaterial> SurfaceMaterial::combine(const SurfaceMaterial &a, const SurfaceMaterial &b,
+                                                   std::optional<float> factor) {
+    std::vector<SurfaceNode> nodes = a.nodes_;
+    const int offset = int(nodes.size());
+    for (SurfaceNode node : b.nodes_) {
+        if (auto *mix = std::get_if<MixShaderNode>(&node)) {
+            mix->first += offset;
+            mix->second += offset;
+        } else if (auto *add = std::get_if<AddShaderNode>(&node)) {
+            add->first += offset;
+            add->second += offset;
+        }
+        nodes.push_back(node);
+    }
+    const int first = offset - 1, second = int(nodes.size()) - 1;
+    if (factor)
+        nodes.push_back(MixShaderNode{*factor, first, second});
+    else
+        nodes.push_back(AddShaderNode{first, second});
+    return create(std::move(nodes));
+}
+
 SurfaceBsdf SurfaceMaterial::prepare(const SurfaceShadingPoint &p) const {
     const Vec3 n = cycles_ == CyclesVersion::V3_4 ? valid_reflection_normal(p.ng, p.wo, p.n) : p.n;
     SurfaceBsdf bsdf(n, p.ng, p.wo);

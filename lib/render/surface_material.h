@@ -40,6 +40,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <variant>
 #include <vector>
 
@@ -144,6 +145,11 @@ class SurfaceMaterial {
 
     /// The lobes at a shading point.
     SurfaceBsdf prepare(const SurfaceShadingPoint &p) const;
+
+    /// A Mix Shader of two materials ((1 − factor) a + factor b; factor finite), or an Add
+    /// Shader when factor is empty: the trees of a and b under a new root.
+    static Expected<SurfaceMaterial> combine(const SurfaceMaterial &a, const SurfaceMaterial &b,
+                                             std::optional<float> factor);
 
   private:
     std::vector<SurfaceNode> nodes_;
