@@ -59,7 +59,8 @@ struct Counters {
 // faces.
 class Bsdf {
   public:
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, ScratchBuffer &scratch) {
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, bool camera_hit,
+         ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
             const float h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
@@ -70,7 +71,7 @@ class Bsdf {
         const Vec3 ng = back ? -sp.normal : sp.normal;
         if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
             const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
-            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v});
+            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, camera_hit});
         } else {
             const auto &d = std::get<DiffuseMaterial>(material);
             surface_ = SurfaceBsdf(ng, ng, wo);
@@ -182,7 +183,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         }
 
         scratch.reset();  // the previous vertex's BSDF is done with
-        const Bsdf bsdf(material, sp, wo, scratch);
+        const Bsdf bsdf(material, sp, wo, depth == 0, scratch);
         if (bsdf.black()) break;
 
         // Next-event estimation.

@@ -64,23 +64,31 @@ Rgb microfacet_fresnel(const SurfaceLobe &l, float c) {
     return Rgb(1.0f);
 }
 
-Rgb eval_microfacet(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf) {
+Rgb eval_microfacet(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf, float *reported) {
     pdf = 0.0f;
+    if (reported) *reported = 0.0f;
     if (!(wo.z > 0.0f) || !(wi.z > 0.0f)) return {};
     const Vec3 sum = wo + wi;
     const Vec3 h = safe_normalize(sum);
     if (!(h.z > 0.0f)) return {};
     const float c = std::clamp(dot(wi, h), 0.0f, 1.0f);
     float d;
+    const float a2 = l.shadowing_alpha2;
+    float reports;
     if (l.distribution == MicrofacetDistribution::Gtr1) {
         d = microfacet::gtr1_d(l.alpha, sum);
-        pdf = microfacet::gtr1_reflection_pdf(wo, wi, l.alpha);
+        if (l.sampling == MicrofacetSampling::Cycles34Clearcoat) {
+            pdf = microfacet::ggx_reflection_pdf(wo, wi, l.alpha);
+            reports = microfacet::ggx_g1(a2, wo.z) * d / (4.0f * wo.z);
+        } else {
+            pdf = reports = microfacet::gtr1_reflection_pdf(wo, wi, l.alpha);
+        }
     } else {
         const float alpha2 = l.alpha * l.alpha;
         d = microfacet::ggx_d(alpha2, sum);
-        pdf = microfacet::ggx_g1(alpha2, wo.z) * d / (4.0f * wo.z);
+        pdf = reports = microfacet::ggx_g1(alpha2, wo.z) * d / (4.0f * wo.z);
     }
-    const float a2 = l.shadowing_alpha2;
+    if (reported) *reported = reports;
     const float g = l.shadowing == MicrofacetShadowing::Separable
                         ? microfacet::ggx_g1(a2, wo.z) * microfacet::ggx_g1(a2, wi.z)
                         : 1.0f / (1.0f + microfacet::ggx_lambda(a2, wo.z) +
@@ -90,14 +98,16 @@ Rgb eval_microfacet(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf) {
 
 }  // namespace
 
-Rgb eval_lobe(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf) {
-    if (l.kind == SurfaceLobeKind::Microfacet) return eval_microfacet(l, wo, wi, pdf);
+Rgb eval_lobe(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf, float *reported) {
+    if (l.kind == SurfaceLobeKind::Microfacet) return eval_microfacet(l, wo, wi, pdf, reported);
     const float ci = wi.z;
     if (!(ci > 0.0f)) {
         pdf = 0.0f;
+        if (reported) *reported = 0.0f;
         return {};
     }
     pdf = ci * kInvPiF;
+    if (reported) *reported = pdf;
     switch (l.kind) {
         case SurfaceLobeKind::Lambert:
             return Rgb(ci * kInvPiF);
@@ -137,7 +147,7 @@ bool sample_lobe(const SurfaceLobe &l, Vec3 wo, float u0, float u1, Vec3 &wi) {
     if (l.kind == SurfaceLobeKind::Microfacet) {
         if (!(wo.z > 0.0f)) return false;
         Vec3 h;
-        if (l.distribution == MicrofacetDistribution::Gtr1) {
+        if (l.distribution == MicrofacetDistribution::Gtr1 && l.sampling == MicrofacetSampling::Exact) {
             h = microfacet::sample_gtr1(l.alpha, u0, u1);
             if (!(dot(wo, h) > 0.0f)) return false;
         } else {
@@ -167,23 +177,36 @@ bool SurfaceBsdf::add(const SurfaceLobe &lobe) {
     return true;
 }
 
-Rgb SurfaceBsdf::eval_local(Vec3 wi, float ng_cos, float &pdf) const {
+void SurfaceBsdf::defend_selection(float share) {
+    const float floor = share * select_total_;
+    select_total_ = 0.0f;
+    for (int k = 0; k < count_; ++k) {
+        SurfaceLobe &l = lobes_[std::size_t(k)];
+        if (l.select > 0.0f) l.select = std::max(l.select, floor);
+        select_total_ += l.select;
+    }
+}
+
+Rgb SurfaceBsdf::eval_local(Vec3 wi, float ng_cos, float &pdf, float *reported) const {
     Rgb f;
-    float p = 0.0f;
+    float q = 0.0f, r = 0.0f;
     for (int k = 0; k < count_; ++k) {
         const SurfaceLobe &l = lobes_[std::size_t(k)];
         if (l.below_ng_is_zero && !(ng_cos >= 0.0f)) continue;
-        float lobe_pdf = 0.0f;
-        const Rgb v = eval_lobe(l, wo_, wi, lobe_pdf);
+        float lobe_pdf = 0.0f, lobe_reported = 0.0f;
+        const Rgb v = eval_lobe(l, wo_, wi, lobe_pdf, &lobe_reported);
         f += l.weight * v;
-        p += l.select * lobe_pdf;
+        q += l.select * lobe_pdf;
+        r += l.select * lobe_reported;
     }
-    pdf = ng_cos > 0.0f && select_total_ > 0.0f ? p / select_total_ : 0.0f;
+    const bool reachable = ng_cos > 0.0f && select_total_ > 0.0f;
+    pdf = reachable ? q / select_total_ : 0.0f;
+    if (reported) *reported = reachable ? r / select_total_ : 0.0f;
     return f;
 }
 
-Rgb SurfaceBsdf::eval(Vec3 wi, float &pdf) const {
-    return eval_local(to_local(wi), dot(ng_, wi), pdf);
+Rgb SurfaceBsdf::eval(Vec3 wi, float &pdf, float *reported) const {
+    return eval_local(to_local(wi), dot(ng_, wi), pdf, reported);
 }
 
 bool SurfaceBsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
@@ -206,9 +229,10 @@ bool SurfaceBsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, fl
     wi = safe_normalize(to_world(local));
     const float ng_cos = dot(ng_, wi);
     if (!(ng_cos > 0.0f)) return false;
-    const Rgb f = eval_local(local, ng_cos, pdf);
-    if (!(pdf > 0.0f)) return false;
-    weight = f / pdf;
+    float reported = 0.0f;
+    const Rgb f = eval_local(local, ng_cos, pdf, &reported);
+    if (!(pdf > 0.0f) || !(reported > 0.0f)) return false;
+    weight = f / reported;
     if (glossy) *glossy = lobes_[std::size_t(chosen)].kind == SurfaceLobeKind::Microfacet;
     return true;
 }

@@ -10,12 +10,21 @@
 // microfacet lobes of Cycles 4.x are also 0 for ω_i below ng.
 //
 // Sampling: one lobe k with probability p_k = select_k / Σ select (u2), then a direction from
-// it (u0, u1): the cosine-weighted hemisphere for the diffuse lobes, visible normals for GGX and
-// exact normals for GTR1. A direction below n or below ng is no sample. The density of what
-// sample() returns is therefore exactly
-//   pdf(ω_i) = 1(ω_i·ng > 0) Σ_k p_k pdf_k(ω_i),   pdf_k = 0 below n,
-// the value eval() and sample() report (one-sample multiple importance sampling over lobes:
+// it (u0, u1): the cosine-weighted hemisphere for the diffuse lobes, visible normals for GGX,
+// exact normals for GTR1 (or GGX visible normals, below). A direction below n or below ng is no
+// sample. The density of what sample() returns is therefore exactly
+//   Q(ω_i) = 1(ω_i·ng > 0) Σ_k p_k q_k(ω_i),   q_k = 0 below n,
+// the pdf eval() and sample() report (one-sample multiple importance sampling over lobes:
 // every lobe's value counts whichever drew the direction).
+//
+// The sample's weight is f·|cos θ_i| / P with P the same mixture of each lobe's *reported*
+// density r_k. For every lobe r_k = q_k, so P = Q and the weight estimates ∫ f cos L without
+// bias — except Cycles 3.4's clearcoat (MicrofacetSampling::Cycles34Clearcoat), which Cycles
+// draws from GGX visible normals of the clearcoat's α but reports with its GTR1 formula; its
+// BSDF-sampled light then converges to ∫ f cos L · Q/P, not to ∫ f cos L, and, Q/P depending on
+// the selection probabilities, so does every lobe's share of it. hairis reproduces that on
+// purpose, with Cycles' selection weights (defend_selection for the camera hit), because it is
+// what Cycles 3.4 renders.
 #pragma once
 
 #include <array>
@@ -67,6 +76,16 @@ enum class MicrofacetFresnel : std::uint8_t {
     Dielectric,
 };
 
+/// How a microfacet lobe is drawn and which density it reports for the sample weight.
+enum class MicrofacetSampling : std::uint8_t {
+    /// GGX from its visible normals, GTR1 from its normals; the reported density is the true one.
+    Exact,
+    /// Cycles 3.4's clearcoat (a GTR1 lobe): drawn from GGX visible normals of the same α
+    /// (density G1_GGX(c_o) D_GGX(h) / (4 c_o)), reported as G1(shadowing α², c_o) D_GTR1(h) /
+    /// (4 c_o) (bsdf_microfacet_ggx_sample and _eval_reflect of Cycles 3.4).
+    Cycles34Clearcoat,
+};
+
 /// One lobe: its kind, its closure weight and the parameters its kind reads.
 struct SurfaceLobe {
     SurfaceLobeKind kind = SurfaceLobeKind::Lambert;
@@ -95,10 +114,12 @@ struct SurfaceLobe {
     float energy_scale = 1.0f;
     /// Cycles 4.x: also 0 for ω_i below the geometric normal.
     bool below_ng_is_zero = false;
+    MicrofacetSampling sampling = MicrofacetSampling::Exact;
 };
 
-/// f·|cos θ_i| of one lobe (without its weight) and the density with which it samples ω_i.
-Rgb eval_lobe(const SurfaceLobe &lobe, Vec3 wo, Vec3 wi, float &pdf);
+/// f·|cos θ_i| of one lobe (without its weight), the density with which it samples ω_i and
+/// (when `reported` is not null) the density it reports for the sample weight.
+Rgb eval_lobe(const SurfaceLobe &lobe, Vec3 wo, Vec3 wi, float &pdf, float *reported = nullptr);
 /// A direction drawn from one lobe with u0, u1; false when there is none (below n).
 bool sample_lobe(const SurfaceLobe &lobe, Vec3 wo, float u0, float u1, Vec3 &wi);
 
@@ -118,6 +139,9 @@ class SurfaceBsdf {
     const SurfaceLobe &lobe(int i) const { return lobes_[std::size_t(i)]; }
     /// True when nothing can be sampled (no lobe with a selection weight).
     bool black() const { return !(select_total_ > 0.0f); }
+    /// Cycles 3.4's defensive sampling at the camera hit: every sampled lobe's selection
+    /// weight raised to at least `share` of their sum (taken before raising).
+    void defend_selection(float share);
 
     /// The shading normal of the frame (world space).
     Vec3 normal() const { return n_; }
@@ -126,16 +150,17 @@ class SurfaceBsdf {
     Vec3 to_local(Vec3 w) const { return {dot(w, a_), dot(w, b_), dot(w, n_)}; }
     Vec3 to_world(Vec3 l) const { return a_ * l.x + b_ * l.y + n_ * l.z; }
 
-    /// f·|cos θ_i| for world ω_i, and pdf(ω_i) (file comment).
-    Rgb eval(Vec3 wi, float &pdf) const;
-    /// Draws ω_i (world); weight = f·|cos θ_i| / pdf. False when there is no sample. `glossy`
-    /// (may be null) says whether the lobe drawn from is a microfacet one (Cycles' glossy
-    /// bounce) or a diffuse one.
+    /// f·|cos θ_i| for world ω_i, and Q(ω_i) (file comment); `reported` (may be null)
+    /// receives P(ω_i).
+    Rgb eval(Vec3 wi, float &pdf, float *reported = nullptr) const;
+    /// Draws ω_i (world) with density pdf = Q(ω_i); weight = f·|cos θ_i| / P(ω_i). False
+    /// when there is no sample. `glossy` (may be null) says whether the lobe drawn from is a
+    /// microfacet one (Cycles' glossy bounce) or a diffuse one.
     bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
                 bool *glossy = nullptr) const;
 
   private:
-    Rgb eval_local(Vec3 wi, float ng_cos, float &pdf) const;
+    Rgb eval_local(Vec3 wi, float ng_cos, float &pdf, float *reported) const;
 
     std::array<SurfaceLobe, kMaxLobes> lobes_{};
     int count_ = 0;

@@ -19,7 +19,7 @@ using testing::Chi2Options;
 using testing::Chi2Result;
 using testing::Sample3;
 
-constexpr int kChi2Tests = 4;
+constexpr int kChi2Tests = 5;
 
 Vec3 from_angles(double theta, double phi) {
     return {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
@@ -83,6 +83,14 @@ std::vector<SurfaceLobe> lobes_4() {
     return {coat, metal, spec, diffuse};
 }
 
+// lobes_34 with Cycles 3.4's clearcoat sampler and selection weights of its magnitude.
+std::vector<SurfaceLobe> cycles_clearcoat_lobes() {
+    std::vector<SurfaceLobe> lobes = lobes_34();
+    lobes[3].sampling = MicrofacetSampling::Cycles34Clearcoat;
+    lobes[3].select = 0.1f;
+    return lobes;
+}
+
 SurfaceBsdf make_bsdf(const std::vector<SurfaceLobe> &lobes, Vec3 wo, Vec3 ng) {
     SurfaceBsdf b(Vec3{0, 0, 1}, ng, wo);
     for (const SurfaceLobe &l : lobes) EXPECT_TRUE(b.add(l));
@@ -122,6 +130,7 @@ TEST(SurfaceBsdf, MixtureSamplerMatchesItsDensity) {
         {"3.4 principled, tilted ng, grazing", lobes_34(), from_angles(1.2, 2.0), tilted_ng},
         {"4.x layers, tilted ng", lobes_4(), from_angles(0.9, -0.5), tilted_ng},
         {"lambert", {lobe(SurfaceLobeKind::Lambert, Rgb(0.7f), 1.0f)}, from_angles(0.4, 0.0), Vec3{0, 0, 1}},
+        {"3.4 principled, Cycles' clearcoat sampler", cycles_clearcoat_lobes(), from_angles(0.7, 0.5), Vec3{0, 0, 1}},
     };
     for (const Case &c : cases) {
         const SurfaceBsdf b = make_bsdf(c.lobes, c.wo, c.ng);
@@ -182,6 +191,57 @@ TEST(SurfaceBsdf, SampleWeightsAverageToTheReflectedEnergy) {
             EXPECT_NEAR(mean, quadrature[k], 5.0 * sd + 1e-4) << "channel " << k;
         }
     }
+}
+
+TEST(SurfaceBsdf, CyclesClearcoatWeightsByTheDensityItReports) {
+    // Cycles 3.4's clearcoat is drawn from GGX visible normals but weighted with its GTR1
+    // formula: the sample's pdf is the true mixture Q, its weight f / P with P the reported
+    // mixture, so the mean weight is ∫ f Q / P (not ∫ f), by quadrature here.
+    const SurfaceBsdf b = make_bsdf(cycles_clearcoat_lobes(), from_angles(0.8, 0.4), Vec3{0, 0, 1});
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const int n = 400000;
+    double sum = 0.0, sum2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+        Vec3 wi;
+        Rgb weight;
+        float pdf;
+        if (!b.sample(u(rng), u(rng), u(rng), wi, weight, pdf)) continue;
+        float q, p;
+        const Rgb f = b.eval(wi, q, &p);
+        ASSERT_NEAR(q, pdf, 1e-4f * pdf);
+        ASSERT_NEAR(weight.g * p, f.g, 1e-4f * f.g + 1e-7f);
+        sum += weight.g;
+        sum2 += double(weight.g) * weight.g;
+    }
+    const auto integral = [&](bool cycles) {
+        return testing::integrate_hemisphere([&](Vec3 wi) {
+            float q, p;
+            const double f = b.eval(wi, q, &p).g;
+            return cycles ? (p > 0.0f ? f * q / p : 0.0) : f;
+        }, 192, 192);
+    };
+    const double mean = sum / n, sd = std::sqrt((sum2 / n - mean * mean) / n);
+    const double cycles = integral(true), exact = integral(false);
+    EXPECT_NEAR(mean, cycles, 5.0 * sd);
+    EXPECT_GT(std::fabs(cycles - exact), 10.0 * sd) << "the test must tell the two apart";
+    // The exact lobes report what they draw: P = Q.
+    const SurfaceBsdf plain = make_bsdf(lobes_34(), from_angles(0.8, 0.4), Vec3{0, 0, 1});
+    for (double t : {0.1, 0.7, 1.3}) {
+        float q, p;
+        plain.eval(from_angles(t, 3.0), q, &p);
+        EXPECT_EQ(q, p);
+    }
+}
+
+TEST(SurfaceBsdf, DefensiveSelectionRaisesSmallLobes) {
+    SurfaceBsdf b = make_bsdf(lobes_34(), from_angles(0.5, 0.0), Vec3{0, 0, 1});
+    const float total = 0.4f + 0.05f + 0.1f + 0.05f;
+    b.defend_selection(0.125f);
+    EXPECT_FLOAT_EQ(b.lobe(0).select, 0.4f);
+    EXPECT_FLOAT_EQ(b.lobe(1).select, 0.125f * total);
+    EXPECT_FLOAT_EQ(b.lobe(2).select, 0.1f);
+    EXPECT_FLOAT_EQ(b.lobe(3).select, 0.125f * total);
 }
 
 TEST(SurfaceBsdf, LambertReflectsItsWeight) {

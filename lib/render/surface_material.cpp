@@ -233,6 +233,7 @@ class LobeBuilder {
             l.f0 = Rgb(0.04f);
             l.ior = 1.5f;
             l.fresnel_scale = 0.25f * pr.coat;
+            l.sampling = MicrofacetSampling::Cycles34Clearcoat;
             l.select = std::fabs(average(w)) * average(fresnel_at_normal(l));
             add(l);
         }
@@ -506,6 +507,7 @@ SurfaceBsdf SurfaceMaterial::prepare(const SurfaceShadingPoint &p) const {
     const Vec3 n = cycles_ == CyclesVersion::V3_4 ? valid_reflection_normal(p.ng, p.wo, p.n) : p.n;
     SurfaceBsdf bsdf(n, p.ng, p.wo);
     LobeBuilder(nodes_, p, bsdf).visit(int(nodes_.size()) - 1, Rgb(1.0f));
+    if (cycles_ == CyclesVersion::V3_4 && p.camera_hit) bsdf.defend_selection(0.125f);
     return bsdf;
 }
 

@@ -22,7 +22,10 @@
 //                 η = 2/(1 − sqrt(0.08 specular)) − 1 (single-scatter "GGX"; Multiscatter GGX
 //                 is approximated as for the Glossy BSDF);
 //      clearcoat= GTR1 with α = Clearcoat Roughness², G at α = 0.25, F from cspec0 0.04 and
-//                 η 1.5, times clearcoat / 4.
+//                 η 1.5, times clearcoat / 4, sampled as Cycles 3.4 samples it (surface_bsdf.h:
+//                 MicrofacetSampling::Cycles34Clearcoat), with Cycles' selection weights:
+//                 |mean(weight)| × (for its microfacets) the mean Fresnel at ω_o·n, and at the
+//                 camera hit at least 1/8 of their sum (its defensive sampling).
 //  - Principled BSDF, 4.x (the layered model): coat (GGX dielectric at Coat IOR with energy
 //    compensation; the layers below lose its albedo estimate and take Coat Tint along the
 //    refracted path), metallic (F82-tint with f0 = base, F82 = Specular Tint), specular
@@ -119,6 +122,8 @@ struct SurfaceShadingPoint {
     Vec3 n;
     Vec3 ng;
     float u = 0.0f, v = 0.0f;
+    /// The camera ray's hit (Cycles 3.4 samples its closures defensively there).
+    bool camera_hit = false;
 };
 
 /// Cycles 3.4's ensure_valid_reflection: n itself when the mirror reflection of ω_o about it

@@ -97,6 +97,29 @@ TEST(SurfaceMaterial, Principled34MetallicTintSheenAndClearcoat) {
     EXPECT_EQ(coat->shadowing_alpha2, 0.0625f);
     EXPECT_NEAR(coat->fresnel_scale, 0.2f, 1e-7f);
     expect_rgb(coat->f0, Rgb(0.04f), 0.0f);
+    EXPECT_EQ(coat->sampling, MicrofacetSampling::Cycles34Clearcoat);
+    // Selection weights: |mean weight| × the mean Fresnel at ω_o·n for the microfacets;
+    // at the camera hit every lobe has at least 1/8 of their sum.
+    const float mu = std::cos(0.3f);
+    const float f0 = fresnel_dielectric(1.0f, 1.5f);
+    const float s = (fresnel_dielectric(mu, 1.5f) - f0) / (1.0f - f0);
+    EXPECT_NEAR(coat->select, (0.04f * (1.0f - s) + s) * 0.2f, 1e-6f);
+    EXPECT_NEAR(diffuse->select, (0.9f + 0.5f + 0.1f) / 3.0f * 0.75f, 1e-6f);
+    const SurfaceMaterial m = material({p});
+    const SurfaceBsdf first = m.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
+    float total = 0.0f;
+    for (int i = 0; i < b.lobe_count(); ++i) total += b.lobe(i).select;
+    for (int i = 0; i < first.lobe_count(); ++i)
+        EXPECT_NEAR(first.lobe(i).select, std::max(b.lobe(i).select, 0.125f * total), 1e-6f) << i;
+    PrincipledBsdfNode later = p;  // Cycles 4.x has no defensive sampling
+    later.cycles = CyclesVersion::V4_5;
+    later.specular_tint = 0.0f;
+    later.sheen = 0.0f;
+    later.sheen_tint = 0.5f;
+    const SurfaceMaterial m4 = material({later});
+    const SurfaceBsdf a4 = m4.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, false});
+    const SurfaceBsdf b4 = m4.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
+    for (int i = 0; i < a4.lobe_count(); ++i) EXPECT_EQ(a4.lobe(i).select, b4.lobe(i).select);
 }
 
 TEST(SurfaceMaterial, Principled4SpecularLayerDimsTheDiffuse) {
