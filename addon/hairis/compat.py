@@ -6,8 +6,10 @@ what the running Blender has, never from socket indices), so the other modules r
 
 - the supported versions: 3.4 and newer within the major versions Hairis knows (3, 4, 5);
   :func:`version_problem` names the running version and the supported ones otherwise;
-- Principled BSDF inputs renamed in 4.0 (Emission → Emission Color, ...): :data:`SURFACE_INPUTS`
-  lists each input's names, newest first, and :func:`find_input` takes the first one present;
+- the Principled BSDF's inputs and meaning changed in 4.0 (a layered model; Specular → Specular
+  IOR Level, Emission → Emission Color, ...): :func:`cycles_surfaces` says which Cycles the
+  surface nodes follow and surfaces.py reads each version's sockets; :func:`find_input` takes
+  the first of an input's names that is present;
 - ``use_nodes`` of materials and worlds is deprecated from 5.0 (always on; reading it warns):
   :func:`uses_nodes`;
 - the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang);
@@ -32,16 +34,6 @@ KNOWN_MAJOR_VERSIONS = (3, 4, 5)
 """Major versions whose node and Python APIs Hairis was written and tested against."""
 
 SUPPORTED_TEXT = "Blender 3.4 to 5.x (tested: 3.4, 4.5 LTS, 5.0)"
-
-SURFACE_INPUTS = {
-    # key: the input's names, newest first (Blender 4.0 renamed Principled BSDF inputs).
-    "base_color": ("Base Color",),
-    "emission_color": ("Emission Color", "Emission"),
-    "emission_strength": ("Emission Strength",),
-    "color": ("Color",),
-    "strength": ("Strength",),
-}
-"""The surface-shader inputs Hairis reads, by every name they have had."""
 
 NODES_ALWAYS_ON = (5, 0, 0)
 """From 5.0 materials and worlds always use nodes (``use_nodes`` is deprecated); lights not."""
@@ -115,6 +107,42 @@ def set_pass_pixels(render_pass, rgba):
         render_pass.rect.foreach_set(pixels.reshape(-1))
     except (TypeError, ValueError):
         render_pass.rect.foreach_set(pixels.reshape(-1, 4))
+
+
+CYCLES_4_SURFACES = (4, 0, 0)
+"""From 4.0 the surface nodes follow Cycles 4.5 (the layered Principled BSDF, multiscatter GGX
+by energy compensation, height-correlated shadowing), unchanged up to 5.0."""
+
+
+def cycles_surfaces(version=None):
+    """The Cycles ('3.4' or '4.5') whose surface nodes the running Blender's Cycles has."""
+    return "4.5" if tuple(version or running_version()) >= CYCLES_4_SURFACES else "3.4"
+
+
+def corner_normals(mesh):
+    """(loops, 3) float32 corner normals of a mesh with its loop triangles: Blender 4.1+'s
+    ``corner_normals``, 3.x's split normals (``calc_normals_split``, which honour smooth and
+    flat faces, auto smooth and custom normals)."""
+    normals = np.empty(len(mesh.loops) * 3, np.float32)
+    corner = getattr(mesh, "corner_normals", None)
+    if corner is not None:
+        corner.foreach_get("vector", normals)
+    else:
+        mesh.calc_normals_split()
+        mesh.loops.foreach_get("normal", normals)
+    return normals.reshape(-1, 3)
+
+
+def render_uv_layer(mesh):
+    """The UV map Cycles reads for an Image Texture's default coordinates (the active render
+    one), or None."""
+    layers = getattr(mesh, "uv_layers", None)
+    if layers is None or len(layers) == 0:
+        return None
+    for layer in layers:
+        if getattr(layer, "active_render", False):
+            return layer
+    return layers.active
 
 
 CYCLES_4_LIGHTS = (4, 0, 0)

@@ -89,6 +89,22 @@ def render_settings(settings):
             "curve_backfaces": compat.curve_backfaces()}
 
 
+def add_surface_nodes(scene, nodes, texture_index):
+    """Adds a surface material's nodes (export's positions → the library's indices); returns
+    the index of its root."""
+    added = []
+    for node in nodes:
+        values = dict(node)
+        for key in ("base_color_texture", "color_texture"):
+            if values.get(key, -1) >= 0:
+                values[key] = texture_index(values[key])
+        for key in ("shader1", "shader2"):
+            if key in values:
+                values[key] = added[values[key]]
+        added.append(scene.add_surface_material(values))
+    return added[-1]
+
+
 def build_native_scene(library, data, hair_tables):
     """A ``native.Scene`` holding everything in ``data`` (SceneData).
 
@@ -98,11 +114,29 @@ def build_native_scene(library, data, hair_tables):
     scene = library.scene()
     try:
         indices = []
+        textures = {}  # position in data.textures → the library's texture index
+
+        def texture_index(position):
+            if position not in textures:
+                texture = data.textures[position]
+                values = texture.options()
+                if texture.path is not None:
+                    textures[position] = scene.add_texture(dict(values, image=texture.path))
+                else:
+                    textures[position] = scene.add_texture(values, texture.pixels)
+            return textures[position]
+
         for i, material in enumerate(data.materials):
             if material.kind == "HAIR":
                 try:
                     indices.append(scene.add_hair_material(material.hair.as_dict(),
                                                            hair_tables.get(i)))
+                except native.HairisError as error:
+                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                        from error
+            elif material.kind == "SURFACE":
+                try:
+                    indices.append(add_surface_nodes(scene, material.nodes, texture_index))
                 except native.HairisError as error:
                     raise RenderFailed("material %r: %s" % (material.name, error.message)) \
                         from error
@@ -118,6 +152,10 @@ def build_native_scene(library, data, hair_tables):
                                  curves.radii)
         for mesh in data.meshes:
             scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
+            if mesh.normals is not None:
+                scene.set_mesh_attribute("normal", mesh.normals)
+            if mesh.uvs is not None:
+                scene.set_mesh_attribute("uv", mesh.uvs)
         for light in data.lights:
             scene.add_light(light_options(light))
         environment = data.world_environment

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, node_eval
+from . import compat, node_eval, surfaces
 
 DEFAULT_CURVES_RADIUS = 0.005
 """Cycles' radius for Curves without a ``radius`` attribute."""
@@ -117,13 +117,15 @@ class HairParameters:
 
 @dataclass
 class MaterialData:
-    """One scene material: ``kind`` is 'HAIR' (``hair`` set) or 'DIFFUSE'."""
+    """One scene material: ``kind`` is 'HAIR' (``hair`` set), 'SURFACE' (``nodes`` set: the
+    surface node options of surfaces.py, root last) or 'DIFFUSE' (``albedo``, ``emission``)."""
 
     name: str
     kind: str
     hair: HairParameters = None
     albedo: tuple = DEFAULT_ALBEDO
     emission: tuple = (0.0, 0.0, 0.0)
+    nodes: list = None
     material_name: str = None
     """The Blender material it came from (None for the default material)."""
     source: object = None
@@ -158,12 +160,15 @@ class CurvesData:
 
 @dataclass
 class MeshData:
-    """A world-space triangle mesh with one scene material index per triangle."""
+    """A world-space triangle mesh with one scene material index per triangle, and per
+    triangle corner (triangles, 3, ·) its world-space normals and UV map (or None)."""
 
     name: str
     positions: np.ndarray
     indices: np.ndarray
     materials: np.ndarray
+    normals: np.ndarray = None
+    uvs: np.ndarray = None
 
 
 @dataclass
@@ -242,6 +247,8 @@ class SceneData:
     """Everything a render needs, as plain Python and numpy values."""
 
     materials: list = field(default_factory=list)
+    textures: list = field(default_factory=list)
+    """surfaces.TextureData of the surface materials, referred to by position."""
     curves: list = field(default_factory=list)
     meshes: list = field(default_factory=list)
     lights: list = field(default_factory=list)
@@ -511,48 +518,19 @@ def read_hair_node(node, material_name="?"):
     return HairParameters(**values), warnings, None
 
 
-def read_surface_material(material):
-    """A non-hair material as (albedo, emission, warnings): Principled/Diffuse/Emission."""
-    warnings = []
-    name = material.name
+def read_surface_nodes(material, warn, add_texture):
+    """A mesh material's surface nodes (surfaces.py), root last: the viewport colour as a
+    diffuse albedo without nodes, a black diffuse when nothing feeds the Surface (Cycles
+    renders it black)."""
+    version = compat.cycles_surfaces()
     if not compat.uses_nodes(material):
-        return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
+        color = tuple(min(max(c, 0.0), 1.0) for c in _rgb(material.diffuse_color))
+        return [{"type": "diffuse", "cycles": version, "color": color}]
     node = surface_node(material)
     if node is None:
-        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), warnings  # Cycles: black surface
-    kind = node.bl_idname
-
-    def value(key, components=3, default=None):
-        names = compat.SURFACE_INPUTS[key]
-        socket = compat.find_input(node, names)
-        if socket is None:
-            warnings.append("material %r: %s has no %s input in Blender %s; hairis uses %r"
-                            % (name, node.name, " or ".join(repr(n) for n in names),
-                               compat.version_string(), default))
-            return default
-        if socket.is_linked:
-            warnings.append("material %r: input %r of %s is linked (textures are not supported); "
-                            "hairis uses its unlinked value" % (name, socket.name, node.name))
-        try:
-            return _socket_value(socket, components)
-        except (TypeError, ValueError) as error:
-            warnings.append("material %r: %s; hairis uses %r" % (name, error, default))
-            return default
-
-    if kind == "ShaderNodeBsdfPrincipled":
-        albedo = value("base_color", 3, DEFAULT_ALBEDO)
-        emission = value("emission_color", 3, (0.0, 0.0, 0.0))
-        strength = value("emission_strength", 1, 1.0)
-        return albedo, tuple(e * strength for e in emission), warnings
-    if kind == "ShaderNodeBsdfDiffuse":
-        return value("color", 3, DEFAULT_ALBEDO), (0.0, 0.0, 0.0), warnings
-    if kind == "ShaderNodeEmission":
-        color = value("color", 3, (1.0, 1.0, 1.0))
-        strength = value("strength", 1, 1.0)
-        return (0.0, 0.0, 0.0), tuple(c * strength for c in color), warnings
-    warnings.append("material %r: %s is not supported on meshes; using its viewport colour as a "
-                    "diffuse albedo" % (name, node.bl_label or kind))
-    return _rgb(material.diffuse_color), (0.0, 0.0, 0.0), warnings
+        return [{"type": "diffuse", "cycles": version, "color": (0.0, 0.0, 0.0)}]
+    reader = surfaces.SurfaceReader(material, warn, add_texture, _follow_link, version)
+    return reader.read(node)
 
 
 # ---- Environment Texture worlds -------------------------------------------------------------
@@ -726,6 +704,7 @@ class _Exporter:
         self._material_index = {}
         self._default_index = None
         self._mesh_cache = {}
+        self._texture_index = {}
 
     # -- materials --
 
@@ -760,15 +739,12 @@ class _Exporter:
                 data = MaterialData(name=material.name, kind="HAIR", hair=params,
                                     material_name=material.name, source=material.original)
         else:
-            albedo, emission, warnings = read_surface_material(material)
-            for warning in warnings:
-                self.data.warn(warning)
+            nodes = read_surface_nodes(material, self.data.warn, self.texture)
             if for_hair:
                 self.data.warn("material %r on hair has no Principled Hair BSDF; hairis renders "
-                               "the strands as diffuse" % material.name)
-            data = MaterialData(name=material.name, kind="DIFFUSE", albedo=albedo,
-                                emission=emission, material_name=material.name,
-                                source=material.original)
+                               "the strands with its surface shader" % material.name)
+            data = MaterialData(name=material.name, kind="SURFACE", nodes=nodes,
+                                material_name=material.name, source=material.original)
         index = len(self.data.materials)
         self.data.materials.append(data)
         self._material_index[key] = index
@@ -795,6 +771,15 @@ class _Exporter:
             inputs[CURVE_INPUT_NAMES.get(field_name, field_name)] = (
                 compiled.domain, values.astype(np.float32))
         return inputs
+    def texture(self, texture):
+        """The position of a surfaces.TextureData in the scene's textures (shared when equal)."""
+        key = texture.key()
+        index = self._texture_index.get(key)
+        if index is None:
+            index = len(self.data.textures)
+            self.data.textures.append(texture)
+            self._texture_index[key] = index
+        return index
 
     @staticmethod
     def slot_material(obj, slot_index):
@@ -965,20 +950,38 @@ class _Exporter:
                 self._mesh_cache[key] = local
         if local is None:
             return
-        positions, indices, slots = local
+        positions, indices, slots, normals, uvs = local
         slot_count = len(obj.material_slots)
         slots = np.clip(slots, 0, max(slot_count - 1, 0))
         materials = np.empty(slots.size, np.int32)
         for slot in np.unique(slots):  # only the slots triangles use
             materials[slots == slot] = self.material(self.slot_material(obj, slot),
                                                      for_hair=False)
+        world = _transform_points(matrix, positions)
+        world_normals = None
+        linear = matrix[:3, :3]
+        if normals is not None and abs(np.linalg.det(linear)) > 0.0:
+            # Normals transform with the inverse transpose: as rows, n · M⁻¹.
+            corner = normals.reshape(-1, 3) @ np.linalg.inv(linear)
+            length = np.linalg.norm(corner, axis=1)
+            bad = ~(length > 0.0)
+            if bad.any():  # a zero corner normal (degenerate faces): the triangle's own
+                p = world[indices.reshape(-1)].reshape(-1, 3, 3)
+                face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+                face = np.repeat(face, 3, axis=0)
+                face[~(np.linalg.norm(face, axis=1) > 0.0)] = (0.0, 0.0, 1.0)
+                corner[bad] = face[bad]
+                length = np.linalg.norm(corner, axis=1)
+            world_normals = (corner / length[:, None]).reshape(-1, 3, 3).astype(np.float32)
         self.data.meshes.append(MeshData(
-            name=obj.name, positions=_transform_points(matrix, positions).astype(np.float32),
-            indices=indices, materials=materials.astype(np.int32)))
+            name=obj.name, positions=world.astype(np.float32), indices=indices,
+            materials=materials.astype(np.int32), normals=world_normals, uvs=uvs))
 
     @staticmethod
     def _triangulate(obj):
-        """(positions, triangle indices, triangle material slots) in object space, or None."""
+        """(positions, triangle indices, triangle material slots, corner normals, corner UVs)
+        in object space, or None; corners (triangles, 3, ·), the UV map Cycles reads by default
+        (None without one)."""
         try:
             mesh = obj.to_mesh()
         except RuntimeError:
@@ -997,10 +1000,19 @@ class _Exporter:
             mesh.loop_triangles.foreach_get("vertices", indices)
             slots = np.empty(triangle_count, np.int32)
             mesh.loop_triangles.foreach_get("material_index", slots)
+            loops = np.empty(triangle_count * 3, np.int32)
+            mesh.loop_triangles.foreach_get("loops", loops)
+            normals = compat.corner_normals(mesh)[loops].reshape(-1, 3, 3).astype(np.float64)
+            uvs = None
+            layer = compat.render_uv_layer(mesh)
+            if layer is not None:
+                uv = np.empty(len(mesh.loops) * 2, np.float32)
+                layer.data.foreach_get("uv", uv)
+                uvs = uv.reshape(-1, 2)[loops].reshape(-1, 3, 2)
         finally:
             obj.to_mesh_clear()
         return (positions.reshape(-1, 3).astype(np.float64),
-                indices.reshape(-1, 3).astype(np.uint32), slots)
+                indices.reshape(-1, 3).astype(np.uint32), slots, normals, uvs)
 
     def export_curves_object(self, obj, matrix):
         """A Curves object (Blender 3.3+ hair): positions, offsets, radius via foreach_get."""

@@ -94,12 +94,16 @@ PROTOTYPES = {
     "hairis_scene_destroy": (_VOID, [c_void_p]),
     "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
     "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_add_texture": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_add_texture_pixels": (c_int, [c_void_p, c_char_p, _F, c_size_t, c_size_t,
+                                                c_int]),
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32), c_size_t,
                                         _F, _F]),
     "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32),
                                                     c_size_t, _F, _F, c_char_p, c_size_t, _F]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, _F, c_size_t, POINTER(c_uint32),
                                       POINTER(c_int32)]),
+    "hairis_scene_set_mesh_attribute": (c_int, [c_void_p, c_char_p, _F, c_size_t]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, _F, c_size_t, c_size_t,
@@ -654,6 +658,44 @@ class Scene(_Handle):
         if index < 0:
             raise self._library._error("hairis_scene_add_surface_material")
         return index
+
+    def add_surface_material(self, values):
+        """Adds a surface material from its options (hairis_render.h: type diffuse,
+        principled, glossy, emission, mix or add); returns its index."""
+        index = self._library.raw.hairis_scene_add_surface_material(self, options(values).encode())
+        if index < 0:
+            raise self._library._error("hairis_scene_add_surface_material")
+        return index
+
+    def add_texture(self, values, pixels=None):
+        """Adds an Image Texture from texture options: with ``image`` (a path) in them, or with
+        ``pixels`` (height, width, channels) floats, bottom row first; returns its index."""
+        text = options(values).encode()
+        if pixels is None:
+            index = self._library.raw.hairis_scene_add_texture(self, text)
+            function = "hairis_scene_add_texture"
+        else:
+            pixels = np.ascontiguousarray(pixels, np.float32)
+            if pixels.ndim == 2:
+                pixels = pixels[:, :, None]
+            if pixels.ndim != 3:
+                raise ValueError("pixels must be (height, width, channels), got shape %s"
+                                 % (pixels.shape,))
+            height, width, channels = pixels.shape
+            index = self._library.raw.hairis_scene_add_texture_pixels(
+                self, text, _ptr(pixels, c_float), width, height, channels)
+            function = "hairis_scene_add_texture_pixels"
+        if index < 0:
+            raise self._library._error(function)
+        return index
+
+    def set_mesh_attribute(self, name, values):
+        """Per-corner data of the mesh added last: ``name`` 'normal' ((corners, 3)) or 'uv'
+        ((corners, 2)), in the order of its triangle indices."""
+        values = np.ascontiguousarray(values, np.float32).reshape(-1)
+        status = self._library.raw.hairis_scene_set_mesh_attribute(
+            self, options({"name": name}).encode(), _ptr(values, c_float), values.size)
+        self._library._status("hairis_scene_set_mesh_attribute", status)
 
     def add_curves(self, material, first, positions, radii):
         """Adds curves: ``first`` (curves+1) offsets, world ``positions`` (p, 3), ``radii`` (p)."""

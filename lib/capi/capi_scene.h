@@ -136,17 +136,170 @@ void describe(Fields &f, CurveInputOptions &o) {
         f.choice(hair_input_info(HairInput(i)).name, o.domain[i], {"material", "curve", "point"});
 }
 
-using SceneMaterial = std::variant<SceneHairMaterial, DiffuseMaterial>;
+using SceneMaterial = std::variant<SceneHairMaterial, SurfaceMaterial>;
 
-/// "type=diffuse": a Lambertian surface with an emission (radiance).
+/// The most textures a scene holds (indices are ints).
+inline constexpr int kMaxTextures = 1 << 20;
+
+/// "type=diffuse": Blender's Diffuse BSDF (Lambert at roughness 0, else Oren–Nayar as the
+/// Cycles version has it) with an emission (radiance) added; color_texture: an index from
+/// hairis_scene_add_texture that replaces color, -1 for none.
 struct DiffuseOptions {
     Rgb color{0.8f};
     Rgb emission{0.0f};
+    float roughness = 0.0f;
+    int color_texture = -1;
+    CyclesVersion cycles = CyclesVersion::V3_4;
 };
 template <typename Fields>
 void describe(Fields &f, DiffuseOptions &o) {
     f.field("color", o.color, 0.0, 1.0);
     f.field("emission", o.emission, 0.0, kHuge);
+    f.field("roughness", o.roughness, 0.0, 1.0);
+    f.field("color_texture", o.color_texture, -1, kMaxTextures - 1);
+    describe_version(f, o.cycles);
+}
+
+/// "distribution=ggx|multi_ggx" of the Glossy and Principled BSDFs.
+template <typename Fields>
+void describe_distribution(Fields &f, bool &multiscatter) {
+    int index = multiscatter ? 1 : 0;
+    f.choice("distribution", index, {"ggx", "multi_ggx"});
+    multiscatter = index == 1;
+}
+
+/// "type=glossy": Blender's Glossy BSDF with GGX or Multiscatter GGX.
+struct GlossyOptions {
+    Rgb color{0.8f};
+    int color_texture = -1;
+    float roughness = 0.5f;
+    bool multiscatter = false;
+    CyclesVersion cycles = CyclesVersion::V3_4;
+};
+template <typename Fields>
+void describe(Fields &f, GlossyOptions &o) {
+    f.field("color", o.color, 0.0, kHuge);
+    f.field("color_texture", o.color_texture, -1, kMaxTextures - 1);
+    f.field("roughness", o.roughness, 0.0, 1.0);
+    describe_distribution(f, o.multiscatter);
+    describe_version(f, o.cycles);
+}
+
+/// "type=emission": radiance color × strength.
+struct EmissionOptions {
+    Rgb color{1.0f};
+    float strength = 1.0f;
+};
+template <typename Fields>
+void describe(Fields &f, EmissionOptions &o) {
+    f.field("color", o.color, 0.0, kHuge);
+    f.field("strength", o.strength, 0.0, kHuge);
+}
+
+/// "type=mix" ((1 − factor) shader1 + factor shader2) and "type=add" (shader1 + shader2):
+/// shader1 and shader2 are surface materials already in the scene.
+struct MixOptions {
+    float factor = 0.5f;
+    int shader1 = -1, shader2 = -1;
+};
+template <typename Fields>
+void describe(Fields &f, MixOptions &o) {
+    f.field("factor", o.factor, 0.0, 1.0);
+    f.field("shader1", o.shader1, -1, 1 << 20);
+    f.field("shader2", o.shader2, -1, 1 << 20);
+}
+
+struct AddOptions {
+    int shader1 = -1, shader2 = -1;
+};
+template <typename Fields>
+void describe(Fields &f, AddOptions &o) {
+    f.field("shader1", o.shader1, -1, 1 << 20);
+    f.field("shader2", o.shader2, -1, 1 << 20);
+}
+
+/// "type=principled": Blender's Principled BSDF in the inputs of the Cycles version given
+/// (surface_material.h says what each becomes). specular is 3.4's Specular or 4.x's Specular
+/// IOR Level; specular_tint is 3.4's (a float), specular_tint_color 4.x's; subsurface_color,
+/// sheen and sheen_tint are 3.4's; coat is 3.4's Clearcoat or 4.x's Coat Weight, coat_ior,
+/// coat_tint and diffuse_roughness are 4.x's. emission is Emission (Color) × Emission Strength.
+struct PrincipledOptions {
+    CyclesVersion cycles = CyclesVersion::V3_4;
+    bool multiscatter = false;
+    Rgb base_color{0.8f};
+    int base_color_texture = -1;
+    float metallic = 0.0f;
+    float roughness = 0.5f;
+    float ior = 1.45f;
+    float specular = 0.5f;
+    float specular_tint = 0.0f;
+    Rgb specular_tint_color{1.0f};
+    float subsurface = 0.0f;
+    Rgb subsurface_color{0.8f};
+    float sheen = 0.0f;
+    float sheen_tint = 0.5f;
+    float coat = 0.0f;
+    float coat_roughness = 0.03f;
+    float coat_ior = 1.5f;
+    Rgb coat_tint{1.0f};
+    float diffuse_roughness = 0.0f;
+    Rgb emission{0.0f};
+};
+template <typename Fields>
+void describe(Fields &f, PrincipledOptions &o) {
+    describe_version(f, o.cycles);
+    describe_distribution(f, o.multiscatter);
+    f.field("base_color", o.base_color, 0.0, kHuge);
+    f.field("base_color_texture", o.base_color_texture, -1, kMaxTextures - 1);
+    f.field("metallic", o.metallic, 0.0, 1.0);
+    f.field("roughness", o.roughness, 0.0, 1.0);
+    f.field("ior", o.ior, 0.0, 1000.0);
+    f.field("specular", o.specular, 0.0, kHuge);
+    f.field("specular_tint", o.specular_tint, 0.0, 1.0);
+    f.field("specular_tint_color", o.specular_tint_color, 0.0, kHuge);
+    f.field("subsurface", o.subsurface, 0.0, 1.0);
+    f.field("subsurface_color", o.subsurface_color, 0.0, kHuge);
+    f.field("sheen", o.sheen, 0.0, kHuge);
+    f.field("sheen_tint", o.sheen_tint, 0.0, 1.0);
+    f.field("coat", o.coat, 0.0, kHuge);
+    f.field("coat_roughness", o.coat_roughness, 0.0, 1.0);
+    f.field("coat_ior", o.coat_ior, 1.0, 1000.0);
+    f.field("coat_tint", o.coat_tint, 0.0, kHuge);
+    f.field("diffuse_roughness", o.diffuse_roughness, 0.0, 1.0);
+    f.field("emission", o.emission, 0.0, kHuge);
+}
+
+/// hairis_scene_add_texture: an Image Texture (texture.h) of a file or of pixels, with its
+/// interpolation, extension and Mapping node (mapping=none: none).
+struct TextureOptions {
+    std::string image;
+    int color_space = 0;  ///< auto | linear | srgb (ImageColorSpace)
+    int interpolation = 0;  ///< linear | closest
+    int extension = 0;  ///< repeat | extend | clip | mirror
+    int mapping = 0;  ///< none | point | texture | vector
+    Vec3 location{0, 0, 0};
+    Vec3 rotation{0, 0, 0};
+    Vec3 scale{1, 1, 1};
+};
+template <typename Fields>
+void describe(Fields &f, TextureOptions &o) {
+    f.field("image", o.image);
+    f.choice("color_space", o.color_space, {"auto", "linear", "srgb"});
+    f.choice("interpolation", o.interpolation, {"linear", "closest"});
+    f.choice("extension", o.extension, {"repeat", "extend", "clip", "mirror"});
+    f.choice("mapping", o.mapping, {"none", "point", "texture", "vector"});
+    f.field("location", o.location);
+    f.field("rotation", o.rotation);
+    f.field("scale", o.scale);
+}
+
+/// hairis_scene_set_mesh_attribute: which corner attribute.
+struct MeshAttributeOptions {
+    int name = 0;  ///< normal | uv
+};
+template <typename Fields>
+void describe(Fields &f, MeshAttributeOptions &o) {
+    f.choice("name", o.name, {"normal", "uv"});
 }
 
 /// "type=area": the light object's matrix (row-major, with its scale), shape, sizes, power.
@@ -213,7 +366,10 @@ void describe(Fields &f, RenderOptions &o) {
 /// camera are filled in by the hairis_scene_* calls; its materials are made by hairis_render.
 struct hairis_scene {
     std::vector<hairis::capi::SceneMaterial> materials;
+    std::vector<std::shared_ptr<const hairis::ImageTexture>> textures;
     hairis::SceneDesc desc;
+    /// The mesh the last hairis_scene_add_mesh call added (-1: it added none).
+    long long last_mesh = -1;
     bool has_camera = false;
     size_t curve_count = 0;      // curves added (before the build skips degenerate ones)
     size_t triangle_count = 0;   // triangles added

@@ -19,6 +19,12 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "sampler") return write_options(SamplerOptions{});
     if (kind == "render") return write_options(RenderOptions{});
     if (kind == "diffuse") return "type=diffuse;" + write_options(DiffuseOptions{});
+    if (kind == "principled") return "type=principled;" + write_options(PrincipledOptions{});
+    if (kind == "glossy") return "type=glossy;" + write_options(GlossyOptions{});
+    if (kind == "emission") return "type=emission;" + write_options(EmissionOptions{});
+    if (kind == "mix") return "type=mix;" + write_options(MixOptions{});
+    if (kind == "add") return "type=add;" + write_options(AddOptions{});
+    if (kind == "texture") return write_options(TextureOptions{});
     if (kind == "sun") return "type=sun;" + write_options(SunLight{});
     if (kind == "point") return "type=point;" + write_options(PointLight{});
     if (kind == "spot") return "type=spot;" + write_options(SpotOptions{});
@@ -26,8 +32,9 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "world") return write_options(WorldOptions{});
     if (kind == "camera") return write_options(CameraOptions{});
     if (kind == "curve_inputs") return write_options(CurveInputOptions{});
-    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
-            "spot, area, world, camera, curve_inputs (got \"" + kind + "\")");
+    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, principled, "
+            "glossy, emission, mix, add, texture, sun, point, spot, area, world, camera, "
+            "curve_inputs (got \"" + kind + "\")");
 }
 
 }  // namespace

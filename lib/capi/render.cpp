@@ -72,7 +72,7 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]))
                 desc.materials.push_back(HairMaterial{hair_shading(*hair, m, o.sampler)});
             else
-                desc.materials.push_back(std::get<DiffuseMaterial>(scene->materials[m]));
+                desc.materials.push_back(std::get<SurfaceMaterial>(scene->materials[m]));
         }
         Expected<Scene> built = Scene::build(std::move(desc));
         if (!built) invalid("scene: " + built.error().message);

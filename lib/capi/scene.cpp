@@ -12,6 +12,8 @@
 #include "render/environment_image.h"
 #include "render/environment_map.h"
 #include "render/lights.h"
+#include "render/surface_material.h"
+#include "render/texture.h"
 
 namespace hairis::capi {
 
@@ -31,6 +33,201 @@ int add_material(hairis_scene &scene, SceneMaterial material) {
 }
 
 Vec3 vec3(const float *v) { return {v[0], v[1], v[2]}; }
+
+std::string name_of(CyclesVersion v) { return v == CyclesVersion::V3_4 ? "3.4" : "4.5"; }
+
+// The texture of a colour input's `<name>_texture` option (-1: none).
+std::shared_ptr<const ImageTexture> texture_of(const hairis_scene &scene, int index, const char *name) {
+    if (index < 0) return nullptr;
+    if (size_t(index) >= scene.textures.size())
+        invalid(std::string(name) + " must be the index of a texture added to the scene, in [0, " +
+                std::to_string(scene.textures.size()) + "), or -1 for none (got " +
+                std::to_string(index) + ")");
+    return scene.textures[size_t(index)];
+}
+
+// A surface material already in the scene, for Mix and Add Shaders.
+const SurfaceMaterial &surface_of(const hairis_scene &scene, int index, const char *name) {
+    if (index < 0 || size_t(index) >= scene.materials.size())
+        invalid(std::string(name) + " must be the index of a surface material added to the "
+                "scene, in [0, " + std::to_string(scene.materials.size()) + ") (got " +
+                std::to_string(index) + ")");
+    const auto *surface = std::get_if<SurfaceMaterial>(&scene.materials[size_t(index)]);
+    if (!surface)
+        invalid(std::string(name) + " = " + std::to_string(index) +
+                " is a hair material; Mix and Add Shaders combine surface materials");
+    return *surface;
+}
+
+SurfaceMaterial make_surface(std::vector<SurfaceNode> nodes, const std::string &what) {
+    Expected<SurfaceMaterial> m = SurfaceMaterial::create(std::move(nodes));
+    if (!m) invalid(what + ": " + m.error().message);
+    return std::move(m).value();
+}
+
+bool same(Rgb a, Rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
+
+// Options the chosen Cycles version has no input for must keep their defaults (so that
+// hairis_defaults("principled") reads back).
+void refuse_other_version(const PrincipledOptions &o) {
+    const PrincipledOptions d;
+    const bool v34 = o.cycles == CyclesVersion::V3_4;
+    const std::pair<const char *, bool> changed[] = {
+        {"specular_tint_color", v34 && !same(o.specular_tint_color, d.specular_tint_color)},
+        {"coat_ior", v34 && o.coat_ior != d.coat_ior},
+        {"coat_tint", v34 && !same(o.coat_tint, d.coat_tint)},
+        {"diffuse_roughness", v34 && o.diffuse_roughness != d.diffuse_roughness},
+        {"specular_tint", !v34 && o.specular_tint != d.specular_tint},
+        {"subsurface_color", !v34 && !same(o.subsurface_color, d.subsurface_color)},
+        {"sheen", !v34 && o.sheen != d.sheen},
+        {"sheen_tint", !v34 && o.sheen_tint != d.sheen_tint}};
+    for (const auto &[name, differs] : changed)
+        if (differs)
+            invalid(std::string("surface material (principled): ") + name + " is not an input hairis "
+                    "renders for the Principled BSDF of cycles=" + name_of(o.cycles) +
+                    " (leave it at its default)");
+}
+
+SurfaceMaterial principled_material(const hairis_scene &scene, const PrincipledOptions &o) {
+    const char *what = "surface material (principled)";
+    refuse_other_version(o);
+    PrincipledBsdfNode p;
+    p.cycles = o.cycles;
+    p.multiscatter = o.multiscatter;
+    p.base_color.value = o.base_color;
+    p.base_color.texture = texture_of(scene, o.base_color_texture, "base_color_texture");
+    p.metallic = o.metallic;
+    p.roughness = o.roughness;
+    p.ior = o.ior;
+    p.specular = o.specular;
+    p.specular_tint = o.specular_tint;
+    p.specular_tint_color = o.specular_tint_color;
+    p.subsurface = o.subsurface;
+    p.subsurface_color = o.subsurface_color;
+    p.sheen = o.sheen;
+    p.sheen_tint = o.sheen_tint;
+    p.coat = o.coat;
+    p.coat_roughness = o.coat_roughness;
+    p.coat_ior = o.coat_ior;
+    p.coat_tint = o.coat_tint;
+    p.diffuse_roughness = o.diffuse_roughness;
+    p.emission = o.emission;
+    return make_surface({p}, what);
+}
+
+// Reads the options of one surface material type and makes it.
+SurfaceMaterial surface_material(const hairis_scene &scene, const char *options) {
+    Expected<OptionReader> parsed = OptionReader::parse(options ? options : "", "surface material");
+    if (!parsed) invalid(parsed.error().message);
+    OptionReader &reader = parsed.value();
+    int type = 0;
+    reader.choice("type", type, {"diffuse", "principled", "glossy", "emission", "mix", "add"});
+    switch (type) {
+        case 0: {
+            DiffuseOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            DiffuseBsdfNode d;
+            d.cycles = o.cycles;
+            d.color.value = o.color;
+            d.color.texture = texture_of(scene, o.color_texture, "color_texture");
+            d.roughness = o.roughness;
+            if (o.emission.max_component() > 0.0f)
+                return make_surface({d, EmissionNode{o.emission, 1.0f}, AddShaderNode{0, 1}}, "surface material (diffuse)");
+            return make_surface({d}, "surface material (diffuse)");
+        }
+        case 1: {
+            PrincipledOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            return principled_material(scene, o);
+        }
+        case 2: {
+            GlossyOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            GlossyBsdfNode g;
+            g.cycles = o.cycles;
+            g.multiscatter = o.multiscatter;
+            g.color.value = o.color;
+            g.color.texture = texture_of(scene, o.color_texture, "color_texture");
+            g.roughness = o.roughness;
+            return make_surface({g}, "surface material (glossy)");
+        }
+        case 3: {
+            EmissionOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            return make_surface({EmissionNode{o.color, o.strength}}, "surface material (emission)");
+        }
+        case 4: {
+            MixOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            const SurfaceMaterial &first = surface_of(scene, o.shader1, "shader1");
+            const SurfaceMaterial &second = surface_of(scene, o.shader2, "shader2");
+            Expected<SurfaceMaterial> m = SurfaceMaterial::combine(first, second, o.factor);
+            if (!m) invalid("surface material (mix): " + m.error().message);
+            return std::move(m).value();
+        }
+        default: {
+            AddOptions o;
+            describe(reader, o);
+            ok_or_invalid(reader.finish());
+            const SurfaceMaterial &first = surface_of(scene, o.shader1, "shader1");
+            const SurfaceMaterial &second = surface_of(scene, o.shader2, "shader2");
+            Expected<SurfaceMaterial> m = SurfaceMaterial::combine(first, second, std::nullopt);
+            if (!m) invalid("surface material (add): " + m.error().message);
+            return std::move(m).value();
+        }
+    }
+}
+
+// The texture of options `o` around an image already read or copied.
+int add_texture(hairis_scene &scene, const TextureOptions &o, EnvironmentImage image) {
+    if (scene.textures.size() >= size_t(kMaxTextures))
+        invalid("scene already has " + std::to_string(kMaxTextures) + " textures (the most allowed)");
+    ImageTextureDesc desc;
+    desc.image = std::make_shared<const EnvironmentImage>(std::move(image));
+    desc.interpolation = TextureInterpolation(o.interpolation);
+    desc.extension = TextureExtension(o.extension);
+    desc.use_mapping = o.mapping != 0;
+    if (desc.use_mapping) {
+        desc.mapping.type = MappingType(o.mapping - 1);
+        desc.mapping.location = o.location;
+        desc.mapping.rotation = o.rotation;
+        desc.mapping.scale = o.scale;
+    }
+    Expected<ImageTexture> texture = ImageTexture::create(std::move(desc));
+    if (!texture) invalid("texture: " + texture.error().message);
+    scene.geometry_bytes += texture.value().image().rgb().size() * sizeof(float);
+    scene.textures.push_back(std::make_shared<const ImageTexture>(std::move(texture).value()));
+    return int(scene.textures.size() - 1);
+}
+
+// Reads texture options; mapping inputs other than their defaults need a mapping.
+TextureOptions read_texture_options(const char *options, bool pixels) {
+    Expected<OptionReader> parsed = OptionReader::parse(options ? options : "", "texture");
+    if (!parsed) invalid(parsed.error().message);
+    OptionReader &reader = parsed.value();
+    TextureOptions o;
+    describe(reader, o);
+    ok_or_invalid(reader.finish());
+    if (pixels && reader.has("image"))
+        invalid("texture: image must not be given with pixels (the pixels are the image)");
+    if (!pixels && o.image.empty())
+        invalid("texture: image=<path> must be given (or use hairis_scene_add_texture_pixels)");
+    const TextureOptions d;
+    const auto same3 = [](Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+    const std::pair<const char *, bool> changed[] = {{"location", !same3(o.location, d.location)},
+                                                     {"rotation", !same3(o.rotation, d.rotation)},
+                                                     {"scale", !same3(o.scale, d.scale)}};
+    if (o.mapping == 0)
+        for (const auto &[name, differs] : changed)
+            if (differs)
+                invalid(std::string("texture: ") + name + " needs a mapping (mapping=point, texture or vector)");
+    return o;
+}
 
 // The world of `o` around an environment image (already read): the Mapping and the matrix
 // composed into world_to_texture, the sampling settings, colour (default 1 with an image)
@@ -187,14 +384,77 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
 HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char *options) {
     return guard_value<int>("hairis_scene_add_surface_material", -1, [&] {
         require(scene, "scene");
-        Expected<OptionReader> reader = OptionReader::parse(options ? options : "", "surface material");
-        if (!reader) invalid(reader.error().message);
-        int type = 0;
-        reader.value().choice("type", type, {"diffuse"});
-        DiffuseOptions diffuse;
-        describe(reader.value(), diffuse);
-        ok_or_invalid(reader.value().finish());
-        return add_material(*scene, DiffuseMaterial{diffuse.color, diffuse.emission});
+        return add_material(*scene, surface_material(*scene, options));
+    });
+}
+
+HAIRIS_API int hairis_scene_add_texture(hairis_scene *scene, const char *options) {
+    return guard_value<int>("hairis_scene_add_texture", -1, [&] {
+        require(scene, "scene");
+        const TextureOptions o = read_texture_options(options, false);
+        Expected<EnvironmentImage> image = load_environment_image(o.image, ImageColorSpace(o.color_space));
+        if (!image) refuse(code_of(image.error().kind), "texture: image: " + image.error().message);
+        return add_texture(*scene, o, std::move(image).value());
+    });
+}
+
+HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *options,
+                                               const float *pixels, size_t width, size_t height,
+                                               int channels) {
+    return guard_value<int>("hairis_scene_add_texture_pixels", -1, [&] {
+        require(scene, "scene");
+        const TextureOptions o = read_texture_options(options, true);
+        if (o.color_space == int(ImageColorSpace::Auto))
+            invalid("texture: color_space must be linear or srgb with pixels (an array does not "
+                    "say what it holds)");
+        if (width < 1 || height < 1 || width > size_t(kMaxEnvironmentImageAxis) ||
+            height > size_t(kMaxEnvironmentImageAxis))
+            invalid("width and height must be in [1, " + std::to_string(kMaxEnvironmentImageAxis) +
+                    "] (got " + std::to_string(width) + " x " + std::to_string(height) + ")");
+        if (channels < 1 || channels > 4)
+            invalid("channels must be in [1, 4] (got " + std::to_string(channels) + ")");
+        const long long count = (long long)width * (long long)height * channels;
+        require_array(pixels, size_t(count), "pixels");
+        Expected<EnvironmentImage> image = EnvironmentImage::from_pixels(
+            pixels, count, int(width), int(height), channels, ImageColorSpace(o.color_space));
+        if (!image) invalid("texture: pixels: " + image.error().message);
+        return add_texture(*scene, o, std::move(image).value());
+    });
+}
+
+HAIRIS_API int hairis_scene_set_mesh_attribute(hairis_scene *scene, const char *options,
+                                               const float *values, size_t count) {
+    return guard_status("hairis_scene_set_mesh_attribute", [&] {
+        require(scene, "scene");
+        MeshAttributeOptions o;
+        read_options(options, "mesh attribute", o);
+        if (scene->last_mesh < 0)
+            invalid("mesh attribute: the last hairis_scene_add_mesh call added no triangles, so "
+                    "there is no mesh to attach corner data to");
+        TriangleMesh &mesh = scene->desc.meshes[size_t(scene->last_mesh)];
+        const size_t corners = mesh.indices.size();
+        const size_t per_corner = o.name == 0 ? 3 : 2;
+        if (count != corners * per_corner)
+            invalid(std::string("mesh attribute ") + (o.name == 0 ? "normal" : "uv") + ": count must be " +
+                    std::to_string(per_corner) + " floats per triangle corner of the last mesh (" +
+                    std::to_string(corners) + " corners: " + std::to_string(corners * per_corner) +
+                    "), got " + std::to_string(count));
+        require_array(values, count, "values");
+        for (size_t i = 0; i < count; ++i) require_finite(values[i], indexed("values", i));
+        if (o.name == 0) {
+            std::vector<Vec3> normals(corners);
+            for (size_t k = 0; k < corners; ++k) {
+                normals[k] = vec3(values + 3 * k);
+                if (!(length(normals[k]) > 0.0f))
+                    invalid("mesh attribute normal: corner " + std::to_string(k) + " has a zero normal");
+            }
+            scene->geometry_bytes += (normals.size() - mesh.normals.size()) * sizeof(Vec3);
+            mesh.normals = std::move(normals);
+        } else {
+            scene->geometry_bytes += (count - mesh.uvs.size()) * sizeof(float);
+            mesh.uvs.assign(values, values + count);
+        }
+        return HAIRIS_OK;
     });
 }
 
@@ -283,10 +543,11 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                 invalid(indexed("materials", t) + " must be the index of a material added to "
                         "the scene, in [0, " + std::to_string(scene->materials.size()) +
                         ") (got " + std::to_string(m) + ")");
-            if (!std::holds_alternative<DiffuseMaterial>(scene->materials[size_t(m)]))
+            if (!std::holds_alternative<SurfaceMaterial>(scene->materials[size_t(m)]))
                 invalid(indexed("materials", t) + " = " + std::to_string(m) +
                         " is a hair material; meshes need a surface material");
         }
+        scene->last_mesh = -1;
         if (triangle_count == 0) return HAIRIS_OK;  // nothing to draw
         TriangleMesh mesh;
         mesh.positions.resize(vertex_count);
@@ -296,6 +557,7 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
         const size_t bytes = vertex_count * sizeof(Vec3) +
                              triangle_count * 4 * sizeof(std::uint32_t);
         scene->desc.meshes.push_back(std::move(mesh));
+        scene->last_mesh = (long long)scene->desc.meshes.size() - 1;
         scene->triangle_count += triangle_count;
         scene->geometry_bytes += bytes;
         return HAIRIS_OK;

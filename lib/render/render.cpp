@@ -54,12 +54,14 @@ struct Counters {
 };
 
 // A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
-// Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`.
+// Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`; surfaces build their
+// lobes (surface_material.h) with both normals on ω_o's side, as Cycles flips them for back
+// faces.
 class Bsdf {
   public:
     // `inputs`: the hit's per-strand node inputs (hair), null for the material's own.
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HairInputValues *inputs,
-         ScratchBuffer &scratch) {
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, bool camera_hit,
+         const HairInputValues *inputs, ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
             FiberHit hit;
@@ -67,33 +69,37 @@ class Bsdf {
             hit.h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
             hit.inputs = inputs;
             hair_.emplace(hair->shading.at(hit, scratch));
+            return;
+        }
+        const bool back = dot(sp.normal, wo) < 0.0f;
+        const Vec3 ng = back ? -sp.normal : sp.normal;
+        if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
+            const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
+            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, camera_hit});
         } else {
             const auto &d = std::get<DiffuseMaterial>(material);
-            albedo_ = d.albedo;
-            n_ = dot(sp.normal, wo) >= 0.0f ? sp.normal : -sp.normal;
-            orthonormal_basis(n_, a_, b_);
+            surface_ = SurfaceBsdf(ng, ng, wo);
+            SurfaceLobe lambert;
+            lambert.kind = SurfaceLobeKind::Lambert;
+            lambert.weight = d.albedo;
+            lambert.select = 1.0f;
+            surface_.add(lambert);
         }
     }
 
-    bool black() const { return !hair_ && is_black(albedo_); }
+    bool black() const { return !hair_ && surface_.black(); }
     bool is_hair() const { return hair_.has_value(); }
 
     // f·|cos θ_i| and the density with which sample() draws wi.
     Rgb eval(Vec3 wi, float &pdf) const {
-        if (hair_) {
-            return hair_->f_and_pdf(frame_.to_local(wi), pdf);
-        }
-        const float c = dot(n_, wi);
-        if (!(c > 0.0f)) {
-            pdf = 0.0f;
-            return {};
-        }
-        pdf = c * float(kInvPi);
-        return albedo_ * (c * float(kInvPi));
+        if (hair_) return hair_->f_and_pdf(frame_.to_local(wi), pdf);
+        return surface_.eval(wi, pdf);
     }
 
     // Draws wi; returns false when there is none. weight = f·|cos|/pdf.
-    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf) const {
+    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
+                bool &glossy) const {
+        glossy = false;
         if (hair_) {
             const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
             if (!s || !(s->pdf > 0.0f)) return false;
@@ -102,22 +108,13 @@ class Bsdf {
             weight = s->f / pdf;
             return dot(wi, wi) > 0.0f;
         }
-        float x, y;
-        concentric_disk(u0, u1, x, y);
-        const float z = std::sqrt(std::max(0.0f, 1.0f - x * x - y * y));
-        wi = safe_normalize(a_ * x + b_ * y + n_ * z);
-        const float c = dot(n_, wi);
-        if (!(c > 0.0f)) return false;
-        pdf = c * float(kInvPi);
-        weight = albedo_;  // (albedo/π · cos) / (cos/π)
-        return true;
+        return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy);
     }
 
   private:
     std::optional<HairBsdf> hair_;
     FiberFrame frame_;
-    Rgb albedo_;
-    Vec3 n_, a_, b_;
+    SurfaceBsdf surface_;
 };
 
 // One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
@@ -137,7 +134,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     Rgb beta(1.0f), radiance;
     float bsdf_pdf = 0.0f;
     bool use_mis = false;  // camera rays take emission at full weight
-    int diffuse_bounces = 0, transmission_bounces = 0;
+    int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0;
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     alpha = 1.0f;
 
@@ -171,15 +168,13 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const Vec3 wo = -dir;
 
         // Surface emission (mesh triangles are light-sampled, curves are not).
-        if (const auto *diffuse = std::get_if<DiffuseMaterial>(&material)) {
-            if (!is_black(diffuse->emission)) {
-                float w = 1.0f;
-                if (use_mis && sp.is_light) {
-                    const float abs_cos = std::fabs(dot(sp.normal, dir));
-                    w = power_heuristic(bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
-                }
-                add(beta * diffuse->emission * w);
+        if (const Rgb emission = material_emission(material); !is_black(emission)) {
+            float w = 1.0f;
+            if (use_mis && sp.is_light) {
+                const float abs_cos = std::fabs(dot(sp.normal, dir));
+                w = power_heuristic(bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
             }
+            add(beta * emission * w);
         }
 
         if (depth > settings.max_bounces || last_segment) break;
@@ -197,7 +192,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             HairInputValues values;
             if (scene.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
         }
-        const Bsdf bsdf(material, sp, wo, inputs, scratch);
+        const Bsdf bsdf(material, sp, wo, depth == 0, inputs, scratch);
         if (bsdf.black()) break;
 
         // Next-event estimation.
@@ -226,11 +221,14 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         Vec3 wi;
         Rgb weight;
         float pdf = 0.0f;
+        bool glossy = false;
         if (!bsdf.sample(rng.get(dim(depth, kDimBsdf0)), rng.get(dim(depth, kDimBsdf1)),
-                         rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf))
+                         rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy))
             break;
         if (bsdf.is_hair())
             last_segment = ++transmission_bounces > settings.max_transmission_bounces;
+        else if (glossy)
+            last_segment = ++glossy_bounces > settings.max_glossy_bounces;
         else
             last_segment = ++diffuse_bounces > settings.max_diffuse_bounces;
         beta *= weight;
@@ -254,6 +252,8 @@ Status validate(const RenderSettings &s) {
     return first_error(check::count_in_range("samples", s.samples, 1, 1 << 24),
                        check::count_in_range("max_bounces", s.max_bounces, 0, 1024),
                        check::count_in_range("max_diffuse_bounces", s.max_diffuse_bounces, 0,
+                                             1024),
+                       check::count_in_range("max_glossy_bounces", s.max_glossy_bounces, 0,
                                              1024),
                        check::count_in_range("max_transmission_bounces",
                                              s.max_transmission_bounces, 0, 1024),

@@ -10,7 +10,8 @@
 //    curves) take weight 1; delta lights cannot be hit. Lamps are transparent to rays, as in
 //    Cycles (kernel/integrator/shade_light.h): every lamp crossed before the next surface
 //    contributes.
-//  - Diffuse and transmission limits the same way, per kind of bounce (see RenderSettings).
+//  - Diffuse, glossy and transmission limits the same way, per kind of bounce (see
+//    RenderSettings).
 //    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
 //    glossy bounce; hairis never blurs: compare against Cycles with Filter Glossy 0.
 //  - Max bounces as Cycles' "Max Bounces: Total" (scene/integrator.cpp stores max_bounce + 1
@@ -22,8 +23,9 @@
 //    documents (uniformly among lamps, the environment world being one, Cycles 3.4's choice;
 //    emissive triangles by area),
 //    a shadow ray (hair, like everything, is opaque to it), MIS with the BSDF's density.
-//  - BSDF sampling: diffuse surfaces sample the cosine-weighted hemisphere around the normal
-//    facing ω_o. Hair samples through its material's HairShading: at each hit one HairBsdf
+//  - BSDF sampling: surfaces sample their lobes as one mixture with its exact density
+//    (surface_bsdf.h; a Lambertian surface: the cosine-weighted hemisphere around the normal
+//    facing ω_o). Hair samples through its material's HairShading: at each hit one HairBsdf
 //    (the fiber model and its strategy's sampler prepared once, lib/sampling/hair_bsdf.h) in
 //    the fiber frame of frame.h (FiberFrame::from_tangent_and_view(tangent, ω_o), Cycles'
 //    frame) at h = dot(cross(Ng, X), Z) (Cycles' bsdf_principled_hair_setup for 3D curves);
@@ -64,9 +66,12 @@ struct RenderSettings {
     int samples = 64;
     /// Cycles' Max Bounces (Total), in [0, 1024]; Blender's default is 12.
     int max_bounces = 12;
-    /// Cycles' Max Bounces: Diffuse, in [0, 1024] (Blender's default 4): counts bounces off
-    /// diffuse materials.
+    /// Cycles' Max Bounces: Diffuse, in [0, 1024] (Blender's default 4): counts bounces drawn
+    /// from a surface's diffuse lobes (Lambert, Oren–Nayar, Principled diffuse and sheen).
     int max_diffuse_bounces = 4;
+    /// Cycles' Max Bounces: Glossy, in [0, 1024] (Blender's default 4): counts bounces drawn
+    /// from a surface's microfacet (glossy) lobes.
+    int max_glossy_bounces = 4;
     /// Cycles' Max Bounces: Transmission, in [0, 1024] (Blender's default 12): counts hair
     /// bounces. Cycles counts a hair bounce drawn from the R lobe as a glossy bounce (limit
     /// Max Bounces: Glossy, default 4) and the other lobes as transmission; a DirectionSampler
@@ -93,6 +98,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("samples", s.samples, 1, 1 << 24);
     f.field("max_bounces", s.max_bounces, 0, 1024);
     f.field("max_diffuse_bounces", s.max_diffuse_bounces, 0, 1024);
+    f.field("max_glossy_bounces", s.max_glossy_bounces, 0, 1024);
     f.field("max_transmission_bounces", s.max_transmission_bounces, 0, 1024);
     f.field("seed", s.seed);
     f.field("threads", s.threads, 0, 1024);

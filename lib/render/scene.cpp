@@ -42,6 +42,8 @@ struct MeshGeometry {
     std::vector<std::uint32_t> indices;     // 3 per kept triangle
     std::vector<std::uint32_t> materials;   // 1 per kept triangle
     std::vector<std::uint8_t> emissive;     // 1 per kept triangle: in the light set
+    std::vector<Vec3> normals;              // 3 per kept triangle, or none
+    std::vector<float> uvs;                 // 6 per kept triangle, or none
 };
 
 struct GeometryInfo {
@@ -93,6 +95,7 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
 
 bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
+bool is_hair(const Material &m) { return std::holds_alternative<HairMaterial>(m); }
 
 std::string describe(Vec3 v) {
     return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) +
@@ -155,6 +158,12 @@ Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Ma
 }
 
 }  // namespace
+
+Rgb material_emission(const Material &material) {
+    if (const auto *d = std::get_if<DiffuseMaterial>(&material)) return d->emission;
+    if (const auto *s = std::get_if<SurfaceMaterial>(&material)) return s->emission();
+    return Rgb(0.0f);
+}
 
 struct Scene::Impl {
     RTCDevice device = nullptr;
@@ -229,8 +238,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         if (const auto *hair = std::get_if<HairMaterial>(&desc.materials[m])) {
             if (!hair->shading.model())
                 return Error{"material " + std::to_string(m) + ": hair material has no fiber"};
-        } else {
-            const auto &d = std::get<DiffuseMaterial>(desc.materials[m]);
+        } else if (const auto *d_ptr = std::get_if<DiffuseMaterial>(&desc.materials[m])) {
+            const DiffuseMaterial &d = *d_ptr;
             for (int i = 0; i < 3; ++i) {
                 const std::string name = "material " + std::to_string(m);
                 if (auto e = check::in_range((name + ": albedo").c_str(), d.albedo[i], 0.0, 1.0))
@@ -372,10 +381,25 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                              ": position must be finite (got " + describe(tm.positions[v]) + ")"};
         for (std::uint32_t m : tm.materials) {
             if (auto e = material_error(name, m)) return *e;
-            if (std::holds_alternative<HairMaterial>(desc.materials[m]))
+            if (is_hair(desc.materials[m]))
                 return Error{name + ": material " + std::to_string(m) +
-                             " is a hair material; meshes need a diffuse material"};
+                             " is a hair material; meshes need a surface material"};
         }
+        if (!tm.normals.empty() && tm.normals.size() != tm.indices.size())
+            return Error{name + ": normals has " + std::to_string(tm.normals.size()) +
+                         " entries; it needs one per triangle corner (" +
+                         std::to_string(tm.indices.size()) + ") or none"};
+        if (!tm.uvs.empty() && tm.uvs.size() != 2 * tm.indices.size())
+            return Error{name + ": uvs has " + std::to_string(tm.uvs.size()) +
+                         " floats; it needs a (u, v) pair per triangle corner (" +
+                         std::to_string(2 * tm.indices.size()) + " floats) or none"};
+        for (std::size_t k = 0; k < tm.normals.size(); ++k)
+            if (!finite3(tm.normals[k]) || !(length(tm.normals[k]) > 0.0f))
+                return Error{name + ", corner " + std::to_string(k) +
+                             ": normal must be finite and not zero (got " + describe(tm.normals[k]) + ")"};
+        for (std::size_t k = 0; k < tm.uvs.size(); ++k)
+            if (!std::isfinite(tm.uvs[k]))
+                return Error{name + ", corner " + std::to_string(k / 2) + ": uv must be finite"};
         MeshGeometry geo;
         std::size_t degenerate = 0;
         for (std::size_t t = 0; t < tri_count; ++t) {
@@ -392,10 +416,13 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                 continue;
             }
             const std::uint32_t m = tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t];
-            const Rgb emission = std::get<DiffuseMaterial>(desc.materials[m]).emission;
+            const Rgb emission = material_emission(desc.materials[m]);
             geo.indices.insert(geo.indices.end(), {i0, i1, i2});
             geo.materials.push_back(m);
             geo.emissive.push_back(is_black(emission) ? 0 : 1);
+            if (!tm.normals.empty())
+                for (int k = 0; k < 3; ++k) geo.normals.push_back(safe_normalize(tm.normals[3 * t + k]));
+            if (!tm.uvs.empty()) geo.uvs.insert(geo.uvs.end(), &tm.uvs[6 * t], &tm.uvs[6 * t] + 6);
         }
         if (degenerate) {
             stats.warnings.push_back(name + ": skipped " + std::to_string(degenerate) +
@@ -474,7 +501,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             et.p0 = vertex(geo.indices[3 * t]);
             et.p1 = vertex(geo.indices[3 * t + 1]);
             et.p2 = vertex(geo.indices[3 * t + 2]);
-            et.radiance = std::get<DiffuseMaterial>(desc.materials[geo.materials[t]]).emission;
+            et.radiance = material_emission(desc.materials[geo.materials[t]]);
             et.geometry = id;
             et.primitive = std::uint32_t(t);
             emissive.push_back(et);
@@ -503,7 +530,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     }
     for (const auto &m : impl->meshes)
         bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
-                 m.materials.capacity() * 4 + m.emissive.capacity();
+                 m.materials.capacity() * 4 + m.emissive.capacity() +
+                 m.normals.capacity() * sizeof(Vec3) + m.uvs.capacity() * 4;
     stats.scene_bytes = bytes;
     stats.embree_peak_bytes = std::size_t(std::max(0ll, impl->embree_peak.load()));
     stats.embree_bytes = std::size_t(std::max(0ll, impl->embree_bytes.load()));
@@ -612,6 +640,7 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         sp.material = geo.material;
         const Vec3 n = safe_normalize(sp.position - centre);
         sp.normal = dot(n, n) > 0.0f ? n : -dir;
+        sp.shading_normal = sp.normal;
         sp.tangent = safe_normalize(dpdu);
         if (dot(sp.tangent, sp.tangent) == 0.0f) {
             // dP/du vanishes (repeated points): the chord, or any direction across the normal.
@@ -641,6 +670,18 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         for (const Vec3 &q : {p0, p1, p2, sp.position})
             extent = std::max({extent, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
         sp.offset = 2e-6f * extent + 1e-9f;
+        const float w0 = 1.0f - u - v;
+        sp.shading_normal = sp.normal;
+        if (!geo.normals.empty()) {
+            const Vec3 *c = &geo.normals[3 * std::size_t(t)];
+            const Vec3 n = safe_normalize(c[0] * w0 + c[1] * u + c[2] * v);
+            if (dot(n, n) > 0.0f) sp.shading_normal = n;
+        }
+        if (!geo.uvs.empty()) {
+            const float *c = &geo.uvs[6 * std::size_t(t)];
+            sp.u = c[0] * w0 + c[2] * u + c[4] * v;
+            sp.v = c[1] * w0 + c[3] * u + c[5] * v;
+        }
         sp.material = geo.materials[t];
         sp.is_light = geo.emissive[t] != 0;
         sp.self = hit.prim;

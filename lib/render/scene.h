@@ -23,9 +23,16 @@
 //  - refused: NaN/inf positions or radii, negative radii, a curve with fewer than 2 points,
 //    inconsistent curve offsets, curve inputs of the wrong size, out of their range
 //    (check_hair_input), repeated, not read by the material's parametrization or on a
-//    material whose model does not vary per strand, mesh indices out of range, material indices out of range,
-//    a hair material on a mesh, a hair material without fiber or sampler, invalid lights or
-//    camera, and a scene with no geometry left (no curve and no triangle).
+//    material whose model does not vary per strand, mesh indices out of range, material
+//    indices out of range, a hair material on a mesh, a hair material without fiber or
+//    sampler, corner normals or UVs that are not one per triangle corner or not finite,
+//    invalid lights or camera, and a scene with no geometry left (no curve and no triangle).
+//
+// Mesh shading data, as Cycles' triangle shader setup: Ng the face normal, N the corner normals
+// interpolated with the hit's barycentrics and normalized (Blender's corner normals: the
+// vertex normal on smooth faces, the face normal on flat ones, split or custom normals where
+// the mesh has them; the face normal when a mesh gives none), and the UV map interpolated the
+// same way ((0, 0) without one, as Cycles' missing attribute).
 //  - skipped with a counted warning: curves of zero length (all points equal) or zero radius
 //    everywhere — they would never be hit — and degenerate (zero-area) triangles.
 #pragma once
@@ -44,6 +51,7 @@
 #include "render/lights.h"
 #include "core/math.h"
 #include "fiber/hair_inputs.h"
+#include "render/surface_material.h"
 #include "sampling/hair_bsdf.h"
 
 namespace hairis {
@@ -60,7 +68,11 @@ struct DiffuseMaterial {
     Rgb emission{0.0f};
 };
 
-using Material = std::variant<HairMaterial, DiffuseMaterial>;
+/// A material of Blender shader nodes (surface_material.h).
+using Material = std::variant<HairMaterial, DiffuseMaterial, SurfaceMaterial>;
+
+/// The radiance a mesh material emits (0 for hair).
+Rgb material_emission(const Material &material);
 
 /// A node input of a hair material given per curve or per point of a curve set: `values`
 /// holds the input's components (3 for colours) for each curve or each point in turn. At a
@@ -86,11 +98,15 @@ struct HairCurves {
 };
 
 /// A triangle mesh in world space. indices holds 3 vertex indices per triangle; materials
-/// holds one material index per triangle, or a single index for the whole mesh.
+/// holds one material index per triangle, or a single index for the whole mesh. normals
+/// (unit, world space) and uvs are per triangle corner, in the order of indices: 3 normals
+/// and 3 UV pairs per triangle, or empty (the face normal; UV (0, 0)).
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<std::uint32_t> indices;
     std::vector<std::uint32_t> materials{0};
+    std::vector<Vec3> normals;
+    std::vector<float> uvs;
 };
 
 /// What a ray that meets a round curve from inside its tube does. Such rays start inside
@@ -159,6 +175,11 @@ struct SurfacePoint {
     Vec3 tangent;
     /// The curve parameter of the hit in its segment, in [0, 1] (0 for triangles).
     float curve_u = 0;
+    /// Triangles: the unit shading normal, on the same side as `normal` (equal to it for flat
+    /// faces); curves: equal to `normal`.
+    Vec3 shading_normal;
+    /// Triangles: the UV map at the hit ((0, 0) without one).
+    float u = 0.0f, v = 0.0f;
     std::uint32_t material = 0;
     bool is_curve = false;
     /// True for a mesh triangle whose emission is in the light set (MIS applies to it).

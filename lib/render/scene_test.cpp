@@ -239,6 +239,75 @@ TEST(Scene, TrianglesAndSkips) {
     EXPECT_FALSE(scene.occluded({0.2f, 0.3f, 1}, {0, 0, 1}, 0.0f, 5.0f, up->prim));
 }
 
+TEST(Scene, CornerNormalsAndUvsAreInterpolatedAtTheHit) {
+    // One triangle in z = 0 with (0, 0), (2, 0), (0, 2); corner normals tilted three ways.
+    TriangleMesh m;
+    m.positions = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    m.indices = {0, 1, 2};
+    m.normals = {safe_normalize(Vec3{0.3f, 0, 1}), safe_normalize(Vec3{0, 0.4f, 1}), Vec3{0, 0, 2}};
+    m.uvs = {0.1f, 0.2f, 0.9f, 0.2f, 0.1f, 0.7f};
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}};
+    d.meshes = {m};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    // At (0.5, 0.3): barycentrics (1 − 0.25 − 0.15, 0.25, 0.15) of the three corners.
+    const auto hit = scene.intersect({0.5f, 0.3f, 1}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    const SurfacePoint sp = scene.surface_point({0.5f, 0.3f, 1}, {0, 0, -1}, *hit);
+    const float w0 = 0.6f, w1 = 0.25f, w2 = 0.15f;
+    const Vec3 n = safe_normalize(safe_normalize(Vec3{0.3f, 0, 1}) * w0 + safe_normalize(Vec3{0, 0.4f, 1}) * w1 +
+                                  Vec3{0, 0, 1} * w2);
+    EXPECT_NEAR(sp.shading_normal.x, n.x, 1e-5f);
+    EXPECT_NEAR(sp.shading_normal.y, n.y, 1e-5f);
+    EXPECT_NEAR(sp.shading_normal.z, n.z, 1e-5f);
+    EXPECT_NEAR(sp.u, 0.1f * w0 + 0.9f * w1 + 0.1f * w2, 1e-5f);
+    EXPECT_NEAR(sp.v, 0.2f * w0 + 0.2f * w1 + 0.7f * w2, 1e-5f);
+    // The face normal stays the geometric normal.
+    EXPECT_NEAR(std::fabs(sp.normal.z), 1.0f, 1e-6f);
+
+    // Without corner data: the face normal and UV (0, 0).
+    SceneDesc flat;
+    flat.materials = {DiffuseMaterial{}};
+    flat.meshes = {quad(0.0f, 0)};
+    flat.camera = small_camera();
+    const Scene plain = build_ok(std::move(flat));
+    const auto h2 = plain.intersect({0.2f, 0.3f, 1}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(h2.has_value());
+    const SurfacePoint p2 = plain.surface_point({0.2f, 0.3f, 1}, {0, 0, -1}, *h2);
+    EXPECT_EQ(p2.shading_normal.z, p2.normal.z);
+    EXPECT_EQ(p2.u, 0.0f);
+    EXPECT_EQ(p2.v, 0.0f);
+}
+
+TEST(Scene, CornerDataIsCheckedPerCorner) {
+    auto mesh = [] {
+        TriangleMesh m;
+        m.positions = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+        m.indices = {0, 1, 2};
+        return m;
+    };
+    auto error = [&](TriangleMesh m) {
+        SceneDesc d;
+        d.materials = {DiffuseMaterial{}};
+        d.meshes = {std::move(m)};
+        d.camera = small_camera();
+        return build_error(std::move(d));
+    };
+    TriangleMesh m = mesh();
+    m.normals = {Vec3{0, 0, 1}, Vec3{0, 0, 1}};
+    EXPECT_NE(error(m).find("normals has 2 entries; it needs one per triangle corner (3)"), std::string::npos) << error(m);
+    m = mesh();
+    m.uvs = {0, 0, 1, 0};
+    EXPECT_NE(error(m).find("uvs has 4 floats"), std::string::npos) << error(m);
+    m = mesh();
+    m.normals = {Vec3{0, 0, 1}, Vec3{0, 0, 0}, Vec3{0, 0, 1}};
+    EXPECT_NE(error(m).find("corner 1: normal must be finite and not zero"), std::string::npos) << error(m);
+    m = mesh();
+    m.uvs = {0, 0, 1, NAN, 0, 1};
+    EXPECT_NE(error(m).find("corner 1: uv must be finite"), std::string::npos) << error(m);
+}
+
 TEST(Scene, RaysEmbreeCannotTraceAreMissesAndBlockedShadows) {
     // Embree asserts (and aborts) on origins or directions beyond ±1.8e18 and NaN t; such
     // rays come from finite but huge inputs (fuzz_capi_params found a camera at ~1e30).
@@ -329,7 +398,7 @@ TEST(Scene, InvalidScenesGiveClearErrors) {
     d = base();
     d.meshes = {quad(0.0f, 0)};
     e = build_error(std::move(d));
-    EXPECT_NE(e.find("meshes need a diffuse material"), std::string::npos) << e;
+    EXPECT_NE(e.find("meshes need a surface material"), std::string::npos) << e;
 
     d = base();
     d.meshes = {quad(0.0f, 1)};

@@ -72,7 +72,22 @@ static const char *const kinds[][2] = {
     {"bake", "theta_r=31;theta_i=64;phi=64;n_h=1,2,4,8,16;source=exact;quadrature_points=2;"
              "threads=0"},
     {"sampler", "strategy=table;multiple_weight=0;n_h=2"},
-    {"diffuse", "type=diffuse;color=0.800000012,0.800000012,0.800000012;emission=0,0,0"},
+    {"diffuse", "type=diffuse;color=0.800000012,0.800000012,0.800000012;emission=0,0,0;"
+                "roughness=0;color_texture=-1;cycles=3.4"},
+    {"principled", "type=principled;cycles=3.4;distribution=ggx;"
+                   "base_color=0.800000012,0.800000012,0.800000012;base_color_texture=-1;"
+                   "metallic=0;roughness=0.5;ior=1.45000005;specular=0.5;specular_tint=0;"
+                   "specular_tint_color=1,1,1;subsurface=0;"
+                   "subsurface_color=0.800000012,0.800000012,0.800000012;sheen=0;sheen_tint=0.5;"
+                   "coat=0;coat_roughness=0.0299999993;coat_ior=1.5;coat_tint=1,1,1;"
+                   "diffuse_roughness=0;emission=0,0,0"},
+    {"glossy", "type=glossy;color=0.800000012,0.800000012,0.800000012;color_texture=-1;"
+               "roughness=0.5;distribution=ggx;cycles=3.4"},
+    {"emission", "type=emission;color=1,1,1;strength=1"},
+    {"mix", "type=mix;factor=0.5;shader1=-1;shader2=-1"},
+    {"add", "type=add;shader1=-1;shader2=-1"},
+    {"texture", "image=;color_space=auto;interpolation=linear;extension=repeat;mapping=none;"
+                "location=0,0,0;rotation=0,0,0;scale=1,1,1"},
     {"sun", "type=sun;direction=0,0,1;color=1,1,1;strength=1;angle=0;cycles=3.4"},
     {"point", "type=point;position=0,0,0;color=1,1,1;power=10;radius=0;cycles=3.4;soft_falloff=1"},
     {"spot", "type=spot;matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;color=1,1,1;power=10;radius=0;"
@@ -85,7 +100,8 @@ static const char *const kinds[][2] = {
     {"camera", "matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;orthographic=0;"
                "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
                "clip_start=0;clip_end=3.40282347e+38"},
-    {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_transmission_bounces=12;"
+    {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
+               "max_transmission_bounces=12;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -329,8 +345,9 @@ const char *hairis_defaults(const char *kind)
     const char *d = defaults_of(kind);
     if (!d) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-             "kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
-             "spot, area, world, camera, curve_inputs (got \"%s\")",
+             "kind must be one of chiang, marschner, bake, sampler, render, diffuse, principled, "
+             "glossy, emission, mix, add, texture, sun, point, spot, area, world, camera, curve_inputs "
+             "(got \"%s\")",
              kind);
         return NULL;
     }
@@ -763,6 +780,9 @@ struct hairis_scene {
     char inputs[512];                 /* the last call's inputs given per curve or point */
     double radius_sum, position_sum[3];
     size_t mesh_count, vertex_count, triangle_count;
+    size_t last_mesh_triangles; /* of the last hairis_scene_add_mesh call (0: it added none) */
+    int texture_count, uv_meshes, normal_meshes;
+    int material_nodes[MAX_MATERIALS]; /* shader nodes of a surface material */
     int suns, points, areas;
     float world[3];
     int has_camera;
@@ -808,26 +828,197 @@ int hairis_scene_add_hair_material(hairis_scene *s, const hairis_fiber *fiber,
     return index;
 }
 
+/* A colour input's texture index: -1 or a texture of the scene. */
+static int texture_index(const hairis_scene *s, const options *o, const char *name)
+{
+    long long t;
+    if (integer_in(o, name, -1, (1 << 20) - 1, &t) != HAIRIS_OK) return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (t >= s->texture_count)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "%s must be the index of a texture added to the scene, in [0, %d), or -1 for none "
+                    "(got %lld)",
+                    name, s->texture_count, t);
+    return HAIRIS_OK;
+}
+
+/* A surface material that Mix and Add Shaders combine. */
+static int shader_index(const hairis_scene *s, const options *o, const char *name, long long *out)
+{
+    if (integer_in(o, name, -1, 1 << 20, out) != HAIRIS_OK) return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (*out < 0 || *out >= s->material_count)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "%s must be the index of a surface material added to the scene, in [0, %d) (got %lld)",
+                    name, s->material_count, *out);
+    if (s->material_is_hair[*out])
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "%s = %lld is a hair material; Mix and Add Shaders combine surface materials", name,
+                    *out);
+    return HAIRIS_OK;
+}
+
 int hairis_scene_add_surface_material(hairis_scene *s, const char *text)
 {
     options o;
     double v[3];
-    int type = 0;
-    const char *types[1] = {"diffuse"};
+    const char *types[6] = {"diffuse", "principled", "glossy", "emission", "mix", "add"};
+    const char *versions[2] = {"3.4", "4.5"};
+    const char *distributions[2] = {"ggx", "multi_ggx"};
+    int kind = -1, choice = 0;
     if (!s) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
         return -1;
     }
-    if (read_options(text, "diffuse", "surface material", NULL, &o) != HAIRIS_OK ||
-        word(&o, "type", types, 1, &type) != HAIRIS_OK || numbers(&o, "color", v, 3) != HAIRIS_OK ||
-        numbers(&o, "emission", v, 3) != HAIRIS_OK)
+    char type[32];
+    find_value(text, "type", type, sizeof type);
+    if (!type[0]) snprintf(type, sizeof type, "diffuse");
+    for (int k = 0; k < 6; ++k)
+        if (strcmp(type, types[k]) == 0) kind = k;
+    if (kind < 0) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+             "surface material: type must be one of diffuse, principled, glossy, emission, mix, add "
+             "(got \"%s\")",
+             type);
         return -1;
+    }
+    if (read_options(text, types[kind], "surface material", NULL, &o) != HAIRIS_OK) return -1;
+    int nodes = 1;
+    if (kind == 0) {
+        if (number_in(&o, "roughness", 0, 1, v) != HAIRIS_OK || numbers(&o, "color", v, 3) != HAIRIS_OK ||
+            numbers(&o, "emission", v, 3) != HAIRIS_OK || texture_index(s, &o, "color_texture") != HAIRIS_OK ||
+            word(&o, "cycles", versions, 2, &choice) != HAIRIS_OK)
+            return -1;
+        if (v[0] > 0 || v[1] > 0 || v[2] > 0) nodes = 3;
+    } else if (kind == 1) {
+        if (word(&o, "cycles", versions, 2, &choice) != HAIRIS_OK ||
+            word(&o, "distribution", distributions, 2, &choice) != HAIRIS_OK ||
+            numbers(&o, "base_color", v, 3) != HAIRIS_OK ||
+            texture_index(s, &o, "base_color_texture") != HAIRIS_OK ||
+            number_in(&o, "metallic", 0, 1, v) != HAIRIS_OK ||
+            number_in(&o, "roughness", 0, 1, v) != HAIRIS_OK ||
+            number_in(&o, "ior", 0, 1000, v) != HAIRIS_OK || numbers(&o, "emission", v, 3) != HAIRIS_OK)
+            return -1;
+    } else if (kind == 2) {
+        if (word(&o, "cycles", versions, 2, &choice) != HAIRIS_OK ||
+            word(&o, "distribution", distributions, 2, &choice) != HAIRIS_OK ||
+            numbers(&o, "color", v, 3) != HAIRIS_OK || texture_index(s, &o, "color_texture") != HAIRIS_OK ||
+            number_in(&o, "roughness", 0, 1, v) != HAIRIS_OK)
+            return -1;
+    } else if (kind == 3) {
+        if (numbers(&o, "color", v, 3) != HAIRIS_OK || number_in(&o, "strength", 0, 3.4e38, v) != HAIRIS_OK)
+            return -1;
+    } else {
+        long long a, b;
+        if ((kind == 4 && number_in(&o, "factor", 0, 1, v) != HAIRIS_OK) ||
+            shader_index(s, &o, "shader1", &a) != HAIRIS_OK || shader_index(s, &o, "shader2", &b) != HAIRIS_OK)
+            return -1;
+        nodes = s->material_nodes[a] + s->material_nodes[b] + 1;
+    }
     if (s->material_count >= MAX_MATERIALS) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "too many materials");
         return -1;
     }
+    s->material_nodes[s->material_count] = nodes;
     clear_error();
     return s->material_count++;
+}
+
+/* Texture options; `pixels` says whether the image comes as an array. */
+static int read_texture(const char *text, int pixels, options *o)
+{
+    const char *spaces[3] = {"auto", "linear", "srgb"};
+    const char *interpolations[2] = {"linear", "closest"};
+    const char *extensions[4] = {"repeat", "extend", "clip", "mirror"};
+    const char *mappings[4] = {"none", "point", "texture", "vector"};
+    int space = 0, choice = 0;
+    double v[3];
+    if (read_options(text, "texture", "texture", NULL, o) != HAIRIS_OK ||
+        word(o, "color_space", spaces, 3, &space) != HAIRIS_OK ||
+        word(o, "interpolation", interpolations, 2, &choice) != HAIRIS_OK ||
+        word(o, "extension", extensions, 4, &choice) != HAIRIS_OK ||
+        word(o, "mapping", mappings, 4, &choice) != HAIRIS_OK || numbers(o, "location", v, 3) != HAIRIS_OK ||
+        numbers(o, "rotation", v, 3) != HAIRIS_OK || numbers(o, "scale", v, 3) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    if (pixels && given(o, "image"))
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "texture: image must not be given with pixels");
+    if (!pixels && !value_of(o, "image")[0])
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "texture: image=<path> must be given");
+    if (pixels && space == 0)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "texture: color_space must be linear or srgb with pixels");
+    return HAIRIS_OK;
+}
+
+int hairis_scene_add_texture(hairis_scene *s, const char *text)
+{
+    options o;
+    if (!s) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+        return -1;
+    }
+    if (read_texture(text, 0, &o) != HAIRIS_OK) return -1;
+    FILE *f = fopen(value_of(&o, "image"), "rb");
+    if (!f) {
+        fail(HAIRIS_ERROR_IO, "texture: image: cannot open %s", value_of(&o, "image"));
+        return -1;
+    }
+    fclose(f);
+    clear_error();
+    return s->texture_count++;
+}
+
+int hairis_scene_add_texture_pixels(hairis_scene *s, const char *text, const float *pixels,
+                                    size_t width, size_t height, int channels)
+{
+    options o;
+    if (!s) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+        return -1;
+    }
+    if (!pixels || width == 0 || height == 0) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "texture: pixels must not be NULL or empty");
+        return -1;
+    }
+    if (channels < 1 || channels > 4) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "channels must be in [1, 4] (got %d)", channels);
+        return -1;
+    }
+    if (read_texture(text, 1, &o) != HAIRIS_OK) return -1;
+    for (size_t i = 0; i < width * height * (size_t)channels; ++i)
+        if (!isfinite(pixels[i]) || pixels[i] < 0.0f) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT, "texture: pixels: value %zu must be finite and >= 0", i);
+            return -1;
+        }
+    clear_error();
+    return s->texture_count++;
+}
+
+int hairis_scene_set_mesh_attribute(hairis_scene *s, const char *text, const float *values,
+                                    size_t count)
+{
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    static const char *const names[2] = {"normal", "uv"};
+    char name[32];
+    find_value(text, "name", name, sizeof name);
+    int which = -1;
+    for (int k = 0; k < 2; ++k)
+        if (strcmp(name, names[k]) == 0) which = k;
+    if (which < 0)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "mesh attribute: name must be one of normal, uv (got \"%s\")",
+                    name);
+    if (s->last_mesh_triangles == 0)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                    "mesh attribute: the last hairis_scene_add_mesh call added no triangles");
+    const size_t want = s->last_mesh_triangles * 3 * (which == 0 ? 3 : 2);
+    if (count != want)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "mesh attribute %s: count must be %zu, got %zu",
+                    names[which], want, count);
+    if (!values) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "values must not be NULL");
+    for (size_t i = 0; i < count; ++i)
+        if (!isfinite(values[i]))
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "values[%zu] must be finite", i);
+    if (which == 0) s->normal_meshes++;
+    else s->uv_meshes++;
+    clear_error();
+    return HAIRIS_OK;
 }
 
 int hairis_scene_add_curves(hairis_scene *s, int material, size_t curve_count,
@@ -934,6 +1125,11 @@ int hairis_scene_add_mesh(hairis_scene *s, size_t vertex_count, const float *pos
         if (s->material_is_hair[materials[t]])
             return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "materials[%zu] = %d is a hair material", t,
                         materials[t]);
+    }
+    s->last_mesh_triangles = triangle_count;
+    if (triangle_count == 0) {
+        clear_error();
+        return HAIRIS_OK;
     }
     s->mesh_count++;
     s->vertex_count += vertex_count;
@@ -1060,8 +1256,8 @@ int hairis_scene_set_camera(hairis_scene *s, const char *text)
 /* ---- Rendering ---------------------------------------------------------------------------- */
 
 typedef struct render_settings {
-    long long samples, max_bounces, max_diffuse_bounces, max_transmission_bounces, threads,
-        tile_size, rr_start_bounce, n_h;
+    long long samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
+        max_transmission_bounces, threads, tile_size, rr_start_bounce, n_h;
     unsigned long long seed;
     int strategy, film_transparent, curve_backfaces;
     double multiple_weight;
@@ -1076,6 +1272,7 @@ static int read_render_settings(const char *text, render_settings *r)
         integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
         integer_in(&o, "max_bounces", 0, 1024, &r->max_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_diffuse_bounces", 0, 1024, &r->max_diffuse_bounces) != HAIRIS_OK ||
+        integer_in(&o, "max_glossy_bounces", 0, 1024, &r->max_glossy_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_transmission_bounces", 0, 1024, &r->max_transmission_bounces) != HAIRIS_OK ||
         integer_in(&o, "threads", 0, 1024, &r->threads) != HAIRIS_OK ||
         integer_in(&o, "tile_size", 1, 4096, &r->tile_size) != HAIRIS_OK ||
@@ -1122,6 +1319,8 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     fprintf(f, "camera=%dx%d orthographic=%d\n", s->width, s->height, s->orthographic);
     fprintf(f, "curve_input_sets=%zu curve_input_values=%zu curve_inputs=%s\n", s->input_sets,
             s->input_values, s->inputs);
+    fprintf(f, "textures=%d uv_meshes=%d normal_meshes=%d\n", s->texture_count, s->uv_meshes,
+            s->normal_meshes);
     for (int i = 0; i < s->material_count; ++i)
         if (s->material_is_hair[i])
             fprintf(f, "hair %d tables=%d %s\n", i, s->material_has_tables[i],

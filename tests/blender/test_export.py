@@ -257,8 +257,231 @@ def test_mesh():
     names = {data.materials[i].name for i in np.unique(mesh.materials)}
     assert names == {"Skin"}, names
     skin = data.materials[mesh.materials[0]]
-    assert skin.kind == "DIFFUSE"
-    np.testing.assert_allclose(skin.albedo, (0.6, 0.4, 0.3), atol=1e-7)
+    assert skin.kind == "SURFACE" and len(skin.nodes) == 1, skin
+    principled = skin.nodes[0]
+    assert principled["type"] == "principled" and principled["cycles"] == CYCLES, principled
+    np.testing.assert_allclose(principled["base_color"], (0.6, 0.4, 0.3), atol=1e-7)
+    assert principled["base_color_texture"] == -1
+
+
+CYCLES = "3.4" if helpers.VERSION < (4, 0, 0) else "4.5"
+"""The Cycles whose surface nodes this Blender has (written here, not read from compat)."""
+
+
+def _sphere(name, smooth, location=(0.0, 0.0, 0.0), scale=(1.0, 1.0, 1.0)):
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=16,
+                                         ring_count=8)
+    obj = bpy.context.view_layer.objects.active
+    obj.name = name
+    obj.scale = scale
+    if smooth:
+        bpy.ops.object.shade_smooth()
+    else:
+        bpy.ops.object.shade_flat()
+    bpy.context.view_layer.update()
+    return obj
+
+
+def test_mesh_normals_and_uvs():
+    """Corner normals: radial on a smooth sphere (its vertex normals, through a non-uniform
+    scale), the face normal on a flat one; the UV map per corner as the loops hold it."""
+    helpers.reset()
+    helpers.make_camera(bpy.context.scene)
+    _sphere("Smooth", True, location=(0.0, 0.0, 0.0), scale=(1.0, 1.0, 2.0))
+    flat = _sphere("Flat", False, location=(3.0, 0.0, 0.0))
+    data = export.export_context()
+    by_name = {m.name: m for m in data.meshes}
+    mesh = by_name["Smooth"]
+    assert mesh.normals.shape == (mesh.indices.shape[0], 3, 3)
+    # The ellipsoid x² + y² + (z/2)² = 1: its normal at p is normalize(x, y, z/4).
+    corners = mesh.positions[mesh.indices.reshape(-1)]
+    analytic = corners * np.array([1.0, 1.0, 0.25])
+    analytic /= np.linalg.norm(analytic, axis=1, keepdims=True)
+    cosines = np.sum(mesh.normals.reshape(-1, 3) * analytic, axis=1)
+    assert cosines.min() > 0.97, cosines.min()  # vertex normals of a 16 x 8 tessellation
+    mesh = by_name["Flat"]
+    p = mesh.positions[mesh.indices.reshape(-1)].reshape(-1, 3, 3)
+    face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    keep = np.linalg.norm(face, axis=1) > 1e-9
+    face = face[keep] / np.linalg.norm(face[keep], axis=1, keepdims=True)
+    for k in range(3):
+        np.testing.assert_allclose(mesh.normals[keep, k], face, atol=1e-5)
+    # UVs: corner k of triangle t is loop loop_triangles[t].loops[k] of the active UV map.
+    evaluated = flat.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    source = evaluated.to_mesh()
+    source.calc_loop_triangles()
+    layer = source.uv_layers.active
+    for t in (0, 7, len(source.loop_triangles) - 1):
+        for k, loop in enumerate(source.loop_triangles[t].loops):
+            np.testing.assert_allclose(mesh.uvs[t, k], tuple(layer.data[loop].uv), atol=1e-7)
+    evaluated.to_mesh_clear()
+    # Without a UV map: no UVs.
+    flat.data.uv_layers.remove(flat.data.uv_layers[0])
+    flat.data.update()  # 4.x does not tag the mesh for the depsgraph by itself
+    bpy.context.view_layer.update()
+    assert {m.name: m for m in export.export_context().meshes}["Flat"].uvs is None
+
+
+def _surface_material(name):
+    material = bpy.data.materials.new(name)
+    helpers.use_nodes(material)
+    return material, material.node_tree.nodes, material.node_tree.links
+
+
+def _principled(nodes):
+    return next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+
+
+def test_surface_nodes():
+    """Principled BSDF inputs per version, an Image Texture through a Mapping node (file by
+    path, generated image by pixels), Mix and Add Shaders, Emission, warnings."""
+    scene = helpers.reset()
+    helpers.make_camera(scene)
+    obj = _sphere("Head", True)
+
+    # A Principled BSDF with a PNG on Base Color through a Mapping node and a UV Map node.
+    path = os.path.join(ARGS.workdir, "skin.png")
+    image = bpy.data.images.new("SkinImage", 4, 2, alpha=False)
+    image.pixels.foreach_set(np.linspace(0.0, 1.0, 4 * 2 * 4, dtype=np.float32))
+    image.filepath_raw = path
+    image.file_format = "PNG"
+    image.save()
+    skin, nodes, links = _surface_material("Skin")
+    principled = _principled(nodes)
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.load(path)
+    texture.interpolation = "Closest"
+    texture.extension = "EXTEND"
+    mapping = nodes.new("ShaderNodeMapping")
+    helpers.socket(mapping, "Location").default_value = (0.1, 0.2, 0.0)
+    helpers.socket(mapping, "Rotation").default_value = (0.0, 0.0, 0.3)
+    helpers.socket(mapping, "Scale").default_value = (2.0, 1.0, 1.0)
+    uv_map = nodes.new("ShaderNodeUVMap")
+    links.new(uv_map.outputs["UV"], helpers.socket(mapping, "Vector"))
+    links.new(mapping.outputs["Vector"], helpers.socket(texture, "Vector"))
+    links.new(texture.outputs["Color"], helpers.socket(principled, "Base Color"))
+    values = {"Metallic": 0.25, "Roughness": 0.35, "IOR": 1.4}
+    if CYCLES == "3.4":
+        values.update({"Specular": 0.6, "Specular Tint": 0.2, "Clearcoat": 0.3,
+                       "Clearcoat Roughness": 0.1, "Sheen": 0.4, "Sheen Tint": 0.7})
+    else:
+        values.update({"Specular IOR Level": 0.6, "Coat Weight": 0.3, "Coat Roughness": 0.1,
+                       "Coat IOR": 1.6})
+        helpers.socket(principled, "Specular Tint").default_value = (0.9, 0.8, 0.7, 1.0)
+        helpers.socket(principled, "Coat Tint").default_value = (0.5, 0.6, 0.7, 1.0)
+    for name, value in values.items():
+        helpers.socket(principled, name).default_value = value
+    emission_name = "Emission" if CYCLES == "3.4" else "Emission Color"
+    helpers.socket(principled, emission_name).default_value = (0.5, 0.25, 0.0, 1.0)
+    helpers.socket(principled, "Emission Strength").default_value = 2.0
+    obj.data.materials.append(skin)
+    data = export.export_context()
+    material = data.materials[data.meshes[0].materials[0]]
+    assert material.kind == "SURFACE" and len(material.nodes) == 1, material
+    node = material.nodes[0]
+    names = {"Metallic": "metallic", "Roughness": "roughness", "IOR": "ior",
+             "Specular": "specular", "Specular IOR Level": "specular",
+             "Specular Tint": "specular_tint",
+             "Clearcoat": "coat", "Clearcoat Roughness": "coat_roughness", "Sheen": "sheen",
+             "Sheen Tint": "sheen_tint", "Coat Weight": "coat", "Coat Roughness": "coat_roughness",
+             "Coat IOR": "coat_ior"}
+    for name, value in values.items():
+        assert math.isclose(node[names[name]], value, rel_tol=1e-6), (name, node)
+    if CYCLES != "3.4":
+        np.testing.assert_allclose(node["specular_tint_color"], (0.9, 0.8, 0.7), atol=1e-6)
+        np.testing.assert_allclose(node["coat_tint"], (0.5, 0.6, 0.7), atol=1e-6)
+        assert node["distribution"] == "multi_ggx"  # 4.x's default
+    else:
+        assert node["distribution"] == "ggx"
+    np.testing.assert_allclose(node["emission"], (1.0, 0.5, 0.0), atol=1e-6)
+    texture_data = data.textures[node["base_color_texture"]]
+    assert texture_data.path == os.path.abspath(path) and texture_data.pixels is None
+    assert texture_data.color_space == "srgb"  # an 8-bit PNG
+    assert texture_data.interpolation == "closest" and texture_data.extension == "extend"
+    assert texture_data.mapping == "point"
+    np.testing.assert_allclose(texture_data.location, (0.1, 0.2, 0.0), atol=1e-6)
+    np.testing.assert_allclose(texture_data.rotation, (0.0, 0.0, 0.3), atol=1e-6)
+    np.testing.assert_allclose(texture_data.scale, (2.0, 1.0, 1.0), atol=1e-6)
+    skin_warnings = [w for w in data.warnings if "Skin" in w]
+    if CYCLES == "3.4":
+        assert not skin_warnings, skin_warnings
+    else:  # a coat over an emission: Cycles 4 dims the emission, hairis does not
+        assert len(skin_warnings) == 1 and "emission under the coat" in skin_warnings[0], \
+            skin_warnings
+
+    # Mix (0.3) of a Diffuse with a generated texture and a Multiscatter Glossy, plus an
+    # Emission through an Add Shader; one Mix input left empty.
+    generated = bpy.data.images.new("Generated", 2, 2, float_buffer=True)
+    generated.colorspace_settings.name = "Non-Color"
+    pixels = np.array([0.1, 0.2, 0.3, 1.0, 0.4, 0.5, 0.6, 1.0, 0.7, 0.8, 0.9, 1.0,
+                       0.2, 0.4, 0.6, 1.0], np.float32)
+    generated.pixels.foreach_set(pixels)
+    mixed, nodes, links = _surface_material("Mixed")
+    output = nodes["Material Output"]
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    helpers.socket(diffuse, "Roughness").default_value = 0.4
+    picture = nodes.new("ShaderNodeTexImage")
+    picture.image = generated
+    links.new(picture.outputs["Color"], helpers.socket(diffuse, "Color"))
+    glossy = nodes.new("ShaderNodeBsdfGlossy")
+    glossy.distribution = "MULTI_GGX"
+    helpers.socket(glossy, "Roughness").default_value = 0.2
+    mix = nodes.new("ShaderNodeMixShader")
+    helpers.socket(mix, "Fac").default_value = 0.3
+    links.new(diffuse.outputs["BSDF"], mix.inputs[1])
+    links.new(glossy.outputs["BSDF"], mix.inputs[2])
+    glow = nodes.new("ShaderNodeEmission")
+    helpers.socket(glow, "Strength").default_value = 3.0
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(mix.outputs["Shader"], add.inputs[0])
+    links.new(glow.outputs["Emission"], add.inputs[1])
+    links.new(add.outputs["Shader"], output.inputs["Surface"])
+    half = nodes.new("ShaderNodeMixShader")  # feeds nothing: not read
+    links.new(diffuse.outputs["BSDF"], half.inputs[1])
+    obj.data.materials[0] = mixed
+    data = export.export_context()
+    nodes_out = data.materials[data.meshes[0].materials[0]].nodes
+    kinds = [n["type"] for n in nodes_out]
+    assert kinds == ["diffuse", "glossy", "mix", "emission", "add"], kinds
+    assert nodes_out[2]["shader1"] == 0 and nodes_out[2]["shader2"] == 1
+    assert math.isclose(nodes_out[2]["factor"], 0.3, rel_tol=1e-6)
+    assert nodes_out[4]["shader1"] == 2 and nodes_out[4]["shader2"] == 3
+    assert nodes_out[1]["distribution"] == "multi_ggx"
+    assert math.isclose(nodes_out[0]["roughness"], 0.4, rel_tol=1e-6)
+    assert math.isclose(nodes_out[3]["strength"], 3.0)
+    generated_texture = data.textures[nodes_out[0]["color_texture"]]
+    assert generated_texture.path is None and generated_texture.color_space == "linear"
+    np.testing.assert_allclose(generated_texture.pixels.reshape(-1), pixels, atol=1e-6)
+
+    # Unsupported things are named: a Noise Texture on Base Color, Transmission, Alpha,
+    # a Box projection, a Glass BSDF, an empty Mix input.
+    odd, nodes, links = _surface_material("Odd")
+    principled = _principled(nodes)
+    noise = nodes.new("ShaderNodeTexNoise")
+    links.new(noise.outputs["Color"], helpers.socket(principled, "Base Color"))
+    helpers.socket(principled, "Transmission" if CYCLES == "3.4" else "Transmission Weight") \
+        .default_value = 0.5
+    helpers.socket(principled, "Alpha").default_value = 0.5
+    mix = nodes.new("ShaderNodeMixShader")
+    glass = nodes.new("ShaderNodeBsdfGlass")
+    links.new(glass.outputs["BSDF"], mix.inputs[1])
+    links.new(mix.outputs["Shader"], nodes["Material Output"].inputs["Surface"])
+    obj.data.materials[0] = odd
+    data = export.export_context()
+    text = "\n".join(data.warnings)
+    assert "Glass BSDF is not supported on meshes" in text, text
+    odd_nodes = data.materials[data.meshes[0].materials[0]].nodes
+    assert [n["type"] for n in odd_nodes] == ["diffuse", "emission", "mix"], odd_nodes
+    assert odd_nodes[1]["strength"] == 0.0  # the empty input: no closure
+    links.new(principled.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
+    data = export.export_context()
+    text = "\n".join(data.warnings)
+    assert "Noise Texture" in text and "not supported" in text, text
+    assert "Transmission" in text and "opaque" in text, text
+    assert "Alpha is not supported" in text, text
+    if CYCLES != "3.4":
+        helpers.socket(principled, "Sheen Weight").default_value = 0.5
+        assert any("Sheen Weight is not supported" in w for w in export.export_context().warnings)
 
 
 def test_unsupported_things_warn():
@@ -663,6 +886,8 @@ helpers.run([
     test_lights_world_camera,
     test_camera_orthographic_and_scale,
     test_mesh,
+    test_mesh_normals_and_uvs,
+    test_surface_nodes,
     test_unsupported_things_warn,
     test_hair_node_models_and_missing_sockets,
     test_huang_material_refused_at_render,

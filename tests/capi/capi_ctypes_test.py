@@ -43,8 +43,9 @@ ERROR_INVALID_TABLE = 3
 ERROR_CANCELLED = 4
 ERROR_INTERNAL = 5
 
-KINDS = ("chiang", "marschner", "bake", "sampler", "diffuse", "sun", "point", "area", "world",
-         "camera", "render", "curve_inputs")
+KINDS = ("chiang", "marschner", "bake", "sampler", "diffuse", "principled", "glossy", "emission",
+         "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
+         "curve_inputs")
 
 # ---- The prototypes, written here by hand ---------------------------------------------------
 
@@ -80,10 +81,13 @@ PROTOTYPES = {
     "hairis_scene_destroy": (None, [c_void_p]),
     "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
     "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_add_texture": (c_int, [c_void_p, c_char_p]),
+    "hairis_scene_add_texture_pixels": (c_int, [c_void_p, c_char_p, F, c_size_t, c_size_t, c_int]),
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F]),
     "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
                                                     c_char_p, c_size_t, F]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
+    "hairis_scene_set_mesh_attribute": (c_int, [c_void_p, c_char_p, F, c_size_t]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, F, c_size_t, c_size_t, c_int]),
@@ -956,6 +960,111 @@ class TestRender(unittest.TestCase):
         self.assertEqual(lib().hairis_render(scene, settings + b";film_transparent=1", ptr(rgba),
                                              PROGRESS_FN(), None), OK)
         self.assertTrue(np.all(rgba == 0), "everything is past clip_end: nothing is seen")
+        lib().hairis_scene_destroy(scene)
+
+
+@unittest.skipIf(np is None, "numpy")
+class TestSurfaces(unittest.TestCase):
+    """Surface materials, Image Textures and mesh attributes through ctypes."""
+
+    def test_surface_defaults_are_accepted(self):
+        scene = lib().hairis_scene_create()
+        for kind in ("diffuse", "principled", "glossy", "emission"):
+            with self.subTest(kind=kind):
+                self.assertGreaterEqual(
+                    lib().hairis_scene_add_surface_material(scene, defaults(kind).encode()), 0,
+                    last_error())
+        # Mix and Add name the materials they combine: the defaults (-1) are refused by name.
+        for kind in ("mix", "add"):
+            self.assertEqual(
+                lib().hairis_scene_add_surface_material(scene, defaults(kind).encode()), -1)
+            self.assertIn("shader1", last_error())
+        self.assertGreaterEqual(lib().hairis_scene_add_surface_material(
+            scene, b"type=add;shader1=0;shader2=1"), 0, last_error())
+        lib().hairis_scene_destroy(scene)
+
+    def test_texture_from_a_file_and_from_pixels(self):
+        scene = lib().hairis_scene_create()
+        pixels = np.array([[[0.25, 0.5, 1.0], [1.0, 0.5, 0.25]]], np.float32)  # 2 x 1, RGB
+        index = lib().hairis_scene_add_texture_pixels(
+            scene, b"color_space=linear;extension=clip;mapping=point;scale=2,1,1", ptr(pixels),
+            2, 1, 3)
+        self.assertEqual(index, 0, last_error())
+        self.assertEqual(lib().hairis_scene_add_texture_pixels(
+            scene, b"color_space=auto", ptr(pixels), 2, 1, 3), -1)
+        self.assertIn("color_space", last_error())
+        self.assertEqual(lib().hairis_scene_add_texture(scene, b"image=/no/such/file.png"), -1)
+        self.assertIn("file.png", last_error())
+        texture_defaults = items(defaults("texture"))
+        self.assertEqual(texture_defaults["mapping"], "none")
+        self.assertEqual(texture_defaults["interpolation"], "linear")
+        self.assertEqual(lib().hairis_scene_add_surface_material(
+            scene, b"type=principled;base_color_texture=0"), 0, last_error())
+        self.assertEqual(lib().hairis_scene_add_surface_material(
+            scene, b"type=glossy;color_texture=1"), -1)
+        self.assertIn("color_texture", last_error())
+        lib().hairis_scene_destroy(scene)
+
+    def test_textured_principled_plane_renders_its_texture(self):
+        """Each half of a UV-mapped quad shows its texel; the ratio of the halves is the ratio
+        of the texels (the same BSDF, view and light on both halves)."""
+        scene = lib().hairis_scene_create()
+        pixels = np.array([[[0.2, 0.4, 0.6], [0.8, 0.6, 0.2]]], np.float32)
+        self.assertEqual(lib().hairis_scene_add_texture_pixels(
+            scene, b"color_space=linear;interpolation=closest;extension=extend", ptr(pixels),
+            2, 1, 3), 0, last_error())
+        material = lib().hairis_scene_add_surface_material(
+            scene, b"type=principled;cycles=4.5;base_color_texture=0;ior=1;roughness=0.4")
+        self.assertEqual(material, 0, last_error())
+        vertices = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32)
+        indices = np.array([0, 1, 2, 0, 2, 3], np.uint32)
+        materials = np.zeros(2, np.int32)
+        self.assertEqual(lib().hairis_scene_add_mesh(scene, 4, ptr(vertices), 2,
+                                                     ptr(indices, c_uint32),
+                                                     ptr(materials, c_int32)), OK, last_error())
+        uv = np.array([[0, 0], [1, 0], [1, 1], [0, 0], [1, 1], [0, 1]], np.float32)
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=uv", ptr(uv), 12), OK,
+                         last_error())
+        self.assertEqual(lib().hairis_scene_add_light(
+            scene, b"type=sun;direction=0.2,0.1,1;strength=2"), OK, last_error())
+        self.assertEqual(lib().hairis_scene_set_camera(
+            scene, b"matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;orthographic=1;"
+                   b"frame=0.8,0.4,-1,0.8,-0.4,-1,-0.8,-0.4,-1,-0.8,0.4,-1;width=4;height=2"), OK)
+        rgba = np.zeros((2, 4, 4), np.float32)
+        self.assertEqual(lib().hairis_render(scene, b"samples=2;max_bounces=0;strategy=analytic",
+                                             ptr(rgba), PROGRESS_FN(), None), OK, last_error())
+        left, right = rgba[:, :2, :3].mean(axis=(0, 1)), rgba[:, 2:, :3].mean(axis=(0, 1))
+        np.testing.assert_allclose(left / right, pixels[0, 0] / pixels[0, 1], rtol=1e-5)
+        lib().hairis_scene_destroy(scene)
+
+    def test_mesh_attributes_need_a_mesh_and_the_right_count(self):
+        scene = lib().hairis_scene_create()
+        uv = np.zeros(6, np.float32)
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=uv", ptr(uv), 6),
+                         ERROR_INVALID_ARGUMENT)
+        self.assertIn("no triangles", last_error())
+        self.assertGreaterEqual(lib().hairis_scene_add_surface_material(scene, b""), 0)
+        vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+        indices = np.array([0, 1, 2], np.uint32)
+        materials = np.zeros(1, np.int32)
+        self.assertEqual(lib().hairis_scene_add_mesh(scene, 3, ptr(vertices), 1,
+                                                     ptr(indices, c_uint32),
+                                                     ptr(materials, c_int32)), OK)
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=normal", ptr(uv), 6),
+                         ERROR_INVALID_ARGUMENT)
+        self.assertIn("9", last_error())
+        normals = np.tile(np.array([0, 0, 1], np.float32), 3)
+        normals[4] = np.nan
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=normal",
+                                                               ptr(normals), 9),
+                         ERROR_INVALID_ARGUMENT)
+        self.assertIn("values[4]", last_error())
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=uv", ptr(uv), 6), OK,
+                         last_error())
+        # A call that adds no triangles leaves no mesh to attach to.
+        self.assertEqual(lib().hairis_scene_add_mesh(scene, 0, None, 0, None, None), OK)
+        self.assertEqual(lib().hairis_scene_set_mesh_attribute(scene, b"name=uv", ptr(uv), 6),
+                         ERROR_INVALID_ARGUMENT)
         lib().hairis_scene_destroy(scene)
 
 

@@ -261,8 +261,10 @@ static void expect_default(const char *kind, const char *name, const char *expec
           defaults ? defaults : "(null)");
 }
 
-static const char *const g_kinds[] = {"chiang", "marschner", "bake",   "sampler", "diffuse",     "sun",
-                                      "point",  "area",      "world",  "camera",  "render", "curve_inputs"};
+static const char *const g_kinds[] = {"chiang", "marschner", "bake",   "sampler",
+                                      "diffuse", "principled", "glossy", "emission",
+                                      "sun",    "point",     "area",   "world",
+                                      "camera", "render", "curve_inputs"};
 enum { KIND_COUNT = sizeof g_kinds / sizeof g_kinds[0] };
 
 static void test_defaults(void)
@@ -317,9 +319,10 @@ static void test_defaults(void)
         CHECK(d != NULL && strchr(d, '=') != NULL, "defaults of %s: \"%s\"", g_kinds[k],
               d ? d : "(null)");
     }
-    CHECK(hairis_defaults("principled") == NULL, "unknown kind");
+    CHECK(hairis_defaults("velvet") == NULL, "unknown kind");
     for (int k = 0; k < KIND_COUNT; ++k) CHECK_ERROR_MENTIONS(g_kinds[k]);
-    CHECK_ERROR_MENTIONS("principled");
+    CHECK_ERROR_MENTIONS("texture");
+    CHECK_ERROR_MENTIONS("mix");
     CHECK(hairis_defaults(NULL) == NULL, "NULL kind");
     CHECK_ERROR_MENTIONS("kind");
 }
@@ -361,8 +364,9 @@ static int try_options(const char *kind, const char *options)
             hairis_render(g_option_scene, options, g_option_rgba, cancel_at_once, NULL);
         return status == HAIRIS_OK || status == HAIRIS_ERROR_CANCELLED;
     }
-    if (strcmp(kind, "diffuse") == 0) {
-        snprintf(text, sizeof text, "type=diffuse;%s", options);
+    if (strcmp(kind, "diffuse") == 0 || strcmp(kind, "principled") == 0 ||
+        strcmp(kind, "glossy") == 0 || strcmp(kind, "emission") == 0) {
+        snprintf(text, sizeof text, "type=%s;%s", kind, options);
         return hairis_scene_add_surface_material(g_option_scene, text) >= 0;
     }
     if (strcmp(kind, "sun") == 0 || strcmp(kind, "point") == 0 || strcmp(kind, "area") == 0) {
@@ -476,8 +480,9 @@ static void test_option_strings(void)
     CHECK_ERROR_MENTIONS("spot");
     CHECK(hairis_scene_add_light(g_option_scene, "strength=2") != HAIRIS_OK, "a light without type");
     CHECK_ERROR_MENTIONS("type");
-    CHECK(hairis_scene_add_surface_material(g_option_scene, "type=glossy") < 0, "glossy");
+    CHECK(hairis_scene_add_surface_material(g_option_scene, "type=velvet") < 0, "velvet");
     CHECK_ERROR_MENTIONS("diffuse");
+    CHECK_ERROR_MENTIONS("principled");
 
     /* NaN, infinity and numbers that are not numbers, refused by name. */
     struct {
@@ -501,6 +506,10 @@ static void test_option_strings(void)
         {"world", "strength=-inf", "strength"},
         {"camera", "frame=0,0,nan,1,1,1,1,1,1,1,1,1", "frame"},
         {"diffuse", "emission=1,1,inf", "emission"},
+        {"principled", "metallic=nan", "metallic"},
+        {"principled", "base_color=1,inf,1", "base_color"},
+        {"glossy", "roughness=-inf", "roughness"},
+        {"emission", "strength=nan", "strength"},
     };
     for (size_t i = 0; i < sizeof numbers / sizeof numbers[0]; ++i) {
         CHECK(!try_options(numbers[i].kind, numbers[i].options), "%s: %s refused",
@@ -1772,6 +1781,9 @@ static void test_defaults_round_trip(void)
         const char *kind, *bare, *name, *value;
     } cases[] = {
         {"diffuse", "type=diffuse", "color", "0.3,0.3,0.3"},
+        {"principled", "type=principled", "roughness", "0.2"},
+        {"glossy", "type=glossy", "color", "0.3,0.6,0.9"},
+        {"emission", "type=emission", "strength", "3"},
         {"sun", "type=sun", "strength", "2"},
         {"point", "type=point", "power", "30"},
         {"area", "type=area", "power", "30"},
@@ -1782,8 +1794,9 @@ static void test_defaults_round_trip(void)
         const char *kind = cases[k].kind;
         keep(d, hairis_defaults(kind));
         with_option(text, d, cases[k].name, cases[k].value);
-        const int is_surface = strcmp(kind, "diffuse") == 0, is_world = strcmp(kind, "world") == 0,
-                  is_camera = strcmp(kind, "camera") == 0;
+        const int is_surface = strcmp(kind, "diffuse") == 0 || strcmp(kind, "principled") == 0 ||
+                               strcmp(kind, "glossy") == 0 || strcmp(kind, "emission") == 0;
+        const int is_world = strcmp(kind, "world") == 0, is_camera = strcmp(kind, "camera") == 0;
         const int is_light = !is_surface && !is_world && !is_camera;
         const char *camera = is_camera ? NULL : CAMERA;
         const int pixels = is_camera ? CW * CH : W * H;
@@ -2111,6 +2124,118 @@ static void test_scene_refusals(void)
     hairis_fiber_destroy(marschner);
 }
 
+/* ---- Surface materials, textures and mesh attributes -------------------------------------- */
+
+static void test_surfaces(void)
+{
+    section("surfaces");
+    hairis_scene *scene = hairis_scene_create();
+
+    /* Textures from pixels (bottom row first) and their refusals. */
+    const float pixels[6] = {0.2f, 0.4f, 0.6f, 0.9f, 0.8f, 0.1f};
+    const int texture = hairis_scene_add_texture_pixels(
+        scene, "color_space=linear;interpolation=closest;extension=extend", pixels, 2, 1, 3);
+    CHECK(texture == 0, "texture index %d", texture);
+    CHECK_NO_ERROR();
+    CHECK(hairis_scene_add_texture_pixels(scene, "", pixels, 2, 1, 3) == -1, "auto colour space");
+    CHECK_ERROR_MENTIONS("color_space");
+    const float bad[3] = {0.0f, NAN, 0.0f};
+    CHECK(hairis_scene_add_texture_pixels(scene, "color_space=linear", bad, 1, 1, 3) == -1, "NaN texel");
+    CHECK_ERROR_MENTIONS("pixel");
+    CHECK(hairis_scene_add_texture_pixels(scene, "color_space=linear", pixels, 2, 1, 5) == -1, "5 channels");
+    CHECK_ERROR_MENTIONS("channels");
+    CHECK(hairis_scene_add_texture_pixels(scene, "color_space=linear;rotation=0,0,1", pixels, 2, 1, 3) == -1,
+          "a rotation without a mapping");
+    CHECK_ERROR_MENTIONS("mapping");
+    CHECK(hairis_scene_add_texture_pixels(scene, "color_space=linear;mapping=normal", pixels, 2, 1, 3) == -1,
+          "a Normal mapping");
+    CHECK_ERROR_MENTIONS("mapping");
+    CHECK(hairis_scene_add_texture(scene, "") == -1, "a texture without image");
+    CHECK_ERROR_MENTIONS("image");
+    CHECK(hairis_scene_add_texture(scene, "image=/nonexistent/skin.png") == -1, "a missing file");
+    CHECK_ERROR_MENTIONS("skin.png");
+
+    /* Materials: textures by index, version-specific inputs, Mix and Add of surfaces. */
+    const int textured = hairis_scene_add_surface_material(scene, "type=diffuse;color_texture=0");
+    CHECK(textured == 0, "textured diffuse %d", textured);
+    CHECK(hairis_scene_add_surface_material(scene, "type=principled;base_color_texture=3") == -1,
+          "a texture index out of range");
+    CHECK_ERROR_MENTIONS("base_color_texture");
+    CHECK(hairis_scene_add_surface_material(scene, "type=principled;cycles=4.5;sheen=0.5") == -1,
+          "4.x sheen");
+    CHECK_ERROR_MENTIONS("sheen");
+    CHECK_ERROR_MENTIONS("4.5");
+    CHECK(hairis_scene_add_surface_material(scene, "type=principled;coat_tint=1,0,0") == -1,
+          "coat tint for 3.4");
+    CHECK_ERROR_MENTIONS("coat_tint");
+    CHECK(hairis_scene_add_surface_material(scene, "type=principled;metallic=1.5") == -1, "metallic > 1");
+    CHECK_ERROR_MENTIONS("metallic");
+    const int glow = hairis_scene_add_surface_material(scene, "type=emission;color=1,0,0;strength=2");
+    const int mix = hairis_scene_add_surface_material(scene, "type=mix;factor=0.25;shader1=0;shader2=1");
+    CHECK(glow == 1 && mix == 2, "emission %d, mix %d", glow, mix);
+    CHECK(hairis_scene_add_surface_material(scene, "type=mix;shader1=0") == -1, "a mix of one");
+    CHECK_ERROR_MENTIONS("shader2");
+    CHECK(hairis_scene_add_surface_material(scene, "type=add;shader1=0;shader2=9") == -1, "out of range");
+    CHECK_ERROR_MENTIONS("shader2");
+    CHECK(hairis_scene_add_surface_material(scene, "type=add;factor=0.5;shader1=0;shader2=1") == -1,
+          "an Add Shader has no factor");
+    CHECK_ERROR_MENTIONS("factor");
+    const int later = hairis_scene_add_surface_material(scene, "type=glossy;cycles=4.5");
+    CHECK(later == 3, "glossy %d", later);
+    CHECK(hairis_scene_add_surface_material(scene, "type=add;shader1=0;shader2=3") == -1,
+          "3.4 and 4.5 nodes in one material");
+    CHECK_ERROR_MENTIONS("same Cycles");
+    hairis_fiber *fiber = hairis_fiber_create("");
+    const int hair = hairis_scene_add_hair_material(scene, fiber, NULL);
+    hairis_fiber_destroy(fiber);
+    CHECK(hairis_scene_add_surface_material(scene, "type=mix;shader1=0;shader2=4") == -1 && hair == 4,
+          "a mix with hair");
+    CHECK_ERROR_MENTIONS("hair");
+
+    /* Mesh attributes attach to the last mesh added. */
+    const float uv[12] = {0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1};
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=uv", uv, 12) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "no mesh yet");
+    CHECK_ERROR_MENTIONS("no triangles");
+    const float quad[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint32_t indices[6] = {0, 1, 2, 0, 2, 3};
+    const int32_t materials[2] = {textured, textured};
+    CHECK(hairis_scene_add_mesh(scene, 4, quad, 2, indices, materials) == HAIRIS_OK, "quad");
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=uv", uv, 10) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "10 floats for 6 corners");
+    CHECK_ERROR_MENTIONS("12");
+    float normals[18] = {0};
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=normal", normals, 18) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "zero normals");
+    CHECK_ERROR_MENTIONS("zero normal");
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=tangent", uv, 12) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "an attribute hairis does not know");
+    CHECK_ERROR_MENTIONS("uv");
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=uv", uv, 12) == HAIRIS_OK, "uv");
+    for (int k = 0; k < 6; ++k) normals[3 * k + 2] = 1.0f;
+    CHECK(hairis_scene_set_mesh_attribute(scene, "name=normal", normals, 18) == HAIRIS_OK, "normals");
+
+    /* A sun from straight above, orthographic view from above: the left half of the image sees
+     * texel 0, the right half texel 1, each exactly colour x strength / pi. */
+    CHECK(hairis_scene_add_light(scene, "type=sun;direction=0,0,1;strength=3") == HAIRIS_OK, "sun");
+    CHECK(hairis_scene_set_world(scene, "color=0,0,0") == HAIRIS_OK, "world");
+    CHECK(hairis_scene_set_camera(scene, "matrix=1,0,0,0,0,1,0,0,0,0,1,3,0,0,0,1;orthographic=1;"
+                                         "frame=0.8,0.4,-1,0.8,-0.4,-1,-0.8,-0.4,-1,-0.8,0.4,-1;"
+                                         "width=4;height=2") == HAIRIS_OK,
+          "camera");
+    float rgba[4 * 2 * 4];
+    CHECK(hairis_render(scene, "samples=2;max_bounces=0;strategy=analytic", rgba, NULL, NULL) == HAIRIS_OK,
+          "render");
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float expected = pixels[(x < 2 ? 0 : 3) + c] * 3.0f / 3.14159265f;
+                CHECK(fabsf(rgba[(y * 4 + x) * 4 + c] - expected) < 1e-5f, "pixel %d,%d channel %d: %g, not %g",
+                      x, y, c, rgba[(y * 4 + x) * 4 + c], expected);
+            }
+    hairis_scene_destroy(scene);
+}
+
 int main(void)
 {
     const char *temp_dir = getenv("TMPDIR");
@@ -2132,6 +2257,7 @@ int main(void)
     test_defaults_round_trip();
     test_scene_refusals();
     test_curve_inputs();
+    test_surfaces();
     hairis_tables_destroy(g_tables);
 
     printf("%d passed, %d failed\n", g_passed, g_failed);

@@ -30,8 +30,45 @@ HAIRIS_API void hairis_scene_destroy(hairis_scene *scene);
  */
 HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_fiber *fiber,
                                               const hairis_tables *tables);
-/** Adds a surface material from options ("diffuse": color, emission); returns its index or -1. */
+/**
+ * Adds a surface material (a mesh's shader nodes, as Cycles renders them) from options; returns
+ * its index or -1. type = diffuse | principled | glossy | emission | mix | add
+ * (hairis_defaults(type) lists each type's names and defaults):
+ *  - "diffuse": Diffuse BSDF (color, roughness: Oren-Nayar above 0) plus an emission radiance;
+ *  - "principled": Principled BSDF with cycles = 3.4 (Blender 3.x's inputs: specular,
+ *    specular_tint, subsurface, subsurface_color, sheen, sheen_tint, coat = Clearcoat,
+ *    coat_roughness) or 4.5 (Blender 4.x and 5.0's: specular = Specular IOR Level,
+ *    specular_tint_color, subsurface = Subsurface Weight, coat = Coat Weight, coat_roughness,
+ *    coat_ior, coat_tint, diffuse_roughness), both with base_color, metallic, roughness, ior,
+ *    distribution = ggx | multi_ggx and emission (Emission Color x Strength); inputs of the other
+ *    version must keep their defaults;
+ *  - "glossy": Glossy BSDF (color, roughness, distribution);
+ *  - "emission": Emission (color, strength);
+ *  - "mix": Mix Shader of surface materials shader1 and shader2 by factor; "add": Add Shader.
+ * Colour inputs base_color (principled) and color (diffuse, glossy) take an Image Texture by
+ * index with base_color_texture / color_texture (-1: none), read at the mesh's UV map (see
+ * hairis_scene_set_mesh_attribute). Every BSDF type takes cycles = 3.4 (default) | 4.5; the BSDF
+ * nodes of one material (through mix and add) must follow the same version.
+ */
 HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char *options);
+/**
+ * Adds an Image Texture for surface materials from options; returns its index or -1.
+ * image=<path> (a file OpenImageIO reads; the path may not hold ';' nor start or end with a
+ * space: use hairis_scene_add_texture_pixels then), color_space = auto (float files linear,
+ * 8-bit files sRGB) | linear | srgb (decoded after interpolation, as Cycles does),
+ * interpolation = linear | closest, extension = repeat | extend | clip | mirror, and the Mapping
+ * node between the UV map and the texture: mapping = none | point | texture | vector with
+ * location, rotation (XYZ Euler, radians) and scale (which need a mapping). Alpha is ignored.
+ */
+HAIRIS_API int hairis_scene_add_texture(hairis_scene *scene, const char *options);
+/**
+ * The same with the image as `pixels`: width x height pixels of `channels` (1 to 4) floats,
+ * the BOTTOM row first (Blender's Image.pixels), finite and >= 0; options without image,
+ * color_space linear or srgb. The pixels are copied.
+ */
+HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *options,
+                                               const float *pixels, size_t width, size_t height,
+                                               int channels);
 /**
  * Adds hair curves drawn as round Catmull-Rom curves (Cycles' "3D Curves"): curve c has points
  * first[c] .. first[c+1]-1 (first has curve_count+1 entries), positions xyz in world space,
@@ -68,6 +105,16 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
 HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                                      const float *positions, size_t triangle_count,
                                      const uint32_t *indices, const int32_t *materials);
+/**
+ * Per-corner data of the mesh the last hairis_scene_add_mesh call added (refused when that call
+ * added no triangles), in the order of its indices, from options name = normal (3 floats per
+ * corner: world-space shading normals, finite and not zero, interpolated across each triangle
+ * and normalized as Cycles does; without them the face normal shades) | uv (2 floats per corner:
+ * the UV map Image Textures read; without it UV is (0, 0)). `count` is the number of floats
+ * (9 or 6 per triangle). Setting a name again replaces it.
+ */
+HAIRIS_API int hairis_scene_set_mesh_attribute(hairis_scene *scene, const char *options,
+                                               const float *values, size_t count);
 /**
  * Adds a light from options, in Blender's units and names: "type=sun" (direction towards the
  * sun, color, strength W/m², angle), "type=point" (position, color, power W, radius),
@@ -117,7 +164,7 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options);
 /**
  * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
- * wants). Settings (options): samples, max_bounces, max_diffuse_bounces,
+ * wants). Settings (options): samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
  * max_transmission_bounces, strategy, multiple_weight, n_h, seed, threads, tile_size,
  * film_transparent, curve_backfaces = ignore (default) | hit: whether a ray that meets a
  * curve from inside its tube (it started inside another, overlapping strand) passes, as in
