@@ -5,6 +5,7 @@
 #include <string>
 
 #include "capi_scene.h"
+#include "fiber/fiber_spec.h"
 #include "render/render.h"
 
 namespace hairis::capi {
@@ -36,6 +37,32 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     return std::move(shading).value();
 }
 
+// The dual-scattering data of hair material `index` (integrator=dual_scattering): its fiber's
+// averages, with the parameters the multiple tables were baked with, and those tables.
+void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, size_t index) {
+    const std::string name = "material " + std::to_string(index) + " (hair): ";
+    if (!hair.tables)
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "integrator=dual_scattering samples multiple scattering from the "
+                                                  "material's baked multiple-scattering tables, but it was added "
+                                                  "without tables; bake or load tables for it, or render with "
+                                                  "integrator=path");
+    if (hair.tables->parameters != canonical_parameters(chiang_parameters(hair.fiber->params())) ||
+        hair.tables->model != hair.fiber->name())
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "the tables were baked for " + hair.tables->model + " \"" +
+                                               hair.tables->parameters + "\", not for this fiber; bake tables for it");
+    SceneHairMaterial::DualCache &cache = *hair.dual_cache;
+    std::call_once(cache.once, [&] {
+        Expected<DualScattering> made = DualScattering::create(*hair.fiber, DualScatteringParams{});
+        if (made)
+            cache.dual = std::make_shared<const DualScattering>(std::move(made).value());
+        else
+            cache.error = made.error().message;
+    });
+    if (!cache.dual) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + cache.error);
+    material.dual = cache.dual;
+    material.multiple = hair.tables->multiple;
+}
+
 }  // namespace
 
 }  // namespace hairis::capi
@@ -63,9 +90,11 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         SceneDesc desc = scene->desc;
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
-            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]))
-                desc.materials.push_back(HairMaterial{hair_shading(*hair, m, o.sampler)});
-            else
+            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {
+                HairMaterial material{hair_shading(*hair, m, o.sampler)};
+                if (o.render.integrator == int(Integrator::DualScattering)) add_dual_scattering(material, *hair, m);
+                desc.materials.push_back(std::move(material));
+            } else
                 desc.materials.push_back(std::get<DiffuseMaterial>(scene->materials[m]));
         }
         Expected<Scene> built = Scene::build(std::move(desc));
