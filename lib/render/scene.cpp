@@ -87,11 +87,21 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
             args->valid[i] = 0;
         } else if (ctx->strands) {
             // Let hair through: record the hit (its distance is the ray's tfar) and reject it.
+            // Embree may report one hit of a round curve many times over (hundreds for a
+            // straight one); the repeats are recorded once.
             StrandCrossing c;
             c.t = RTCRayN_tfar(args->ray, args->N, i);
             c.segment = {RTCHitN_geomID(args->hit, args->N, i), RTCHitN_primID(args->hit, args->N, i)};
             c.u = RTCHitN_u(args->hit, args->N, i);
-            ctx->strands->push_back(c);
+            std::vector<StrandCrossing> &out = *ctx->strands;
+            bool repeat = false;
+            for (std::size_t k = out.size(); k-- > 0 && out.size() - k <= 8;)
+                if (out[k].segment.geometry == c.segment.geometry &&
+                    out[k].segment.primitive == c.segment.primitive && out[k].t == c.t) {
+                    repeat = true;
+                    break;
+                }
+            if (!repeat) out.push_back(c);
             args->valid[i] = 0;
         }
     }
