@@ -93,9 +93,11 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options);
 /**
  * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
- * wants). Settings (options): samples, max_bounces, max_diffuse_bounces,
- * max_transmission_bounces, strategy, multiple_weight, n_h, seed, threads, tile_size,
- * film_transparent. progress may be NULL; non-zero from it cancels (HAIRIS_ERROR_CANCELLED,
+ * wants). Settings (options): integrator (path | dual_scattering), samples, max_bounces,
+ * max_diffuse_bounces, max_transmission_bounces, strategy, multiple_weight, n_h, seed,
+ * threads, tile_size, film_transparent. integrator=dual_scattering shades hair by dual
+ * scattering (lib/render/dual_scattering_integrator.h) and needs every hair material's tables
+ * (HAIRIS_ERROR_INVALID_TABLE naming the material otherwise). progress may be NULL; non-zero from it cancels (HAIRIS_ERROR_CANCELLED,
  * promptly; rgba then holds the samples finished so far); it is only called on the calling
  * thread. A scene without camera or geometry is refused. Each call builds the scene anew, so
  * a scene can be rendered again with other settings, also from several threads at once.
