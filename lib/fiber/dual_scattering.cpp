@@ -328,7 +328,7 @@ DualScattering::Rgbd DualScattering::local_term(double theta_i, double theta_o) 
     Rgbd out;
     for (int ch = 0; ch < 3; ++ch) {
         const double v = std::max(sig2.v[ch], 1e-12);
-        const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], v) / (kPi * cos_d2);
+        const double f_back = big_a.v[ch] * gaussian(theta_h - delta.v[ch], v) / (kPi * cos_d2);
         out.v[ch] = params_.d_b * f_back * cos_i;
     }
     return out;
@@ -357,7 +357,7 @@ DualScattering::Rgbd DualScattering::scattered_term(double theta_i, double theta
             f_s += gaussian(theta_h - s.alpha, var) * ng[std::size_t(p)].v[ch] / cos_d2;
         }
         const double var_b = std::max(sig2.v[ch] + spread, 1e-12);
-        const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], var_b) / (kPi * cos_d2);
+        const double f_back = big_a.v[ch] * gaussian(theta_h - delta.v[ch], var_b) / (kPi * cos_d2);
         out.v[ch] = t_f.v[ch] * df * (f_s + kPi * db * f_back) * cos_i;
     }
     return out;
