@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <variant>
@@ -123,14 +122,6 @@ void describe(Fields &f, WorldOptions &o) {
 struct SceneHairMaterial {
     std::shared_ptr<const ChiangFiber> fiber;
     std::optional<SamplingTables> tables;
-    /// The fiber's dual-scattering averages, computed by the first integrator=dual_scattering
-    /// render and shared by later ones (and by renders on other threads).
-    struct DualCache {
-        std::once_flag once;
-        std::shared_ptr<const DualScattering> dual;
-        std::string error;
-    };
-    std::shared_ptr<DualCache> dual_cache = std::make_shared<DualCache>();
 };
 
 using SceneMaterial = std::variant<SceneHairMaterial, DiffuseMaterial>;

@@ -1,6 +1,8 @@
 // C API: hairis_render — each hair material's sampler from the settings (the policy in
 // sampling/strategy.h), the Scene (Embree BVH) and the path tracer (render/render.h).
 #include <chrono>
+#include <deque>
+#include <mutex>
 #include <functional>
 #include <string>
 
@@ -37,6 +39,25 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     return std::move(shading).value();
 }
 
+// A fiber's dual-scattering averages (about a second of quadrature), kept for the process by
+// model and parameters: the add-on builds a new scene for every render. At most kDualCacheSize
+// fibers are kept; the oldest goes first.
+constexpr std::size_t kDualCacheSize = 64;
+std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fiber, const std::string &name) {
+    static std::mutex mutex;
+    static std::deque<std::pair<std::string, std::shared_ptr<const DualScattering>>> cache;
+    const std::string key = fiber.name() + ":" + canonical_parameters(chiang_parameters(fiber.params()));
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto &entry : cache)
+        if (entry.first == key) return entry.second;
+    Expected<DualScattering> made = DualScattering::create(fiber, DualScatteringParams{});
+    if (!made) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + made.error().message);
+    auto dual = std::make_shared<const DualScattering>(std::move(made).value());
+    if (cache.size() == kDualCacheSize) cache.pop_front();
+    cache.emplace_back(key, dual);
+    return dual;
+}
+
 // The dual-scattering data of hair material `index` (integrator=dual_scattering): its fiber's
 // averages, with the parameters the multiple tables were baked with, and those tables.
 void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, size_t index) {
@@ -50,16 +71,7 @@ void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, 
         hair.tables->model != hair.fiber->name())
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "the tables were baked for " + hair.tables->model + " \"" +
                                                hair.tables->parameters + "\", not for this fiber; bake tables for it");
-    SceneHairMaterial::DualCache &cache = *hair.dual_cache;
-    std::call_once(cache.once, [&] {
-        Expected<DualScattering> made = DualScattering::create(*hair.fiber, DualScatteringParams{});
-        if (made)
-            cache.dual = std::make_shared<const DualScattering>(std::move(made).value());
-        else
-            cache.error = made.error().message;
-    });
-    if (!cache.dual) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + cache.error);
-    material.dual = cache.dual;
+    material.dual = dual_scattering_of(*hair.fiber, name);
     material.multiple = hair.tables->multiple;
 }
 

@@ -116,9 +116,9 @@ struct DualVertex {
 /// Per-thread buffers and counts of the estimator.
 struct DualWork {
     std::vector<StrandCrossing> light, probe, table;
-    std::uint64_t rays = 0;  ///< rays traced (probe, light, table)
-    int last_strand_index = -1;  ///< the table strand count the last vertex used (for tests)
-    int last_probe_strands = -1; ///< the strands the last probe crossed (for tests)
+    std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
+    int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
+    int last_strand_index = -1;   ///< the index into the table's n_h values it chose
 };
 
 /// The radiance the vertex sends towards ω_o from emitters by dual scattering (light and

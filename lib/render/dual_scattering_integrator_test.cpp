@@ -13,6 +13,7 @@
 #include "fiber/chiang.h"
 #include "fiber/distributions.h"
 #include "fiber/principled_hair.h"
+#include "core/scratch.h"
 #include "render/render.h"
 #include "sampling/analytic_sampler.h"
 
@@ -361,6 +362,39 @@ TEST(DualScatteringRender, SunThroughKStrandsIsTheClosedForm) {
         RenderSettings path = dual_settings(0);
         path.integrator = int(Integrator::Path);
         EXPECT_EQ(render_sample(scene, path, 3, 1, 0).g, 0.0f);
+    }
+}
+
+TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
+    // The top hair of sun_through_strands(k), shaded directly: the n_h probe goes towards the
+    // (only) lamp and crosses the k strands under it; the table's strand count is the nearest.
+    for (int k : {0, 1, 3, 6}) {
+        const Scene scene = sun_through_strands(k, 1.0f);
+        const Vec3 origin{0.05f, 0.004f, 1.0f}, down{0, 0, -1};
+        const std::optional<Hit> hit = scene.intersect(origin, down, 0.0f, INFINITY);
+        ASSERT_TRUE(hit.has_value());
+        const SurfacePoint sp = scene.surface_point(origin, down, *hit);
+        ASSERT_TRUE(sp.is_curve);
+        const HairMaterial &material = std::get<HairMaterial>(scene.materials()[sp.material]);
+        DualVertex v;
+        v.point = &sp;
+        v.material = &material;
+        v.wo = -down;
+        v.frame = FiberFrame::from_tangent_and_view(sp.tangent, v.wo);
+        ScratchBuffer scratch;
+        const float h = std::clamp(dot(cross(sp.normal, v.frame.x), v.frame.z), -1.0f, 1.0f);
+        const HairBsdf bsdf = material.shading.at({v.frame.to_local(v.wo), h}, scratch);
+        v.bsdf = &bsdf;
+        DualWork work;
+        DualRandom u;
+        u.table_u0 = u.table_u1 = u.table_u2 = 0.5f;
+        const Rgb l = dual_scattering_light(scene, v, u, work);
+        EXPECT_EQ(work.last_probe_strands, k);
+        EXPECT_EQ(material.multiple->n_h_values()[std::size_t(work.last_strand_index)],
+                  material.multiple->n_h_values()[std::size_t(nearest_strand_index(*material.multiple, k))]);
+        // The sun's probe ray is the light sample's shadow ray: traced once (and the table's).
+        EXPECT_EQ(work.rays, 2u);
+        EXPECT_GT(l.r, 0.0f);
     }
 }
 
