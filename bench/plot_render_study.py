@@ -19,7 +19,8 @@ import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 STYLE = {"UNIFORM": ("tab:gray", "v"), "ANALYTIC": ("tab:blue", "o"),
-         "GAUSSIAN": ("tab:green", "s"), "TABLE": ("tab:red", "D"), "CYCLES": ("black", "x")}
+         "GAUSSIAN": ("tab:green", "s"), "TABLE": ("tab:red", "D"), "DUAL": ("tab:purple", "^"),
+         "CYCLES": ("black", "x")}
 
 
 def srgb(linear):
@@ -34,6 +35,8 @@ def plot_curves(results, path):
     s = results["settings"]
     figure, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4))
     for method, (color, marker) in STYLE.items():
+        if method not in summary:  # results of a run without it
+            continue
         points = summary[method]["per_spp"]
         spp = [p["spp"] for p in points]
         seconds = [p["seconds"] for p in points]

@@ -1,6 +1,7 @@
 // Google Benchmark: time per sample of the path tracer on a scene like bench/render_versions'
 // "sphere" (1000 strands of particle-like hair on a diffuse sphere, a sun and a dim world,
-// 8 bounces, 96 × 96, one thread), per strategy, without Blender. Each iteration renders
+// 8 bounces, 96 × 96, one thread), per strategy and integrator (path, dual_scattering),
+// without Blender. Each iteration renders
 // kSamples samples per pixel; the counter ms_per_spp is its CPU time per sample per pixel
 // of the whole image, the unit bench/render_versions reports.
 #include <benchmark/benchmark.h>
@@ -9,6 +10,7 @@
 #include <ctime>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fiber/fiber_spec.h"
@@ -67,7 +69,7 @@ TriangleMesh sphere_mesh(int rings, int segments) {
     return m;
 }
 
-Expected<Scene> sphere_scene(StrategyKind kind) {
+Expected<Scene> sphere_scene(StrategyKind kind, Integrator integrator) {
     PrincipledHairNode node;
     node.parametrization = HairParametrization::Melanin;
     node.melanin = 0.25f;
@@ -80,13 +82,14 @@ Expected<Scene> sphere_scene(StrategyKind kind) {
     StrategyInputs inputs;
     inputs.chiang = fiber;
     std::optional<SamplingTables> tables;
-    if (kind == StrategyKind::Table) {
+    const bool dual = integrator == Integrator::DualScattering;
+    if (kind == StrategyKind::Table || dual) {
         auto baked = bake_tables(*fiber, chiang_parameters(params.value()), BakeOptions{});
         if (!baked) return baked.error();
         auto loaded = SamplingTables::from(baked.value());
         if (!loaded) return loaded.error();
         tables = std::move(loaded).value();
-        inputs.tables = &*tables;
+        if (kind == StrategyKind::Table) inputs.tables = &*tables;
     }
     auto sampler = make_sampler(kind, inputs);
     if (!sampler) return sampler.error();
@@ -94,7 +97,14 @@ Expected<Scene> sphere_scene(StrategyKind kind) {
     if (!shading) return shading.error();
 
     SceneDesc desc;
-    desc.materials.push_back(HairMaterial{shading.value()});
+    HairMaterial hair{shading.value()};
+    if (dual) {
+        auto averages = DualScattering::create(*fiber, DualScatteringParams{});
+        if (!averages) return averages.error();
+        hair.dual = std::make_shared<const DualScattering>(std::move(averages).value());
+        hair.multiple = tables->multiple;
+    }
+    desc.materials.push_back(std::move(hair));
     DiffuseMaterial skin;
     skin.albedo = {0.6f, 0.5f, 0.45f};
     desc.materials.push_back(skin);
@@ -118,12 +128,14 @@ Expected<Scene> sphere_scene(StrategyKind kind) {
 
 void render_sphere(benchmark::State &state) {
     const auto kind = StrategyKind(state.range(0));
-    auto scene = sphere_scene(kind);
+    const auto integrator = Integrator(state.range(1));
+    auto scene = sphere_scene(kind, integrator);
     if (!scene) {
         state.SkipWithError(scene.error().message.c_str());
         return;
     }
     RenderSettings settings;
+    settings.integrator = int(integrator);
     settings.samples = kSamples;
     settings.max_bounces = 8;
     settings.max_transmission_bounces = 8;
@@ -147,11 +159,12 @@ void render_sphere(benchmark::State &state) {
     state.counters["ms_per_spp"] = 1e3 * cpu_seconds / double(state.iterations()) / kSamples;
     state.counters["rays_per_sample"] = double(stats.rays) / samples;
     state.counters["shadow_rays_per_sample"] = double(stats.shadow_rays) / samples;
-    state.SetLabel(strategy_name(kind));
+    state.SetLabel(std::string(strategy_name(kind)) + (integrator == Integrator::DualScattering ? ", dual" : ", path"));
 }
 BENCHMARK(render_sphere)
-    ->Arg(int(StrategyKind::Analytic))
-    ->Arg(int(StrategyKind::Table))
+    ->Args({int(StrategyKind::Analytic), int(Integrator::Path)})
+    ->Args({int(StrategyKind::Table), int(Integrator::Path)})
+    ->Args({int(StrategyKind::Table), int(Integrator::DualScattering)})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();

@@ -12,8 +12,8 @@ In one run, on the scene of tests/blender/test_cycles_compare.py (helpers.make_c
    engine is favoured; half the mean squared difference of the two halves over two estimates
    the reference's own noise (MSE_ref = mean((hairis − cycles)²)/4), which is subtracted from
    every measured MSE ("noise-corrected" RMSE);
-2. every Hairis strategy (UNIFORM, ANALYTIC, GAUSSIAN at multiple_weight 0.25, TABLE at 0)
-   and Cycles at each of SPPS samples per pixel, SEEDS seeds each (seeds other than the
+2. every Hairis strategy (UNIFORM, ANALYTIC, GAUSSIAN at multiple_weight 0.25, TABLE at 0),
+   DUAL (TABLE with integrator=dual_scattering) and Cycles at each of SPPS samples per pixel, SEEDS seeds each (seeds other than the
    reference's), timing ``bpy.ops.render.render()`` alone; a warm-up render of each
    strategy and of Cycles comes first, so TABLE's auto-bake and first-render costs are not
    timed;
@@ -104,7 +104,8 @@ def configure(scene, method, samples):
     """Engine, strategy and sample count of ``method`` (a strategy name or CYCLES)."""
     helpers.set_samples(scene, samples)
     if method != "CYCLES":
-        scene.hairis.strategy = method
+        scene.hairis.integrator = "DUAL_SCATTERING" if method == "DUAL" else "PATH"
+        scene.hairis.strategy = "TABLE" if method == "DUAL" else method
         # Each strategy at its recommended weight: 0 for TABLE (the default), 0.25 for the
         # seed's Gaussian PDFs, which are heavy-tailed without their multiple-scattering part.
         scene.hairis.multiple_weight = 0.25 if method == "GAUSSIAN" else 0.0

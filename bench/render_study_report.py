@@ -16,7 +16,9 @@ import sys
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-STRATEGIES = ("UNIFORM", "ANALYTIC", "GAUSSIAN", "TABLE")
+STRATEGIES = ("UNIFORM", "ANALYTIC", "GAUSSIAN", "TABLE", "DUAL")
+"""Hairis methods: the strategies with integrator=path, and DUAL (TABLE with the dual
+scattering integrator, which is biased by design: bench/results/dual_scattering.md)."""
 METHODS = STRATEGIES + ("CYCLES",)
 # Beyond a strategy's measured times, RMSE is extrapolated with the Monte Carlo rate
 # RMSE ∝ time^(-1/2) from its nearest point (its end segments are too noisy to extrapolate).
@@ -84,9 +86,12 @@ def summarize(results):
             "rmse_vs_spp_slope": loglog_slope(spps, [p["rmse_corrected"] for p in per_spp]),
             "seconds_per_sample": linear_time_fit(per_spp),
         }
+    # Results of a run made before a method existed lack it.
+    strategies = [m for m in STRATEGIES if m in summary]
+    methods = [m for m in METHODS if m in summary]
     cycles = summary["CYCLES"]["per_spp"]
     equal_time = {}
-    for method in STRATEGIES:
+    for method in strategies:
         own = summary[method]["per_spp"]
         rows = []
         for point in cycles:
@@ -115,6 +120,8 @@ def markdown(results):
     m = results["machine"]
     r = results["reference"]
     summary = results["summary"]
+    strategies = [m for m in STRATEGIES if m in summary]
+    methods = [m for m in METHODS if m in summary]
     lines = [
         "# Render study: Hairis strategies against Cycles",
         "",
@@ -153,11 +160,11 @@ def markdown(results):
     lines += table(["method"] + ["%d spp" % v for v in s["spps"]] + ["slope vs spp"],
                    [[method] + ["%.4f" % p["relative_rmse_corrected"]
                                 for p in summary[method]["per_spp"]]
-                    + ["%.2f" % summary[method]["rmse_vs_spp_slope"]] for method in METHODS])
+                    + ["%.2f" % summary[method]["rmse_vs_spp_slope"]] for method in methods])
     lines += ["", "Raw relative RMSE (reference noise included):", ""]
     lines += table(["method"] + ["%d spp" % v for v in s["spps"]],
                    [[method] + ["%.4f" % p["relative_rmse"] for p in summary[method]["per_spp"]]
-                    for method in METHODS])
+                    for method in methods])
     lines += ["", "## Render time (s, mean over seeds; min–max)", ""]
     lines += table(["method"] + ["%d spp" % v for v in s["spps"]] + ["overhead", "per spp"],
                    [[method] + ["%.2f (%.2f–%.2f)" % (p["seconds"], p["seconds_min"],
@@ -166,7 +173,7 @@ def markdown(results):
                     + ["%.2f s" % summary[method]["seconds_per_sample"]["overhead_seconds"],
                        "%.1f ms" % (1e3 * summary[method]["seconds_per_sample"]
                                     ["seconds_per_spp"])]
-                    for method in METHODS])
+                    for method in methods])
     lines += ["", "Overhead and per-spp cost: a least-squares line through the mean times.", "",
               "## Equal time against Cycles",
               "",
@@ -181,7 +188,7 @@ def markdown(results):
                                    for p in cycles],
                    [[method] + ["%.3f%s" % (row["ratio"], "*" if row["extrapolated"] else "")
                                 for row in summary["equal_time"][method]]
-                    for method in STRATEGIES])
+                    for method in strategies])
     lines += ["", "## Bias check",
               "",
               "Per channel (R, G, B): (mean(image) − mean(reference)) / mean(reference), in "
@@ -193,7 +200,7 @@ def markdown(results):
               ""]
     rows = []
     zs = []
-    for method in METHODS:
+    for method in methods:
         for p in summary[method]["per_spp"]:
             zs += p["bias_z"]
             rows.append([method, str(p["spp"]), fmt_percent(p["relative_bias"]),
@@ -202,12 +209,12 @@ def markdown(results):
     zs = np.array(zs)
     lines += ["", "Over all %d (method, spp, channel) cells: mean z² %.2f (1 expected when "
               "unbiased and independent), max |z| %.2f." % z_stats(zs), ""]
-    for method in METHODS:
+    for method in methods:
         own = np.array([p["bias_z"] for p in summary[method]["per_spp"]]).ravel()
         lines.append("- %s: mean z² %.2f, max |z| %.2f over %d cells; relative bias at %d spp "
                      "%s." % ((method,) + z_stats(own)[1:] + (own.size, s["spps"][-1])
                               + (fmt_percent(summary[method]["per_spp"][-1]["relative_bias"]),)))
-    others = np.array([z for method in METHODS if method != "UNIFORM"
+    others = np.array([z for method in methods if method != "UNIFORM"
                        for p in summary[method]["per_spp"] for z in p["bias_z"]])
     lines += ["", "Without UNIFORM: mean z² %.2f, max |z| %.2f over %d cells." % (
         z_stats(others)[1:] + (others.size,)), "",

@@ -82,7 +82,8 @@ def light_options(light):
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``, and how the running Blender's
     Cycles traces curves (:func:`compat.curve_backfaces`)."""
-    return {"samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
+    return {"integrator": settings.integrator.lower(),
+            "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
             "strategy": settings.strategy.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
@@ -246,8 +247,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         hair_tables = self._resolve_tables(library, data, settings)
         try:
             with build_native_scene(library, data, hair_tables) as native_scene:
-                self.update_stats("", "Rendering %d samples (%s)"
-                                  % (settings.samples, settings.strategy.lower()))
+                self.update_stats("", "Rendering %d samples (%s%s)"
+                                  % (settings.samples, settings.strategy.lower(),
+                                     ", dual scattering"
+                                     if settings.integrator == "DUAL_SCATTERING" else ""))
                 rgba, stats = native_scene.render(render_settings(settings),
                                                   ProgressReporter(self))
         finally:
@@ -264,12 +267,13 @@ class HairisRenderEngine(bpy.types.RenderEngine):
     def _resolve_tables(self, library, data, settings):
         """Tables per hair material index: current ones, auto-baked ones, or an error.
 
-        Only the TABLE strategy uses tables (the others get none). It refuses materials
-        without current tables unless Auto Bake is on, never rendering them silently wrong.
+        Only the TABLE strategy and the Dual Scattering integrator use tables (other settings
+        get none). They refuse materials without current tables unless Auto Bake is on, never
+        rendering them silently wrong.
         """
         found = {}
         problems = []
-        if settings.strategy != "TABLE":
+        if not settings.needs_tables:
             return found
         try:
             for index, material in data.hair_materials():
@@ -300,9 +304,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             for table in found.values():
                 table.close()
             raise RenderFailed(
-                "the Table strategy needs current sampling tables: %s. Bake them (Material "
+                "%s needs current sampling tables: %s. Bake them (Material "
                 "Properties > Hairis Sampling Tables > Bake) or enable Auto Bake"
-                % "; ".join(problems))
+                % ("the Table strategy" if settings.strategy == "TABLE"
+                   else "Dual Scattering", "; ".join(problems)))
         return found
 
     def _auto_bake(self, library, material, fiber, settings, status):

@@ -14,6 +14,16 @@ STRATEGY_ITEMS = (
 )
 """Values and numbers match ``hairis_strategy``."""
 
+INTEGRATOR_ITEMS = (
+    ("PATH", "Path Tracing",
+     "Unbiased path tracing of every bounce, as Cycles renders hair", 0),
+    ("DUAL_SCATTERING", "Dual Scattering",
+     "Zinke et al. 2008: light reaching hair through other strands in closed form from shadow "
+     "rays that count the strands, multiple scattering sampled from the baked tables (needs "
+     "baked tables)", 1),
+)
+"""Values match the C API's ``integrator`` (path | dual_scattering)."""
+
 N_H_ITEMS = tuple(
     (str(n), str(n), "Multiple-scattering distribution through %d strand%s"
      % (n, "" if n == 1 else "s"), i)
@@ -29,6 +39,9 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     max_bounces: IntProperty(
         name="Max Bounces", description="Total maximum number of bounces (as Cycles)",
         default=12, min=0, max=1024)
+    integrator: EnumProperty(
+        name="Integrator", description="How light reaching hair is computed",
+        items=INTEGRATOR_ITEMS, default="PATH")
     strategy: EnumProperty(
         name="Strategy", description="How hair scattering directions are sampled",
         items=STRATEGY_ITEMS, default="TABLE")
@@ -51,7 +64,7 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     auto_bake: BoolProperty(
         name="Auto Bake",
         description="Bake missing or stale sampling tables when rendering (otherwise the Table "
-                    "strategy refuses materials without current tables)",
+                    "strategy and Dual Scattering refuse materials without current tables)",
         default=True)
 
     @classmethod
@@ -64,6 +77,11 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     def unregister(cls):
         """Removes ``bpy.types.Scene.hairis``."""
         del bpy.types.Scene.hairis
+
+    @property
+    def needs_tables(self):
+        """True when rendering needs every hair material's tables."""
+        return self.strategy == "TABLE" or self.integrator == "DUAL_SCATTERING"
 
     @property
     def n_h_value(self):

@@ -136,6 +136,7 @@ class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
         layout.use_property_decorate = False
         settings = context.scene.hairis
         column = layout.column()
+        column.prop(settings, "integrator")
         column.prop(settings, "samples")
         column.prop(settings, "seed")
         column.prop(settings, "max_bounces")
@@ -161,7 +162,7 @@ class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
         sub.prop(settings, "multiple_weight")
         sub.prop(settings, "n_h")
         sub = column.column()
-        sub.active = settings.strategy == "TABLE"
+        sub.active = settings.needs_tables
         sub.prop(settings, "auto_bake")
         sub.operator("hairis.bake_tables", icon="RENDER_STILL")
         layout.separator()

@@ -1,10 +1,13 @@
 // C API: hairis_render — each hair material's sampler from the settings (the policy in
 // sampling/strategy.h), the Scene (Embree BVH) and the path tracer (render/render.h).
 #include <chrono>
+#include <deque>
+#include <mutex>
 #include <functional>
 #include <string>
 
 #include "capi_scene.h"
+#include "fiber/fiber_spec.h"
 #include "render/render.h"
 
 namespace hairis::capi {
@@ -41,6 +44,42 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     return std::move(shading).value();
 }
 
+// A fiber's dual-scattering averages (about a second of quadrature), kept for the process by
+// model and parameters: the add-on builds a new scene for every render. At most kDualCacheSize
+// fibers are kept; the oldest goes first.
+constexpr std::size_t kDualCacheSize = 64;
+std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fiber, const std::string &name) {
+    static std::mutex mutex;
+    static std::deque<std::pair<std::string, std::shared_ptr<const DualScattering>>> cache;
+    const std::string key = fiber.name() + ":" + canonical_parameters(chiang_parameters(fiber.params()));
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto &entry : cache)
+        if (entry.first == key) return entry.second;
+    Expected<DualScattering> made = DualScattering::create(fiber, DualScatteringParams{});
+    if (!made) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + made.error().message);
+    auto dual = std::make_shared<const DualScattering>(std::move(made).value());
+    if (cache.size() == kDualCacheSize) cache.pop_front();
+    cache.emplace_back(key, dual);
+    return dual;
+}
+
+// The dual-scattering data of hair material `index` (integrator=dual_scattering): its fiber's
+// averages, with the parameters the multiple tables were baked with, and those tables.
+void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, size_t index) {
+    const std::string name = "material " + std::to_string(index) + " (hair): ";
+    if (!hair.tables)
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "integrator=dual_scattering samples multiple scattering from the "
+                                                  "material's baked multiple-scattering tables, but it was added "
+                                                  "without tables; bake or load tables for it, or render with "
+                                                  "integrator=path");
+    if (hair.tables->parameters != canonical_parameters(chiang_parameters(hair.fiber->params())) ||
+        hair.tables->model != hair.fiber->name())
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "the tables were baked for " + hair.tables->model + " \"" +
+                                               hair.tables->parameters + "\", not for this fiber; bake tables for it");
+    material.dual = dual_scattering_of(*hair.fiber, name);
+    material.multiple = hair.tables->multiple;
+}
+
 }  // namespace
 
 }  // namespace hairis::capi
@@ -69,9 +108,11 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         desc.curve_backfaces = o.curve_backfaces;
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
-            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]))
-                desc.materials.push_back(HairMaterial{hair_shading(*hair, m, o.sampler)});
-            else
+            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {
+                HairMaterial material{hair_shading(*hair, m, o.sampler)};
+                if (o.render.integrator == int(Integrator::DualScattering)) add_dual_scattering(material, *hair, m);
+                desc.materials.push_back(std::move(material));
+            } else
                 desc.materials.push_back(std::get<SurfaceMaterial>(scene->materials[m]));
         }
         Expected<Scene> built = Scene::build(std::move(desc));

@@ -317,48 +317,77 @@ Rgb DualScattering::forward_spread_variance(double theta, int n_h) const {
 // ------------------------------------------------------------------------------------------
 // Shading
 
-Rgb DualScattering::multiple_f_cos(float theta_i_f, float theta_o_f, int n_h) const {
-    if (n_h < 0) return {};
-    const double theta_i = theta_i_f, theta_o = theta_o_f;
+DualScattering::Rgbd DualScattering::local_term(double theta_i, double theta_o) const {
+    const double theta_h = 0.5 * (theta_i + theta_o);
+    const double theta_d = 0.5 * (theta_o - theta_i);
+    const double cos_i = std::max(0.0, std::cos(theta_i));
+    const double cos_d2 = std::max(sqr(std::cos(theta_d)), 1e-12);
+    const Rgbd big_a = lookup(big_a_b_, theta_i);
+    const Rgbd delta = lookup(delta_b_, theta_i);
+    const Rgbd sig2 = lookup(sigma2_b_, theta_i);
+    Rgbd out;
+    for (int ch = 0; ch < 3; ++ch) {
+        const double v = std::max(sig2.v[ch], 1e-12);
+        const double f_back = big_a.v[ch] * gaussian(theta_h - delta.v[ch], v) / (kPi * cos_d2);
+        out.v[ch] = params_.d_b * f_back * cos_i;
+    }
+    return out;
+}
+
+DualScattering::Rgbd DualScattering::scattered_term(double theta_i, double theta_o, const Rgbd &t_f,
+                                                    const Rgbd &s_f2) const {
     const double theta_h = 0.5 * (theta_i + theta_o);
     const double theta_d = 0.5 * (theta_o - theta_i);
     const double cos_i = std::max(0.0, std::cos(theta_i));
     const double cos_d2 = std::max(sqr(std::cos(theta_d)), 1e-12);
     const double db = params_.d_b, df = params_.d_f;
-
     const Rgbd big_a = lookup(big_a_b_, theta_i);
     const Rgbd delta = lookup(delta_b_, theta_i);
     const Rgbd sig2 = lookup(sigma2_b_, theta_i);
-
-    Rgbd out;
-    if (n_h == 0) {
-        for (int ch = 0; ch < 3; ++ch) {
-            const double v = std::max(sig2.v[ch], 1e-12);
-            const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], v) / (kPi * cos_d2);
-            out.v[ch] = db * f_back * cos_i;
-        }
-        return to_rgb(out);
-    }
-
-    const Rgbd a_f = lookup(a_f_, theta_i);
-    const Rgbd b2f = lookup(beta2_f_, theta_i);
     std::array<Rgbd, 16> ng{};
     for (int p = 0; p < lobe_count_; ++p)
         ng[std::size_t(p)] = lookup(n_g_lobe_, theta_d, std::size_t(p) * std::size_t(params_.theta_count));
+    Rgbd out;
     for (int ch = 0; ch < 3; ++ch) {
-        const double t_f = df * std::pow(std::max(0.0, a_f.v[ch]), n_h);
-        const double s_f2 = n_h * b2f.v[ch];
+        const double spread = std::max(0.0, s_f2.v[ch]);
         double f_s = 0;
         for (int p = 0; p < lobe_count_; ++p) {
             const LobeShape &s = shapes_[std::size_t(p)];
-            const double var = std::max(sqr(double(s.beta)) + s_f2, 1e-12);
+            const double var = std::max(sqr(double(s.beta)) + spread, 1e-12);
             f_s += gaussian(theta_h - s.alpha, var) * ng[std::size_t(p)].v[ch] / cos_d2;
         }
-        const double var_b = std::max(sig2.v[ch] + s_f2, 1e-12);
-        const double f_back = 2.0 * big_a.v[ch] * gaussian(theta_h - delta.v[ch], var_b) / (kPi * cos_d2);
-        out.v[ch] = t_f * df * (f_s + kPi * db * f_back) * cos_i;
+        const double var_b = std::max(sig2.v[ch] + spread, 1e-12);
+        const double f_back = big_a.v[ch] * gaussian(theta_h - delta.v[ch], var_b) / (kPi * cos_d2);
+        out.v[ch] = t_f.v[ch] * df * (f_s + kPi * db * f_back) * cos_i;
     }
-    return to_rgb(out);
+    return out;
+}
+
+Rgb DualScattering::local_f_cos(float theta_i, float theta_o) const {
+    return to_rgb(local_term(theta_i, theta_o));
+}
+
+Rgb DualScattering::scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance) const {
+    Rgbd t_f, s_f2;
+    for (int ch = 0; ch < 3; ++ch) {
+        t_f.v[ch] = transmittance[ch];
+        s_f2.v[ch] = spread_variance[ch];
+    }
+    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2));
+}
+
+Rgb DualScattering::multiple_f_cos(float theta_i_f, float theta_o_f, int n_h) const {
+    if (n_h < 0) return {};
+    const double theta_i = theta_i_f, theta_o = theta_o_f;
+    if (n_h == 0) return to_rgb(local_term(theta_i, theta_o));
+    const Rgbd a_f = lookup(a_f_, theta_i);
+    const Rgbd b2f = lookup(beta2_f_, theta_i);
+    Rgbd t_f, s_f2;
+    for (int ch = 0; ch < 3; ++ch) {
+        t_f.v[ch] = params_.d_f * std::pow(std::max(0.0, a_f.v[ch]), n_h);
+        s_f2.v[ch] = n_h * b2f.v[ch];
+    }
+    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2));
 }
 
 }  // namespace hairis

@@ -56,8 +56,14 @@
 //
 // Shading (paper §4.3 / Fig. 6, with directFraction = 0 for n_h ≥ 1 and 1 for n_h = 0):
 //   θ_h = (θ_i + θ_o)/2, θ_d = (θ_o − θ_i)/2, tables looked up at θ_L = θ_i,
-//   f_back^direct  = 2 Ā_b g(θ_h − Δ̄_b; σ̄_b²)        / (π cos²θ_d)
-//   f_back^scatter = 2 Ā_b g(θ_h − Δ̄_b; σ̄_b² + σ_f²) / (π cos²θ_d)
+//   f_back^direct  = Ā_b g(θ_h − Δ̄_b; σ̄_b²)        / (π cos²θ_d)
+//   f_back^scatter = Ā_b g(θ_h − Δ̄_b; σ̄_b² + σ_f²) / (π cos²θ_d)
+//         DECISION: the paper prints 2 Ā_b (...) — Marschner's normalisation, whose lobes are
+//         unit Gaussians in θ_h and so carry twice their energy over θ_i (see energy_scale).
+//         Single scattering f_s here is an energy-conserving fiber (Chiang) and f_s^scatter is
+//         normalised like it (N_p^G below), so f_back is too: half the printed value, which
+//         keeps the paper's balance between f_back and f_s (its d_b = 0.7 was chosen with both
+//         in Marschner's normalisation). bench/results/dual_scattering.md has the effect.
 //   f_s^scatter    = Σ_p g(θ_h − α_p; β_p² + σ_f²) N_p^G(θ_d) / cos²θ_d      (M_p^G N_p^G)
 //   n_h ≥ 1: F = T_f d_f (f_s^scatter + π d_b f_back^scatter)          (F_direct = 0)
 //   n_h = 0: F = d_b f_back^direct (the local multiple scattering; single scattering f_s is
@@ -149,6 +155,17 @@ class DualScattering {
     /// and was clamped in Ā_b, Δ̄_b, σ̄_b (0 for a well-behaved model).
     int clamped_entries() const { return clamped_entries_; }
 
+    /// The local multiple-scattering term of a point the light reaches directly (n_h = 0):
+    /// d_b f_back^direct cos θ_i, per unit solid angle of ω_i (single scattering f_s is not in
+    /// it). The same as multiple_f_cos(θ_i, θ_o, 0).
+    Rgb local_f_cos(float theta_i, float theta_o) const;
+    /// The global term of light that crossed strands on its way, for a forward transmittance
+    /// T_f (d_f included) and spread σ_f² (radians²) gathered strand by strand along the light's
+    /// path: T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i, per channel. With
+    /// T_f = forward_transmittance(θ_i, n) and σ_f² = forward_spread_variance(θ_i, n) it is
+    /// multiple_f_cos(θ_i, θ_o, n) for n ≥ 1. Negative σ_f² is taken as 0.
+    Rgb scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance) const;
+
     /// The multiple-scattering term F·cos θ_i, averaged over azimuth, per unit solid angle of
     /// ω_i (see "Measure" above). n_h < 0 is a precondition violation and returns 0.
     Rgb multiple_f_cos(float theta_i, float theta_o, int n_h) const;
@@ -164,6 +181,8 @@ class DualScattering {
         double v[3] = {0, 0, 0};
     };
     Rgbd lookup(const std::vector<Rgbd> &table, double theta, std::size_t offset = 0) const;
+    Rgbd local_term(double theta_i, double theta_o) const;
+    Rgbd scattered_term(double theta_i, double theta_o, const Rgbd &t_f, const Rgbd &s_f2) const;
     static Rgb to_rgb(const Rgbd &c);
 
     DualScatteringParams params_;

@@ -269,7 +269,8 @@ TEST(DualScattering, MultipleTermAssemblesThePaperFormulas) {
                     const double sb2 = sqr(double(ds.backscatter_width(ti)[ch]));
                     double expected;
                     if (n == 0) {
-                        expected = d_b * 2 * big_a * gauss(th - delta, sb2) / (kPi * cd2) * std::cos(ti);
+                        // f_back: Ā_b g / (π cos²θ_d), half the paper's printed 2 Ā_b (header).
+                        expected = d_b * big_a * gauss(th - delta, sb2) / (kPi * cd2) * std::cos(ti);
                     } else {
                         const double tf = d_f * std::pow(double(ds.forward_attenuation(ti)[ch]), n);
                         const double sf2 = n * sqr(double(ds.forward_width(ti)[ch]));
@@ -277,7 +278,7 @@ TEST(DualScattering, MultipleTermAssemblesThePaperFormulas) {
                         for (int p = 0; p < 3; ++p)
                             fs += gauss(th - kShapes[p].alpha, sqr(double(kShapes[p].beta)) + sf2) *
                                   0.5 * kScale[p][ch] * test_n_forward(p) * kInvPi / cd2;
-                        const double fb = 2 * big_a * gauss(th - delta, sb2 + sf2) / (kPi * cd2);
+                        const double fb = big_a * gauss(th - delta, sb2 + sf2) / (kPi * cd2);
                         expected = tf * d_f * (fs + kPi * d_b * fb) * std::cos(ti);
                     }
                     EXPECT_NEAR(got[ch], expected, 1e-5 + 1e-4 * std::fabs(expected))

@@ -21,6 +21,7 @@
 #include "core/frame.h"
 #include "core/rng.h"
 #include "core/scratch.h"
+#include "render/dual_scattering_integrator.h"
 
 namespace hairis {
 
@@ -46,11 +47,31 @@ constexpr std::uint32_t dim(int depth, VertexDim d) {
     return kDimFirstVertex + std::uint32_t(depth) * kDimsPerVertex + std::uint32_t(d);
 }
 
+// Dual scattering's extra numbers per vertex, in a block of their own far above the path's
+// (paths stop at depth 1025), so that integrator=path draws what it always drew. Pairs: probe
+// point (0, 1), table θ_i and φ (2, 3), probe light and table node (4, 5).
+constexpr std::uint32_t kDimDualFirst = 1u << 24;
+DualRandom dual_random(const SobolSampleRng &rng, int depth) {
+    const std::uint32_t b = kDimDualFirst + std::uint32_t(depth) * kDimsPerVertex;
+    DualRandom u;
+    u.light_select = rng.get(dim(depth, kDimLightSelect));
+    u.light_u = rng.get(dim(depth, kDimLightU));
+    u.light_v = rng.get(dim(depth, kDimLightV));
+    u.probe_u = rng.get(b + 0);
+    u.probe_v = rng.get(b + 1);
+    u.table_u0 = rng.get(b + 2);
+    u.table_u1 = rng.get(b + 3);
+    u.probe_select = rng.get(b + 4);
+    u.table_u2 = rng.get(b + 5);
+    return u;
+}
+
 bool finite(Rgb c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b); }
 bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
 
 struct Counters {
     std::uint64_t rays = 0, shadow_rays = 0, dropped = 0;
+    DualWork dual;
 };
 
 // A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
@@ -89,6 +110,8 @@ class Bsdf {
 
     bool black() const { return !hair_ && surface_.black(); }
     bool is_hair() const { return hair_.has_value(); }
+    const HairBsdf *hair() const { return hair_ ? &*hair_ : nullptr; }
+    const FiberFrame &frame() const { return frame_; }
 
     // f·|cos θ_i| and the density with which sample() draws wi.
     Rgb eval(Vec3 wi, float &pdf) const {
@@ -136,6 +159,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     bool use_mis = false;  // camera rays take emission at full weight
     int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0;
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
+    const bool dual = settings.integrator == int(Integrator::DualScattering);
+    bool from_dual_hair = false;  // the ray left a hair vertex shaded by dual scattering
     alpha = 1.0f;
 
     auto add = [&](Rgb contribution) {
@@ -164,6 +189,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         }
 
         const SurfacePoint sp = scene.surface_point(origin, dir, *hit);
+        if (from_dual_hair && sp.is_curve) break;  // hair-to-hair light is the dual estimate's
         const Material &material = scene.materials()[sp.material];
         const Vec3 wo = -dir;
 
@@ -196,7 +222,20 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         if (bsdf.black()) break;
 
         // Next-event estimation.
-        if (!lights.empty()) {
+        // render() refuses hair without dual-scattering data; render_sample() path-traces it.
+        const auto *hair = dual ? std::get_if<HairMaterial>(&material) : nullptr;
+        const bool dual_vertex = hair && hair->dual && hair->multiple;
+        if (dual_vertex) {
+            DualVertex v;
+            v.point = &sp;
+            v.material = hair;
+            v.bsdf = bsdf.hair();
+            v.frame = bsdf.frame();
+            v.wo = wo;
+            const std::uint64_t before = counters.dual.rays;
+            add(beta * dual_scattering_light(scene, v, dual_random(rng, depth), counters.dual));
+            counters.shadow_rays += counters.dual.rays - before;
+        } else if (!lights.empty()) {
             const auto ls = lights.sample(sp.position, rng.get(dim(depth, kDimLightSelect)),
                                           rng.get(dim(depth, kDimLightU)),
                                           rng.get(dim(depth, kDimLightV)));
@@ -225,6 +264,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         if (!bsdf.sample(rng.get(dim(depth, kDimBsdf0)), rng.get(dim(depth, kDimBsdf1)),
                          rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy))
             break;
+        from_dual_hair = dual_vertex;
         if (bsdf.is_hair())
             last_segment = ++transmission_bounces > settings.max_transmission_bounces;
         else if (glossy)
@@ -249,7 +289,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
 }
 
 Status validate(const RenderSettings &s) {
-    return first_error(check::count_in_range("samples", s.samples, 1, 1 << 24),
+    return first_error(check::count_in_range("integrator", s.integrator, 0, 1),
+                       check::count_in_range("samples", s.samples, 1, 1 << 24),
                        check::count_in_range("max_bounces", s.max_bounces, 0, 1024),
                        check::count_in_range("max_diffuse_bounces", s.max_diffuse_bounces, 0,
                                              1024),
@@ -260,6 +301,19 @@ Status validate(const RenderSettings &s) {
                        check::count_in_range("threads", s.threads, 0, 1024),
                        check::count_in_range("tile_size", s.tile_size, 1, 4096),
                        check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024));
+}
+
+// Dual scattering needs every hair material's dual-scattering data and multiple table.
+Status check_integrator(const Scene &scene, const RenderSettings &s) {
+    if (s.integrator != int(Integrator::DualScattering)) return std::nullopt;
+    const std::vector<Material> &materials = scene.materials();
+    for (std::size_t m = 0; m < materials.size(); ++m)
+        if (const auto *hair = std::get_if<HairMaterial>(&materials[m]))
+            if (!hair->dual || !hair->multiple)
+                return Error{"integrator=dual_scattering: hair material " + std::to_string(m) +
+                             " has no " + (hair->dual ? "multiple-scattering table" : "dual-scattering data") +
+                             " (HairMaterial::dual and ::multiple are needed; integrator=path needs neither)"};
+    return std::nullopt;
 }
 
 struct Tile {
@@ -286,6 +340,7 @@ Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int
 Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
               const std::function<bool(float)> &progress, RenderStats *stats_out) {
     if (auto e = validate(settings)) return e;
+    if (auto e = check_integrator(scene, settings)) return e;
     if (!rgba) return Error{"rgba must not be null"};
     const auto start = std::chrono::steady_clock::now();
 

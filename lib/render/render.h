@@ -36,6 +36,10 @@
 //    what the sampler follows.
 //  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
 //    min(1, sqrt(max throughput component)) and division by it (unbiased).
+//  - integrator=dual_scattering: at hair vertices next-event estimation is replaced by the
+//    dual-scattering estimate (render/dual_scattering_integrator.h: light, probe and
+//    multiple-table samples whose shadow rays let hair through), the continuation is drawn as
+//    above and a continuation that then reaches hair ends there. Meshes are path-traced.
 //  - A contribution that is NaN or infinite is dropped (counted in RenderStats), never
 //    accumulated; a non-finite throughput ends the path (counted too).
 //
@@ -60,8 +64,15 @@
 
 namespace hairis {
 
+/// How hair vertices are shaded: path tracing (unbiased), or dual scattering
+/// (render/dual_scattering_integrator.h), whose hair materials need HairMaterial::dual and
+/// ::multiple.
+enum class Integrator { Path = 0, DualScattering = 1 };
+
 /// How to render.
 struct RenderSettings {
+    /// An Integrator: "path" or "dual_scattering".
+    int integrator = int(Integrator::Path);
     /// Samples per pixel, in [1, 2^24].
     int samples = 64;
     /// Cycles' Max Bounces (Total), in [0, 1024]; Blender's default is 12.
@@ -95,6 +106,7 @@ struct RenderSettings {
 /// The option names of RenderSettings (core/options.h's field descriptions).
 template <typename Fields>
 void describe(Fields &f, RenderSettings &s) {
+    f.choice("integrator", s.integrator, {"path", "dual_scattering"});
     f.field("samples", s.samples, 1, 1 << 24);
     f.field("max_bounces", s.max_bounces, 0, 1024);
     f.field("max_diffuse_bounces", s.max_diffuse_bounces, 0, 1024);

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <string>
 #include <sys/types.h>
+#include <vector>
 
 namespace hairis {
 
@@ -51,12 +52,14 @@ struct GeometryInfo {
     std::uint32_t index = 0;  // into curves or meshes
 };
 
-// The context handed to Embree: the primitives a ray must ignore, and whether the inside of
-// a curve tube counts (CurveBackfaces::Hit).
+// The context handed to Embree: the primitives a ray must ignore, whether the inside of a
+// curve tube counts (CurveBackfaces::Hit) and, for rays that let hair through, where the hair
+// hits go.
 struct TraceContext {
     RTCIntersectContext rtc;
     PrimRef skip_a, skip_b;
     bool hit_curve_backfaces = false;
+    std::vector<StrandCrossing> *strands = nullptr;
 };
 
 bool skipped(const TraceContext *ctx, unsigned geom, unsigned prim) {
@@ -88,8 +91,27 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
                         RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
         const bool culled = d > 0.0f && !ctx->hit_curve_backfaces;
         if (culled || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
-                              curve_of[RTCHitN_primID(args->hit, args->N, i)]))
+                              curve_of[RTCHitN_primID(args->hit, args->N, i)])) {
             args->valid[i] = 0;
+        } else if (ctx->strands) {
+            // Let hair through: record the hit (its distance is the ray's tfar) and reject it.
+            // Embree may report one hit of a round curve many times over (hundreds for a
+            // straight one); the repeats are recorded once.
+            StrandCrossing c;
+            c.t = RTCRayN_tfar(args->ray, args->N, i);
+            c.segment = {RTCHitN_geomID(args->hit, args->N, i), RTCHitN_primID(args->hit, args->N, i)};
+            c.u = RTCHitN_u(args->hit, args->N, i);
+            std::vector<StrandCrossing> &out = *ctx->strands;
+            bool repeat = false;
+            for (std::size_t k = out.size(); k-- > 0 && out.size() - k <= 8;)
+                if (out[k].segment.geometry == c.segment.geometry &&
+                    out[k].segment.primitive == c.segment.primitive && out[k].t == c.t) {
+                    repeat = true;
+                    break;
+                }
+            if (!repeat) out.push_back(c);
+            args->valid[i] = 0;
+        }
     }
 }
 
@@ -612,6 +634,79 @@ bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip
     ray.flags = 0;
     rtcOccluded1(impl_->rtc_scene, &ctx.rtc, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to −inf on a hit
+}
+
+std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                             PrimRef skip_a, PrimRef skip_b,
+                                             std::vector<StrandCrossing> &strands) const {
+    strands.clear();
+    if (!traceable(origin, dir, tmin, tmax)) return Hit{tmin, PrimRef{}, 0.0f, 0.0f};  // blocked
+    TraceContext ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.skip_a = skip_a;
+    ctx.skip_b = skip_b;
+    ctx.strands = &strands;
+    RTCRayHit rh;
+    rh.ray.org_x = origin.x;
+    rh.ray.org_y = origin.y;
+    rh.ray.org_z = origin.z;
+    rh.ray.tnear = tmin;
+    rh.ray.dir_x = dir.x;
+    rh.ray.dir_y = dir.y;
+    rh.ray.dir_z = dir.z;
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->rtc_scene, &ctx.rtc, &rh);
+    std::optional<Hit> mesh;
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+        mesh = Hit{rh.ray.tfar, {rh.hit.geomID, rh.hit.primID}, rh.hit.u, rh.hit.v};
+
+    // Hair hits recorded before a nearer triangle was found lie behind it.
+    const float t_end = mesh ? mesh->t : tmax;
+    strands.erase(std::remove_if(strands.begin(), strands.end(),
+                                 [&](const StrandCrossing &c) { return !(c.t < t_end); }),
+                  strands.end());
+    std::sort(strands.begin(), strands.end(),
+              [](const StrandCrossing &a, const StrandCrossing &b) { return a.t < b.t; });
+    // One entry per crossing: where neighbouring segments of a curve overlap at their joint
+    // (or a primitive is reported twice) the hits lie within a tube's chord of each other.
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < strands.size(); ++k) {
+        StrandCrossing c = strands[k];
+        const GeometryInfo &info = impl_->geometries[c.segment.geometry];
+        const CurveGeometry &geo = impl_->curves[info.index];
+        Vec3 dpdu;
+        curve_point(c.segment, c.u, &dpdu, &c.radius);
+        c.tangent = safe_normalize(dpdu);
+        if (dot(c.tangent, c.tangent) == 0.0f) {
+            const std::uint32_t first = geo.segments[c.segment.primitive];
+            const Float4 &a = geo.cvs[first + 1], &b = geo.cvs[first + 2];
+            c.tangent = safe_normalize(Vec3{b.x - a.x, b.y - a.y, b.z - a.z});
+        }
+        c.material = geo.material;
+        const float sin_cross = std::max(length(cross(dir, c.tangent)), 0.05f);
+        bool duplicate = false;
+        for (std::size_t j = kept; j-- > 0 && kept - j <= 4;) {
+            const StrandCrossing &prev = strands[j];
+            if (prev.segment.geometry != c.segment.geometry) continue;
+            const std::uint32_t pa = prev.segment.primitive, pb = c.segment.primitive;
+            if (geo.curve_of[pa] != geo.curve_of[pb] || (pa > pb ? pa - pb : pb - pa) > 1) continue;
+            if (c.t - prev.t < 2.0f * (c.radius + prev.radius) / sin_cross) {
+                duplicate = true;
+                break;
+            }
+        }
+        if (duplicate) continue;
+        strands[kept++] = c;
+    }
+    strands.resize(kept);
+    return mesh;
 }
 
 Vec3 Scene::curve_point(PrimRef segment, float u, Vec3 *derivative, float *radius) const {

@@ -43,6 +43,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -52,13 +53,21 @@
 #include "core/math.h"
 #include "fiber/hair_inputs.h"
 #include "render/surface_material.h"
+#include "fiber/dual_scattering.h"
 #include "sampling/hair_bsdf.h"
+#include "sampling/sampling_table.h"
 
 namespace hairis {
 
 /// A hair material: the Cycles-exact fiber and the strategy that draws ω_i for it.
 struct HairMaterial {
+    explicit HairMaterial(HairShading shading_) : shading(std::move(shading_)) {}
     HairShading shading;
+    /// What integrator=dual_scattering shades with (render/dual_scattering_integrator.h): the
+    /// fiber's dual-scattering averages and its baked multiple-scattering tables. Null for the
+    /// path tracer.
+    std::shared_ptr<const DualScattering> dual;
+    std::shared_ptr<const MultipleTable> multiple;
 };
 
 /// A Lambertian surface with optional emission (radiance, on both sides as in Cycles). A pure
@@ -165,6 +174,17 @@ struct Hit {
     float u = 0, v = 0;  ///< Embree's hit coordinates (curve parameter for curves)
 };
 
+/// A hair strand a ray crosses (Scene::trace_through_hair): where, on which segment and at
+/// which curve parameter, the strand's unit tangent and radius there and its material.
+struct StrandCrossing {
+    float t = 0;
+    PrimRef segment;
+    float u = 0;
+    Vec3 tangent;
+    float radius = 0;
+    std::uint32_t material = 0;
+};
+
 /// What shading needs at a hit point.
 struct SurfacePoint {
     Vec3 position;
@@ -229,6 +249,14 @@ class Scene {
     /// intersect()). Hair is opaque to shadow rays, as in Cycles.
     bool occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip_a = {},
                   PrimRef skip_b = {}) const;
+    /// The ray (tmin, tmax) with hair let through (dual scattering's shadow rays): returns the
+    /// first mesh triangle it hits (nullopt when none; skip_a, skip_b and curve insides are
+    /// ignored as in occluded()) and puts the strands it crosses before that hit into
+    /// `strands` (cleared first), one entry per crossing of a tube, in order of t. A crossing
+    /// is reported once even where two segments of a curve overlap at their joint.
+    std::optional<Hit> trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                          PrimRef skip_a, PrimRef skip_b,
+                                          std::vector<StrandCrossing> &strands) const;
     /// Shading data of a hit of the ray (origin, dir).
     SurfacePoint surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const;
     /// The node inputs a curve hit's curve set gives (HairCurves::inputs) at the hit, in

@@ -100,7 +100,7 @@ static const char *const kinds[][2] = {
     {"camera", "matrix=1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1;orthographic=0;"
                "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
                "clip_start=0;clip_end=3.40282347e+38"},
-    {"render", "samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
+    {"render", "integrator=path;samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
                "max_transmission_bounces=12;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
@@ -1259,7 +1259,7 @@ typedef struct render_settings {
     long long samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
         max_transmission_bounces, threads, tile_size, rr_start_bounce, n_h;
     unsigned long long seed;
-    int strategy, film_transparent, curve_backfaces;
+    int integrator, strategy, film_transparent, curve_backfaces;
     double multiple_weight;
 } render_settings;
 
@@ -1268,7 +1268,9 @@ static int read_render_settings(const char *text, render_settings *r)
     options o;
     const char *flags[4] = {"0", "1", "false", "true"};
     const char *backfaces[2] = {"ignore", "hit"};
+    const char *integrators[2] = {"path", "dual_scattering"};
     if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
+        word(&o, "integrator", integrators, 2, &r->integrator) != HAIRIS_OK ||
         integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
         integer_in(&o, "max_bounces", 0, 1024, &r->max_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_diffuse_bounces", 0, 1024, &r->max_diffuse_bounces) != HAIRIS_OK ||
@@ -1304,10 +1306,10 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     if (!f) return;
     fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
                "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
-               "tile_size=%lld film_transparent=%d curve_backfaces=%s\n",
+               "tile_size=%lld film_transparent=%d curve_backfaces=%s integrator=%d\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_transmission_bounces, r->tile_size,
-            r->film_transparent, r->curve_backfaces ? "hit" : "ignore");
+            r->film_transparent, r->curve_backfaces ? "hit" : "ignore", r->integrator);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,
@@ -1347,6 +1349,19 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
     if (!s->has_camera)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                     "scene has no camera: call hairis_scene_set_camera before hairis_render");
+    /* integrator=dual_scattering samples multiple scattering from every hair material's tables. */
+    if (r.integrator == 1)
+        for (int i = 0; i < s->material_count; ++i) {
+            if (s->material_is_hair[i] && !s->material_has_tables[i])
+                return fail(HAIRIS_ERROR_INVALID_TABLE,
+                            "material %d (hair): integrator=dual_scattering samples multiple "
+                            "scattering from the material's baked multiple-scattering tables, but "
+                            "it was added without tables",
+                            i);
+            if (s->material_is_hair[i] && !s->material_tables_match[i])
+                return fail(HAIRIS_ERROR_INVALID_TABLE,
+                            "material %d (hair): the tables were baked for other parameters", i);
+        }
     if (r.strategy == 3)
         for (int i = 0; i < s->material_count; ++i) {
             if (s->material_is_hair[i] && !s->material_has_tables[i])

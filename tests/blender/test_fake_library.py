@@ -198,6 +198,7 @@ def test_engine_renders_scene():
     assert summary_value(summary, "strategy") == "1" and summary_value(summary, "n_h") == "4"
     assert summary_value(summary, "threads") == "1"
     assert summary_value(summary, "max_bounces") == "5"
+    assert summary_value(summary, "integrator") == "0"  # PATH, the default
     assert float(summary_value(summary, "multiple_weight")) == 0.5
     # Cycles with Embree 4 (Blender's builds from 3.6) hits strands from inside their tube.
     backfaces = "hit" if helpers.VERSION >= (3, 6, 0) else "ignore"
@@ -227,6 +228,27 @@ def test_table_strategy_refuses_missing_tables():
     message = expect_render_error(scene, "the Table strategy needs current sampling tables",
                                   "'Hair'", "'Curly'", "enable Auto Bake")
     assert "no sampling tables" in message
+
+
+def test_dual_scattering_needs_tables_whatever_the_strategy():
+    """DUAL_SCATTERING reaches the library and takes every hair material's tables, also with
+    a strategy that needs none; without tables and auto bake it is refused naming them."""
+    scene = helpers.make_test_scene()
+    scene.hairis.integrator = "DUAL_SCATTERING"
+    scene.hairis.strategy = "ANALYTIC"
+    scene.hairis.auto_bake = False
+    message = expect_render_error(scene, "Dual Scattering needs current sampling tables",
+                                  "'Hair'", "'Curly'", "enable Auto Bake")
+    assert "no sampling tables" in message
+    scene.hairis.auto_bake = True
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "integrator") == "1"
+    assert summary_value(summary, "strategy") == "1"
+    assert summary.count("tables=1") == 2, summary
+    scene.hairis.integrator = "PATH"
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "integrator") == "0"
+    assert "tables=1" not in summary, summary
 
 
 def test_auto_bake_leaves_blend_data_alone():
@@ -395,6 +417,7 @@ helpers.run([
     test_sampler_and_eval,
     test_engine_renders_scene,
     test_table_strategy_refuses_missing_tables,
+    test_dual_scattering_needs_tables_whatever_the_strategy,
     test_auto_bake_leaves_blend_data_alone,
     test_bake_operator_saved_blend,
     test_bake_operator_unsaved_blend_packs,

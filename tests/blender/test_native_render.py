@@ -145,6 +145,34 @@ def test_each_strategy_renders():
         assert pixels.reshape(-1, 4)[:, :3].mean() > 1e-3, "%s rendered black" % strategy
 
 
+def test_dual_scattering_renders():
+    """F12 with the Dual Scattering integrator: finite, not black, and within a factor of two
+    of the path tracer's image mean (a sanity bound: dual scattering approximates multiple
+    scattering; its measured bias is in bench/results/dual_scattering.md)."""
+    means = {}
+    for integrator in ("PATH", "DUAL_SCATTERING"):
+        SCENE.hairis.integrator = integrator
+        SCENE.hairis.strategy = "TABLE"
+        SCENE.hairis.samples = 16
+        bpy.ops.render.render()
+        path = os.path.join(ARGS.workdir, "integrator_%s.exr" % integrator)
+        SCENE.render.image_settings.file_format = "OPEN_EXR"
+        SCENE.render.image_settings.color_depth = "32"
+        bpy.data.images["Render Result"].save_render(path, scene=SCENE)
+        image = bpy.data.images.load(path, check_existing=False)
+        pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
+        image.pixels.foreach_get(pixels)
+        bpy.data.images.remove(image)
+        assert np.all(np.isfinite(pixels)), integrator
+        means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
+    SCENE.hairis.integrator = "PATH"
+    assert means["DUAL_SCATTERING"] > 1e-3, "dual scattering rendered black"
+    if not FAKE:
+        ratio = means["DUAL_SCATTERING"] / means["PATH"]
+        print("dual scattering / path image mean: %.3f" % ratio)
+        assert 0.5 < ratio < 2.0, ratio
+
+
 def test_strategies_agree():
     """Every strategy's mean image agrees with ANALYTIC's within the per-tile noise bound.
 
@@ -268,6 +296,7 @@ helpers.run([
     test_library_loads,
     test_bake_operator,
     test_each_strategy_renders,
+    test_dual_scattering_renders,
     test_strategies_agree,
     test_convergence,
     test_cancel_within_one_second,

@@ -296,6 +296,7 @@ static void test_defaults(void)
     expect_default("sampler", "strategy", "table");
     expect_default("sampler", "multiple_weight", "0");
     expect_default("sampler", "n_h", "2");
+    expect_default("render", "integrator", "path");
     expect_default("render", "samples", "64");
     expect_default("render", "max_bounces", "12");
     expect_default("render", "max_diffuse_bounces", "4");
@@ -462,6 +463,7 @@ static void test_option_strings(void)
         {"sampler", "strategy=9", "strategy", "analytic"},
         {"sampler", "strategy=TABLE", "strategy", "gaussian"},
         {"render", "strategy=tables", "strategy", "uniform"},
+        {"render", "integrator=dual", "integrator", "dual_scattering"},
         {"bake", "source=2", "source", "gaussian"},
         {"area", "shape=hexagon", "shape", "ellipse"},
         {"render", "film_transparent=2", "film_transparent", "true"},
@@ -1395,6 +1397,35 @@ static void test_render(void)
         CHECK(stat_of("cancelled") == 0, "cancelled: \"%s\"", stats);
     }
 
+    /* Dual scattering: with either sampler for the direct term, an image of its own (not the
+     * path tracer's), the same for any thread count. */
+    {
+        static float path[W * H * 4];
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=2"), path, NULL,
+                            NULL) == HAIRIS_OK,
+              "path reference");
+        const char *direct[2] = {"table", "analytic"};
+        for (int k = 0; k < 2; ++k) {
+            CHECK(hairis_render(scene, tiny_settings(s, direct[k], ";integrator=dual_scattering;seed=7;threads=2"),
+                                rgba, NULL, NULL) == HAIRIS_OK,
+                  "dual scattering with strategy %s", direct[k]);
+            CHECK_NO_ERROR();
+            CHECK(pixels_ok(rgba), "dual %s: pixels finite, >= 0, alpha 1", direct[k]);
+            CHECK(pixel_sum(rgba, W * H) > 0.0, "dual %s: the image is not black", direct[k]);
+            CHECK(stat_of("shadow_rays") > 0, "dual %s: shadow rays: \"%s\"", direct[k],
+                  hairis_last_render_stats());
+        }
+        CHECK(memcmp(rgba, path, sizeof rgba) != 0, "dual scattering is not the path tracer");
+        CHECK(hairis_render(scene, tiny_settings(s, "analytic", ";integrator=dual_scattering;seed=7;threads=1"),
+                            again, NULL, NULL) == HAIRIS_OK,
+              "dual scattering, 1 thread");
+        CHECK(memcmp(rgba, again, sizeof rgba) == 0, "dual: bit-identical with 1 and 2 threads");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";integrator=path;seed=7;threads=2"),
+                            again, NULL, NULL) == HAIRIS_OK,
+              "integrator=path");
+        CHECK(memcmp(path, again, sizeof again) == 0, "integrator=path is the default");
+    }
+
     /* Same seed, same image, whatever the thread count or tile size; another seed differs. */
     {
         CHECK(hairis_render(scene, tiny_settings(s, "table", ";seed=7;threads=2"), rgba, NULL,
@@ -1546,6 +1577,12 @@ static void test_render(void)
         CHECK(hairis_render(no_tables, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) ==
                   HAIRIS_OK,
               "ANALYTIC needs no tables");
+        CHECK(hairis_render(no_tables, tiny_settings(s, "analytic", ";integrator=dual_scattering"), rgba,
+                            NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+              "dual scattering without tables is refused, whatever the strategy");
+        CHECK_ERROR_MENTIONS("material 0");
+        CHECK_ERROR_MENTIONS("integrator=dual_scattering");
+        CHECK_ERROR_MENTIONS("without tables");
         hairis_scene_destroy(no_tables);
     }
 
@@ -1560,6 +1597,11 @@ static void test_render(void)
         CHECK(hairis_render(mismatch, tiny_settings(s, "uniform", ""), rgba, NULL, NULL) ==
                   HAIRIS_OK,
               "UNIFORM ignores the tables");
+        CHECK(hairis_render(mismatch, tiny_settings(s, "uniform", ";integrator=dual_scattering"), rgba,
+                            NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+              "dual scattering with mismatched tables is refused");
+        CHECK_ERROR_MENTIONS("material 0");
+        CHECK_ERROR_MENTIONS("baked for");
         hairis_scene_destroy(mismatch);
     }
 

@@ -164,14 +164,17 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options);
 /**
  * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
- * wants). Settings (options): samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
+ * wants). Settings (options): integrator (path | dual_scattering), samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
  * max_transmission_bounces, strategy, multiple_weight, n_h, seed, threads, tile_size,
  * film_transparent, curve_backfaces = ignore (default) | hit: whether a ray that meets a
  * curve from inside its tube (it started inside another, overlapping strand) passes, as in
  * Cycles built with Embree 3 (Blender 3.4), or hits it, as in Cycles with Embree 4 (Blender's
  * builds from 3.6: 4.5, 5.0). progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
- * called on the calling thread. A scene without camera or geometry is refused. Each call builds the scene anew, so
+ * called on the calling thread. integrator=dual_scattering shades hair by dual scattering
+ * (lib/render/dual_scattering_integrator.h) and needs every hair material's tables
+ * (HAIRIS_ERROR_INVALID_TABLE naming the material otherwise). A scene without camera or
+ * geometry is refused. Each call builds the scene anew, so
  * a scene can be rendered again with other settings, also from several threads at once.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,

@@ -1,0 +1,306 @@
+"""Dual scattering study (issue 14): bias and noise of Hairis' DUAL_SCATTERING integrator
+against converged path tracing, and its error at equal time against Cycles 3.4.
+
+Runs inside Blender through tests/blender/run_test.py (bench/dual_scattering_study does it and
+then writes the report):
+
+    /usr/bin/python3 tests/blender/run_test.py --blender blender --zip build/hairis-addon.zip \\
+        --timeout 20000 bench/dual_scattering_study.py
+
+Cases: particle hair on a diffuse sphere, in three colours (Principled Hair Melanin 0.1, 0.5,
+0.9; Melanin Redness 0.5, Roughness and Radial Roughness 0.3) and two lightings (a sun with a
+world colour; an area light in a black world), 8 bounces. Per case, in one Blender run:
+
+1. a hair mask: a transparent-film Cycles render with the sphere itself hidden (its hair
+   stays), mask = alpha > 0.5;
+2. the reference: Hairis PATH (TABLE strategy) at REF_SPP samples, seed 1000, and Cycles at
+   CYCLES_REF_SPP (seed 1000) as a check of the reference (their per-channel means);
+3. DUAL_SCATTERING at each of SPPS, PATH and Cycles at each of PATH_SPPS, two seeds each
+   (1 and 2), every render timed (wall time of bpy.ops.render.render(), one thread for Hairis
+   and for Cycles, after a warm-up render of each method that also bakes the tables and
+   computes the dual-scattering averages);
+4. per render: the per-channel mean error over the hair pixels against the reference, the
+   noise-corrected RMSE over the hair pixels (the reference's own noise, estimated from its two
+   halves, subtracted), and the variance from the two seeds.
+
+Writes bench/results/dual_scattering.json and dual_scattering_images.npz; the report (tables,
+the crossover times, difference images) is bench/dual_scattering_report.py's.
+
+Environment: HAIRIS_DUAL_RESOLUTION (64x64), HAIRIS_DUAL_REF_SPP (1024),
+HAIRIS_DUAL_CYCLES_REF_SPP (256; 0 leaves Cycles' reference out), HAIRIS_DUAL_SPPS (1,4,16,64),
+HAIRIS_DUAL_PATH_SPPS (4,16,64), HAIRIS_DUAL_CASES (all: blonde_sun, brunette_sun, black_sun,
+blonde_area, brunette_area, black_area), HAIRIS_DUAL_OUT (bench/results), HAIRIS_DUAL_PROBE=1
+(one render of each method at 4 spp per case, timings only).
+"""
+
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import time
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.join(ROOT, "tests", "blender"))
+import helpers  # noqa: E402
+
+ARGS, PACKAGE = helpers.setup()
+if not os.path.isfile(helpers.bundled_library(PACKAGE)):
+    helpers.skip("libhairis.so is not built yet (looked for %s)"
+                 % helpers.bundled_library(PACKAGE))
+
+RESOLUTION = tuple(int(v) for v in os.environ.get("HAIRIS_DUAL_RESOLUTION", "64x64").split("x"))
+REF_SPP = int(os.environ.get("HAIRIS_DUAL_REF_SPP", "1024"))
+CYCLES_REF_SPP = int(os.environ.get("HAIRIS_DUAL_CYCLES_REF_SPP", "256"))
+SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_SPPS", "1,4,16,64").split(",")]
+PATH_SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_PATH_SPPS", "4,16,64").split(",")]
+OUT = os.environ.get("HAIRIS_DUAL_OUT", os.path.join(HERE, "results"))
+PROBE = os.environ.get("HAIRIS_DUAL_PROBE", "0") == "1"
+BOUNCES = 8
+REF_SEED = 1000
+SEEDS = (1, 2)
+COLOURS = {"blonde": 0.1, "brunette": 0.5, "black": 0.9}
+LIGHTINGS = ("sun", "area")
+ALL_CASES = ["%s_%s" % (c, l) for l in LIGHTINGS for c in COLOURS]
+CASES = os.environ.get("HAIRIS_DUAL_CASES", ",".join(ALL_CASES)).split(",")
+METHODS = ("DUAL", "PATH", "CYCLES")
+START = time.monotonic()
+
+
+def log(message):
+    """Prints with a timestamp, flushed (Blender buffers stdout)."""
+    print("[dual_study %7.1f s] %s" % (time.monotonic() - START, message), flush=True)
+
+
+def machine_info():
+    """nproc, CPU model, load, Blender version, git commit."""
+    model = ""
+    try:
+        with open("/proc/cpuinfo") as cpuinfo:
+            for line in cpuinfo:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    try:
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                universal_newlines=True).stdout.strip()
+    except OSError:
+        commit = ""
+    return {"nproc": len(os.sched_getaffinity(0)), "cpu_model": model,
+            "platform": platform.platform(), "blender_version": bpy.app.version_string,
+            "git_commit": commit, "load_average_start": list(os.getloadavg())}
+
+
+def look_at(obj, target):
+    """Points an object's −Z axis at ``target`` (+Y up)."""
+    direction = Vector(target) - obj.location
+    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+
+
+def make_case_scene(colour, lighting):
+    """Particle hair of ``colour`` on a diffuse sphere under ``lighting``, both engines alike."""
+    scene = helpers.reset()
+    camera = helpers.make_camera(scene, location=(0.0, -4.6, 1.2), resolution=RESOLUTION,
+                                 percentage=100)
+    look_at(camera, (0.0, 0.0, 0.55))
+    if lighting == "sun":
+        helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+        helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(1.0),
+                           rotation=(math.radians(40), 0.0, math.radians(35)))
+    else:
+        helpers.make_world(scene, color=(0.0, 0.0, 0.0), strength=0.0)
+        light = helpers.make_light(scene, "AREA", "Panel", location=(2.0, -2.2, 2.6),
+                                   energy=250.0, shape="SQUARE", size=1.2)
+        look_at(light, (0.0, 0.0, 0.6))
+    hair = helpers.make_hair_material("Hair", "MELANIN", **{
+        "Melanin": COLOURS[colour], "Melanin Redness": 0.5, "Roughness": 0.3,
+        "Radial Roughness": 0.3, "Coat": 0.0, "IOR": 1.55, "Random Color": 0.0,
+        "Random Roughness": 0.0})
+    skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    sphere = helpers.make_particle_hair(scene, count=1500, children=8, location=(0.0, 0.0, 0.0),
+                                        scale=1.0, hair_material=hair, skin_material=skin)
+    settings = sphere.modifiers["Hair"].particle_system.settings
+    settings.hair_length = 0.5
+    settings.radius_scale = 0.006
+    settings.root_radius = 1.0
+    settings.tip_radius = 0.5
+    settings.child_radius = 0.08
+    settings.render_step = 3
+    helpers.match_cycles(scene, 4, BOUNCES)
+    scene.cycles.diffuse_bounces = 4  # Hairis' max_diffuse_bounces default
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = 1
+    hairis = scene.hairis
+    hairis.max_bounces = BOUNCES
+    hairis.strategy = "TABLE"
+    hairis.auto_bake = True
+    hairis.threads = 1
+    bpy.context.view_layer.update()
+    return scene, sphere
+
+
+def render(scene, method, samples, seed):
+    """(image, seconds) of ``method`` (DUAL, PATH or CYCLES) at ``samples`` spp."""
+    helpers.set_samples(scene, samples)
+    if method != "CYCLES":
+        scene.hairis.integrator = "DUAL_SCATTERING" if method == "DUAL" else "PATH"
+    engine = "CYCLES" if method == "CYCLES" else "HAIRIS"
+    image, seconds = helpers.render_pixels(scene, engine, seed, ARGS.workdir)
+    assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % method
+    return image, seconds
+
+
+def hair_mask(scene, sphere):
+    """Pixels the hair covers: alpha > 0.5 of a transparent-film Cycles render without the
+    sphere (the add-on does not pass Film > Transparent to Hairis)."""
+    sphere.show_instancer_for_render = False
+    scene.render.film_transparent = True
+    helpers.set_samples(scene, 16)
+    scene.render.engine = "CYCLES"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    bpy.ops.render.render()
+    path = os.path.join(ARGS.workdir, "mask.exr")
+    bpy.data.images["Render Result"].save_render(path, scene=scene)
+    image = bpy.data.images.load(path)
+    width, height = image.size
+    pixels = np.empty(width * height * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    os.remove(path)
+    sphere.show_instancer_for_render = True
+    scene.render.film_transparent = False
+    return pixels.reshape(height, width, 4)[..., 3] > 0.5
+
+
+def errors(image, reference, mask, ref_mse_channel):
+    """Per-channel mean error, noise-corrected MSE and raw MSE over the mask."""
+    d = (image - reference)[mask]
+    ref_mean = reference[mask].mean(axis=0)
+    mse_channel = np.mean(d ** 2, axis=0)
+    return {
+        "channel_mean": image[mask].mean(axis=0).tolist(),
+        "relative_mean_error": (d.mean(axis=0) / ref_mean).tolist(),
+        "mean_error_se": np.sqrt(mse_channel / d.shape[0]).tolist(),
+        "mse": float(mse_channel.mean()),
+        "mse_corrected": float(max(mse_channel.mean() - ref_mse_channel.mean(), 0.0)),
+        "whole_image_relative_mean_error":
+            ((image - reference).reshape(-1, 3).mean(axis=0)
+             / reference.reshape(-1, 3).mean(axis=0)).tolist(),
+    }
+
+
+def study_case(name, keep):
+    """Every render of one case; returns its record."""
+    colour, lighting = name.split("_")
+    scene, sphere = make_case_scene(colour, lighting)
+    mask = hair_mask(scene, sphere)
+    log("%s: %d hair pixels of %d" % (name, int(mask.sum()), mask.size))
+    warmup = {}
+    for method in METHODS:
+        _, seconds = render(scene, method, 1, 1)
+        warmup[method] = seconds
+        log("%s warm-up %s: %.2f s" % (name, method, seconds))
+    if PROBE:
+        for method in METHODS:
+            image, seconds = render(scene, method, 4, 1)
+            log("%s probe %s 4 spp: %.2f s, hair mean %s" % (name, method, seconds,
+                                                              np.round(image[mask].mean(axis=0), 4)))
+            keep["%s_%s_probe" % (name, method.lower())] = image.astype(np.float32)
+        keep["%s_mask" % name] = mask
+        return {"warmup_seconds": warmup}
+
+    # The reference in two halves of REF_SPP/2 samples (seeds 1000 and 1001): their difference
+    # estimates the reference's own noise.
+    half_a, time_a = render(scene, "PATH", REF_SPP // 2, REF_SEED)
+    half_b, time_b = render(scene, "PATH", REF_SPP // 2, REF_SEED + 1)
+    reference = 0.5 * (half_a + half_b)
+    ref_mse_channel = np.mean(((half_a - half_b)[mask]) ** 2, axis=0) / 4.0
+    ref_mean = reference[mask].mean(axis=0)
+    log("%s reference: PATH %d spp in %.1f s, hair mean %s, own relative RMSE %.4f"
+        % (name, REF_SPP, time_a + time_b, np.round(ref_mean, 4),
+           math.sqrt(ref_mse_channel.mean()) / ref_mean.mean()))
+    record = {"warmup_seconds": warmup, "hair_pixels": int(mask.sum()),
+              "reference": {"spp": REF_SPP, "seconds": time_a + time_b,
+                            "channel_mean": ref_mean.tolist(),
+                            "noise_mse": float(ref_mse_channel.mean())}}
+    if CYCLES_REF_SPP:
+        cycles_ref, cycles_time = render(scene, "CYCLES", CYCLES_REF_SPP, REF_SEED)
+        d = (cycles_ref - reference)[mask]
+        se = np.sqrt(np.mean(d ** 2, axis=0) / d.shape[0])
+        record["cycles_reference"] = {
+            "spp": CYCLES_REF_SPP, "seconds": cycles_time,
+            "channel_mean": cycles_ref[mask].mean(axis=0).tolist(),
+            "relative_difference": (d.mean(axis=0) / ref_mean).tolist(),
+            "z": (d.mean(axis=0) / se).tolist()}
+        log("%s Cycles %d spp: hair mean %s, (Cycles − PATH)/PATH %s"
+            % (name, CYCLES_REF_SPP, np.round(cycles_ref[mask].mean(axis=0), 4),
+               np.round(d.mean(axis=0) / ref_mean, 4)))
+        keep["%s_cycles_reference" % name] = cycles_ref.astype(np.float32)
+    keep["%s_reference" % name] = reference.astype(np.float32)
+    keep["%s_mask" % name] = mask
+
+    renders = {method: [] for method in METHODS}
+    for method in METHODS:
+        for samples in (SPPS if method == "DUAL" else PATH_SPPS):
+            images, times = [], []
+            for seed in SEEDS:
+                image, seconds = render(scene, method, samples, seed)
+                images.append(image)
+                times.append(seconds)
+            entry = {"spp": samples, "seconds": times}
+            entry["seeds"] = [errors(image, reference, mask, ref_mse_channel) for image in images]
+            # Per-pixel variance of one render from the two seeds' difference.
+            entry["variance"] = float(np.mean(((images[0] - images[1])[mask]) ** 2) / 2.0)
+            renders[method].append(entry)
+            e = entry["seeds"][0]
+            log("%s %-6s %4d spp: %6.2f s, mean error %s, relative RMSE %.4f"
+                % (name, method, samples, np.mean(times),
+                   np.round(np.array(e["relative_mean_error"]) * 100, 2),
+                   math.sqrt(e["mse_corrected"]) / ref_mean.mean()))
+            if samples == max(SPPS if method == "DUAL" else PATH_SPPS):
+                keep["%s_%s" % (name, method.lower())] = images[0].astype(np.float32)
+    record["renders"] = renders
+    return record
+
+
+def main():
+    """Runs every case and writes the results."""
+    info = machine_info()
+    log("cases %s, %dx%d, %d bounces; %s" % (CASES, RESOLUTION[0], RESOLUTION[1], BOUNCES, info))
+    keep = {}
+    cases = {}
+    for name in CASES:
+        cases[name] = study_case(name, keep)
+    info["load_average_end"] = list(os.getloadavg())
+    info["total_seconds"] = time.monotonic() - START
+    results = {"machine": info,
+               "settings": {"resolution": list(RESOLUTION), "bounces": BOUNCES,
+                            "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
+                            "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
+                            "threads": 1, "probe": PROBE},
+               "cases": cases}
+    os.makedirs(OUT, exist_ok=True)
+    suffix = "_probe" if PROBE else ""
+    with open(os.path.join(OUT, "dual_scattering%s.json" % suffix), "w") as handle:
+        json.dump(results, handle, indent=1)
+    np.savez_compressed(os.path.join(OUT, "dual_scattering_images%s.npz" % suffix), **keep)
+    log("wrote %s" % OUT)
+    sys.exit(0)
+
+
+try:
+    main()
+except Exception:  # noqa: BLE001 - report and fail
+    import traceback
+    traceback.print_exc()
+    sys.exit(1)

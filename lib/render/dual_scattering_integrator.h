@@ -1,0 +1,130 @@
+// integrator=dual_scattering: the light a hair shading point receives, estimated with Zinke,
+// Yuksel, Weber and Keyser 2008 ("Dual Scattering Approximation for Fast Multiple Scattering
+// in Hair") in its ray-shooting form — shadow rays let hair through, and the forward-scattering
+// transmittance T_f and spread σ_f² are gathered strand by strand along them (the paper's
+// products and sums over the strands crossed, each strand at its own inclination) — instead of
+// its deep-opacity-map form. The averages (ā_f, β̄_f², Ā_b, Δ̄_b, σ̄_b, N_p^G) are
+// fiber/dual_scattering.h's; single scattering f_s is the material's Cycles-exact fiber.
+//
+// At a hair vertex x seen from ω_o, for light L from direction ω_i that crosses n strands
+// k = 1..n before reaching x (meshes block it):
+//   n = 0:  F·cos θ_i = f_s·cos θ_i  +  d_b f_back^direct cos θ_i              = D + M
+//   n ≥ 1:  F·cos θ_i = T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i    =     M
+//   T_f = d_f Π_k ā_f(θ_k),  σ_f² = Σ_k β̄_f²(θ_k),  θ_k = asin(ω_i · tangent_k),
+// with ā_f and β̄_f² from each crossed strand's own material, and d_f, d_b, the backscatter
+// terms and f^scatter from the shading point's. D is single scattering of unoccluded light, M
+// the multiple-scattering term (the local d_b f_back^direct where the light is visible, the
+// global term where it is not).
+//
+// Estimator per vertex (three strategies, two MIS pairs; each lamp's light is its own integrand,
+// as in the path tracer):
+//  - light sampling (LightSet::sample): one shadow ray that lets hair through gives n, T_f and
+//    σ_f²; D is weighted by the power heuristic against the material's sampler (the direct
+//    tables as in the path tracer) and M against the multiple table;
+//  - multiple-table sampling: ω_i from the baked 1D multiple-scattering table (MultipleTable)
+//    of the strand count n_h estimated below, at θ_o; a ray that lets hair through gathers n,
+//    T_f and σ_f² up to each lamp it crosses and to the world or sun it escapes to, and M there
+//    is weighted against light sampling (LightSet's MIS densities, and weight 1 for a world
+//    that is not light-sampled — a constant world's multiple scattering comes from here alone);
+//  - the material's sampler draws the path's continuation as in the path tracer and collects
+//    D from the emitters it reaches unoccluded, MIS-weighted as there. It ends at hair: light
+//    reaching x from another strand is M's. It goes on from meshes (light that meshes reflect
+//    onto hair, single-scattered).
+// n_h estimate: the strands a probe ray crosses from x towards a point drawn from LightSet with
+// random numbers of its own (towards a direction uniform on the sphere when there is no lamp),
+// up to the first mesh; that count (at least 1) is rounded in log2 to the nearest strand count
+// the table holds. The probe is independent of the estimator's samples, so the table's density
+// is fixed given the probe and MIS stays unbiased; when the probe and the light sample draw the
+// same delta light their shadow rays coincide and one is traced.
+//
+// What dual scattering covers: light from lamps, suns, emissive triangles and the world that
+// reaches hair directly or through other strands. What is still traced: everything that
+// arrives at meshes (hair is opaque to their shadow rays, as in the path tracer, and the light
+// hair sends them — the head under the hair — is what their continuation rays find at hair
+// vertices, each shaded as above), and light meshes reflect onto hair (single scattering of
+// it, through the continuation). Not covered: light that meshes reflect and that then crosses
+// strands before reaching x (the continuation ends at hair).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/frame.h"
+#include "fiber/dual_scattering.h"
+#include "render/scene.h"
+#include "sampling/hair_bsdf.h"
+#include "sampling/sampling_table.h"
+
+namespace hairis {
+
+/// The forward scattering gathered along a ray: strands crossed, Π ā_f(θ_k) and Σ β̄_f²(θ_k)
+/// (T_f without d_f, and σ_f²).
+struct ForwardScattering {
+    int strands = 0;
+    Rgb attenuation{1.0f};
+    Rgb spread_variance{0.0f};
+};
+
+/// Gathers the crossings strands[0 .. count) of a ray along unit direction `dir` (towards the
+/// light): each strand's ā_f and β̄_f² at θ_k = asin(dir · tangent_k) from its material's
+/// dual-scattering data (`fallback` for a material without one).
+ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
+                                            std::size_t count, Vec3 dir,
+                                            const DualScattering &fallback);
+
+/// M·cos θ_i of light from θ_i (fiber frame of the shading point) that crossed `forward`:
+/// the local term for 0 strands, the global term with T_f = d_f·attenuation otherwise.
+Rgb dual_multiple_f_cos(const DualScattering &dual, float theta_i, float theta_o,
+                        const ForwardScattering &forward);
+
+/// The index into table.n_h_values() of the strand count nearest max(strands, 1) in log2
+/// (ties to the smaller count).
+int nearest_strand_index(const MultipleTable &table, int strands);
+
+/// A direction drawn from a multiple-scattering table, in world space.
+struct MultipleTableSample {
+    Vec3 wi;                ///< unit, towards the light
+    float sin_theta_i = 0;  ///< wi's sin θ_i in the fiber frame
+    float pdf = 0;          ///< per steradian; 0 when nothing was drawn
+};
+
+/// ω_i from `table` (strand index `strand`) for the view with fiber-frame direction wo_local
+/// in `frame`: θ_i from the table's row of θ_o, φ uniform around the fiber.
+MultipleTableSample sample_multiple_table(const MultipleTable &table, int strand,
+                                          const FiberFrame &frame, Vec3 wo_local, float u0,
+                                          float u1, float u2);
+/// The density (per steradian) with which sample_multiple_table draws the unit direction wi.
+float multiple_table_pdf(const MultipleTable &table, int strand, const FiberFrame &frame,
+                         Vec3 wo_local, Vec3 wi);
+
+/// The random numbers of one dual-scattering vertex, in [0, 1).
+struct DualRandom {
+    float light_select = 0, light_u = 0, light_v = 0;  ///< the light sample
+    float probe_select = 0, probe_u = 0, probe_v = 0;  ///< the n_h probe
+    float table_u0 = 0, table_u1 = 0, table_u2 = 0;    ///< the multiple-table sample
+};
+
+/// A hair vertex as the estimator sees it.
+struct DualVertex {
+    const SurfacePoint *point = nullptr;
+    const HairMaterial *material = nullptr;  ///< with dual and multiple set
+    const HairBsdf *bsdf = nullptr;          ///< the material's fiber and sampler at this hit
+    FiberFrame frame;                        ///< the fiber frame the BSDF was prepared in
+    Vec3 wo;                                 ///< unit, towards the viewer
+};
+
+/// Per-thread buffers and counts of the estimator.
+struct DualWork {
+    std::vector<StrandCrossing> light, probe, table;
+    std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
+    int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
+    int last_strand_index = -1;   ///< the index into the table's n_h values it chose
+};
+
+/// The radiance the vertex sends towards ω_o from emitters by dual scattering (light and
+/// multiple-table samples, MIS-weighted as described above; the continuation's share is the
+/// caller's). Adds the rays it traces to work.rays.
+Rgb dual_scattering_light(const Scene &scene, const DualVertex &vertex, const DualRandom &u,
+                          DualWork &work);
+
+}  // namespace hairis

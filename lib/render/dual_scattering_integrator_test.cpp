@@ -1,0 +1,618 @@
+#include "render/dual_scattering_integrator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "chi2.h"
+#include "core/quadrature.h"
+#include "fiber/chiang.h"
+#include "fiber/distributions.h"
+#include "fiber/principled_hair.h"
+#include "core/scratch.h"
+#include "render/render.h"
+#include "sampling/analytic_sampler.h"
+
+namespace hairis {
+namespace {
+
+// ---- Fixtures -------------------------------------------------------------------------------
+
+// A light (blonde-like) Chiang fiber, its dual-scattering averages and a multiple table made
+// from them as the bake makes it (distributions.h's multiple_distribution per node and n_h).
+struct Blonde {
+    std::shared_ptr<const ChiangFiber> fiber;
+    std::shared_ptr<const DualScattering> dual;
+    std::shared_ptr<const MultipleTable> table;
+    std::vector<int> n_h{1, 2, 4, 8, 16};
+    int theta_i_count = 24;
+};
+
+std::shared_ptr<const MultipleTable> table_from(const DualScattering &dual, const std::vector<int> &n_h,
+                                                int theta_r_count, int theta_i_count) {
+    std::vector<float> nodes, values;
+    for (int r = 0; r < theta_r_count; ++r) nodes.push_back(float(-kHalfPi + kPi * (r + 0.5) / theta_r_count));
+    ThetaGridSpec spec;
+    spec.theta_count = theta_i_count;
+    for (float node : nodes)
+        for (int n : n_h) {
+            const Grid1D g = multiple_distribution(dual, node, n, spec).value();
+            for (double v : g.values) values.push_back(float(v));
+        }
+    return std::make_shared<const MultipleTable>(MultipleTable::create(nodes, n_h, theta_i_count, values).value());
+}
+
+const Blonde &blonde() {
+    static const Blonde b = [] {
+        Blonde out;
+        ChiangParams p;
+        p.sigma_a = principled_hair::sigma_from_concentration(0.05, 0.05);  // melanin ≈ 0.1
+        p.roughness = 0.3f;
+        p.radial_roughness = 0.3f;
+        out.fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(p).value());
+        out.dual = std::make_shared<const DualScattering>(DualScattering::create(*out.fiber, {}).value());
+        out.table = table_from(*out.dual, out.n_h, 12, out.theta_i_count);
+        return out;
+    }();
+    return b;
+}
+
+HairMaterial dual_hair(const Blonde &b, std::shared_ptr<const MultipleTable> table = nullptr) {
+    HairMaterial m{HairShading::create(b.fiber, std::make_shared<const AnalyticSampler>(b.fiber)).value()};
+    m.dual = b.dual;
+    m.multiple = table ? std::move(table) : b.table;
+    return m;
+}
+
+// Straight hairs along +X (from x = −half to half, 4 points each) at the given (y, z).
+HairCurves straight_hairs(const std::vector<Vec3> &centres, const std::vector<float> &radii, float half = 1.5f) {
+    HairCurves c;
+    c.first.push_back(0);
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+        for (int k = 0; k < 4; ++k) {
+            c.points.push_back({-half + 2.0f * half * float(k) / 3.0f, centres[i].y, centres[i].z});
+            c.radii.push_back(radii[i]);
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    return c;
+}
+
+TriangleMesh quad_at(float half, float z, std::uint32_t material) {
+    TriangleMesh m;
+    m.positions = {{-half, -half, z}, {half, -half, z}, {half, half, z}, {-half, half, z}};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    m.materials = {material};
+    return m;
+}
+
+// An orthographic camera at height 5 looking down −Z onto a half_x × half_y window.
+CameraDesc looking_down(float half_x, float half_y, int w, int h) {
+    CameraDesc c;
+    c.camera_to_world = Mat4::translation({0, 0, 5});
+    c.projection = Projection::Orthographic;
+    c.frame = {Vec3{half_x, half_y, -1}, Vec3{half_x, -half_y, -1}, Vec3{-half_x, -half_y, -1},
+               Vec3{-half_x, half_y, -1}};
+    c.width = w;
+    c.height = h;
+    return c;
+}
+
+Scene build(SceneDesc d) {
+    auto s = Scene::build(std::move(d));
+    EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+    return std::move(s).value();
+}
+
+RenderSettings dual_settings(int max_bounces = 0) {
+    RenderSettings s;
+    s.integrator = int(Integrator::DualScattering);
+    s.max_bounces = max_bounces;
+    s.film_transparent = true;
+    s.threads = 1;
+    return s;
+}
+
+// ---- Strand crossings -------------------------------------------------------------------------
+
+TEST(TraceThroughHair, ReportsEveryStrandCrossedOnceInOrder) {
+    // Five hairs stacked under each other at z = −1, −2, ..., −5 (and one beside them that the
+    // ray misses); the ray comes down the z axis at x = 0.3.
+    const int k = 5;
+    std::vector<Vec3> centres;
+    std::vector<float> radii;
+    for (int j = 1; j <= k; ++j) {
+        centres.push_back({0, 0, -float(j)});
+        radii.push_back(0.05f);
+    }
+    centres.push_back({0, 0.5f, -2.5f});
+    radii.push_back(0.05f);
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
+    d.curves = {straight_hairs(centres, radii)};
+    d.curves[0].material = 1;
+    d.camera = looking_down(1, 1, 4, 4);
+    const Scene scene = build(std::move(d));
+    std::vector<StrandCrossing> strands;
+    const auto mesh = scene.trace_through_hair({0.3f, 0, 1}, {0, 0, -1}, 0.0f, INFINITY, {}, {}, strands);
+    EXPECT_FALSE(mesh.has_value());
+    ASSERT_EQ(strands.size(), std::size_t(k));
+    for (int j = 0; j < k; ++j) {
+        // The top of the tube of hair j + 1: t = 1 + (j + 1) − r.
+        EXPECT_NEAR(strands[std::size_t(j)].t, 2.0f + float(j) - 0.05f, 1e-3f) << j;
+        EXPECT_NEAR(std::fabs(strands[std::size_t(j)].tangent.x), 1.0f, 1e-5f);
+        EXPECT_NEAR(strands[std::size_t(j)].radius, 0.05f, 1e-5f);
+        EXPECT_EQ(strands[std::size_t(j)].material, 1u);
+    }
+    // Up to t = 3.5 only the first two.
+    scene.trace_through_hair({0.3f, 0, 1}, {0, 0, -1}, 0.0f, 3.5f, {}, {}, strands);
+    EXPECT_EQ(strands.size(), 2u);
+    // Skipping the first hair's curve (a ray leaving it).
+    const PrimRef first_curve{strands[0].segment.geometry, 0};
+    scene.trace_through_hair({0.3f, 0, 1}, {0, 0, -1}, 0.0f, INFINITY, first_curve, {}, strands);
+    EXPECT_EQ(strands.size(), std::size_t(k - 1));
+}
+
+TEST(TraceThroughHair, AJointOfTwoSegmentsIsOneCrossing) {
+    // Points at x = −1.5, −0.5, 0.5, 1.5: the rays go through the joints at x = ±0.5, straight
+    // down and obliquely, and through the middle of a segment.
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs({{0, 0, 0}}, {0.08f})};
+    d.camera = looking_down(1, 1, 4, 4);
+    const Scene scene = build(std::move(d));
+    std::vector<StrandCrossing> strands;
+    for (float x : {-0.5f, 0.5f, 0.0f, -0.5f + 1e-3f}) {
+        for (Vec3 dir : {Vec3{0, 0, -1}, safe_normalize(Vec3{0.7f, 0.2f, -1}), safe_normalize(Vec3{-0.1f, 0.9f, -0.3f})}) {
+            const Vec3 origin = Vec3{x, 0, 0} - dir * 2.0f;
+            scene.trace_through_hair(origin, dir, 0.0f, INFINITY, {}, {}, strands);
+            EXPECT_EQ(strands.size(), 1u) << "x " << x << " dir " << dir.x << "," << dir.y << "," << dir.z;
+        }
+    }
+}
+
+TEST(TraceThroughHair, MeshesStopTheRayAndHairBehindThemIsNotReported) {
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
+    d.curves = {straight_hairs({{0, 0, -1}, {0, 0, -2}, {0, 0, -3}}, {0.05f, 0.05f, 0.05f})};
+    d.curves[0].material = 1;
+    d.meshes = {quad_at(2.0f, -2.5f, 0)};
+    d.camera = looking_down(1, 1, 4, 4);
+    const Scene scene = build(std::move(d));
+    std::vector<StrandCrossing> strands;
+    const auto mesh = scene.trace_through_hair({0.2f, 0, 1}, {0, 0, -1}, 0.0f, INFINITY, {}, {}, strands);
+    ASSERT_TRUE(mesh.has_value());
+    EXPECT_NEAR(mesh->t, 3.5f, 1e-4f);
+    EXPECT_EQ(strands.size(), 2u);
+    // The same query's occlusion agrees with Scene::occluded for the mesh alone.
+    EXPECT_TRUE(scene.occluded({0.2f, 0, -2.2f}, {0, 0, -1}, 0.0f, INFINITY));
+}
+
+// ---- Forward scattering and the multiple term ----------------------------------------------
+
+StrandCrossing crossing_with_tangent(Vec3 tangent) {
+    StrandCrossing c;
+    c.tangent = safe_normalize(tangent);
+    c.material = 99;  // not a material of the scene: the fallback's averages apply
+    return c;
+}
+
+TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveThePapersFixedCountForm) {
+    // k strands crossed at the shading fiber's own inclination: T_f = d_f ā_f^k and
+    // σ_f² = k β̄_f² (DualScattering's closed forms), and the multiple term is multiple_f_cos.
+    const Blonde &b = blonde();
+    SceneDesc d;
+    d.materials = {dual_hair(b)};
+    d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
+    d.camera = looking_down(1, 1, 2, 2);
+    const Scene scene = build(std::move(d));
+    for (double theta : {-0.9, -0.2, 0.0, 0.35, 1.1}) {
+        const Vec3 dir{float(std::sin(theta)), float(std::cos(theta)), 0.0f};
+        for (int k : {1, 2, 3, 7, 16}) {
+            const std::vector<StrandCrossing> strands(std::size_t(k), crossing_with_tangent({1, 0, 0}));
+            const ForwardScattering f = gather_forward_scattering(scene, strands.data(), strands.size(), dir, *b.dual);
+            EXPECT_EQ(f.strands, k);
+            const Rgb t_f = b.dual->forward_transmittance(theta, k);
+            const Rgb s_f = b.dual->forward_spread_variance(theta, k);
+            for (int ch = 0; ch < 3; ++ch) {
+                EXPECT_NEAR(b.dual->params().d_f * f.attenuation[ch], t_f[ch], 1e-5 * t_f[ch] + 1e-12);
+                EXPECT_NEAR(f.spread_variance[ch], s_f[ch], 1e-5 * s_f[ch]);
+            }
+            for (double theta_o : {-0.5, 0.0, 0.8}) {
+                const Rgb got = dual_multiple_f_cos(*b.dual, float(theta), float(theta_o), f);
+                const Rgb want = b.dual->multiple_f_cos(float(theta), float(theta_o), k);
+                for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], want[ch], 1e-4 * want[ch] + 1e-12);
+            }
+        }
+        const ForwardScattering none = gather_forward_scattering(scene, nullptr, 0, dir, *b.dual);
+        const Rgb got = dual_multiple_f_cos(*b.dual, float(theta), 0.3f, none);
+        const Rgb want = b.dual->multiple_f_cos(float(theta), 0.3f, 0);
+        for (int ch = 0; ch < 3; ++ch) EXPECT_FLOAT_EQ(got[ch], want[ch]);
+    }
+}
+
+TEST(DualScatteringIntegrator, EachStrandCountsAtItsOwnInclination) {
+    // Strands of different orientations: T_f/d_f is the product of each one's ā_f at the
+    // inclination of the light to it, σ_f² the sum of its β̄_f², and reversing a tangent flips
+    // the sign of that inclination.
+    const Blonde &b = blonde();
+    SceneDesc d;
+    d.materials = {dual_hair(b)};
+    d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
+    d.camera = looking_down(1, 1, 2, 2);
+    const Scene scene = build(std::move(d));
+    const Vec3 dir = safe_normalize(Vec3{0.3f, -0.5f, 0.8f});
+    const std::vector<Vec3> tangents{{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0.2f, 0.9f, 0.4f}, {0, 0, -1}};
+    std::vector<StrandCrossing> strands;
+    double attenuation[3] = {1, 1, 1}, spread[3] = {0, 0, 0};
+    for (Vec3 t : tangents) {
+        strands.push_back(crossing_with_tangent(t));
+        const double theta = std::asin(double(dot(dir, safe_normalize(t))));
+        const Rgb a = b.dual->forward_attenuation(theta);
+        const Rgb w = b.dual->forward_width(theta);
+        for (int ch = 0; ch < 3; ++ch) {
+            attenuation[ch] *= a[ch];
+            spread[ch] += double(w[ch]) * w[ch];
+        }
+    }
+    const ForwardScattering f = gather_forward_scattering(scene, strands.data(), strands.size(), dir, *b.dual);
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(f.attenuation[ch], attenuation[ch], 1e-5 * attenuation[ch]);
+        EXPECT_NEAR(f.spread_variance[ch], spread[ch], 1e-5 * spread[ch]);
+    }
+    // The sign matters for a tilted fiber: ā_f(θ) ≠ ā_f(−θ).
+    EXPECT_GT(std::fabs(b.dual->forward_attenuation(0.3).r - b.dual->forward_attenuation(-0.3).r), 1e-4f);
+}
+
+TEST(DualScatteringIntegrator, NearestStrandCountInLog2) {
+    const MultipleTable &t = *blonde().table;
+    const std::vector<std::pair<int, int>> cases{{0, 1}, {1, 1}, {2, 2}, {3, 4}, {4, 4}, {5, 4},
+                                                 {6, 8}, {11, 8}, {12, 16}, {100, 16}};
+    for (const auto &[strands, n_h] : cases)
+        EXPECT_EQ(t.n_h_values()[std::size_t(nearest_strand_index(t, strands))], n_h) << strands;
+}
+
+// ---- The multiple-table sampling in world space (χ²) ------------------------------------------
+
+TEST(DualScatteringIntegratorChi2, MultipleTableSamplesFollowTheirPdf) {
+    const Blonde &b = blonde();
+    const MultipleTable &table = *b.table;
+    const Vec3 tangent = safe_normalize(Vec3{0.3f, -0.8f, 0.5f});
+    const std::vector<Vec3> views{safe_normalize(Vec3{0.2f, 0.4f, 0.9f}), safe_normalize(Vec3{-0.7f, 0.1f, -0.2f})};
+    const std::vector<int> strands{0, 4};
+    const int tests = int(views.size() * strands.size());
+    for (Vec3 wo : views) {
+        const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);
+        const Vec3 wo_local = frame.to_local(wo);
+        for (int strand : strands) {
+            testing::Chi2Options o;
+            o.test_count = tests;
+            o.sin_theta_cells = 48;
+            o.phi_cells = 24;
+            for (int i = 1; i < table.theta_i_count(); ++i)
+                o.theta_breaks.push_back(-kHalfPi + kPi * i / table.theta_i_count());
+            // The harness's cells are in the fiber frame; samples and pdf go through the world.
+            // A sample's own density and the pdf of its direction differ only where rounding
+            // moves it across a cell edge.
+            long long mismatches = 0;
+            const testing::Chi2Result r = testing::chi2_direction_test(
+                [&](testing::Sample3 u) -> std::optional<Vec3> {
+                    const MultipleTableSample s = sample_multiple_table(table, strand, frame, wo_local, u.u0, u.u1, u.u2);
+                    if (!(s.pdf > 0.0f)) return std::nullopt;
+                    const float pdf = multiple_table_pdf(table, strand, frame, wo_local, s.wi);
+                    if (std::fabs(pdf - s.pdf) > 1e-4f * s.pdf) ++mismatches;
+                    return frame.to_local(s.wi);
+                },
+                [&](Vec3 l) { return double(multiple_table_pdf(table, strand, frame, wo_local, frame.to_world(l))); }, o);
+            EXPECT_TRUE(r.passed) << "strand " << strand << ": " << r.message;
+            EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+            EXPECT_LT(mismatches, 100) << "of " << o.sample_count;
+        }
+    }
+}
+
+// ---- Renders against closed forms and quadrature ---------------------------------------------
+
+// A thin hair at z = 0 seen from above through a window that only it fills, k thicker hairs
+// under it at z = −0.2j, and a delta sun below and along +X at θ_i = 0.4 from the hairs' normal
+// plane, in a black world.
+Scene sun_through_strands(int k, float strength) {
+    std::vector<Vec3> centres{{0, 0, 0}};
+    std::vector<float> radii{0.02f};
+    for (int j = 1; j <= k; ++j) {
+        centres.push_back({0, 0, -0.2f * float(j)});
+        radii.push_back(0.06f);
+    }
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs(centres, radii)};
+    SunLight sun;
+    sun.to_sun = {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))};
+    sun.strength = strength;
+    d.suns = {sun};
+    d.world = {Rgb(0.0f), 1.0f};
+    d.camera = looking_down(0.4f, 0.012f, 8, 2);
+    return build(std::move(d));
+}
+
+TEST(DualScatteringRender, SunThroughKStrandsIsTheClosedForm) {
+    // Every sample sees the top hair at θ_o = 0 with the sun behind k strands: its light is
+    // E·T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i, DualScattering's fixed-count form
+    // (the strands are parallel to the shading fiber), whatever h and the other samples do.
+    const float strength = 2.0f;
+    for (int k : {1, 3, 6}) {
+        const Scene scene = sun_through_strands(k, strength);
+        const Rgb want = blonde().dual->multiple_f_cos(0.4f, 0.0f, k) * strength;
+        for (int bounces : {0, 4}) {
+            const RenderSettings s = dual_settings(bounces);
+            for (int x = 0; x < 8; x += 3)
+                for (std::uint64_t i = 0; i < 16; ++i) {
+                    float alpha = 0;
+                    const Rgb got = render_sample(scene, s, x, 1, i, &alpha);
+                    ASSERT_EQ(alpha, 1.0f);
+                    for (int ch = 0; ch < 3; ++ch)
+                        EXPECT_NEAR(got[ch], want[ch], 2e-4 * want[ch]) << "k " << k << " ch " << ch;
+                }
+        }
+        // The path tracer sees the sun blocked by hair: its single-scattering term is zero.
+        RenderSettings path = dual_settings(0);
+        path.integrator = int(Integrator::Path);
+        EXPECT_EQ(render_sample(scene, path, 3, 1, 0).g, 0.0f);
+    }
+}
+
+TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
+    // The top hair of sun_through_strands(k), shaded directly: the n_h probe goes towards the
+    // (only) lamp and crosses the k strands under it; the table's strand count is the nearest.
+    for (int k : {0, 1, 3, 6}) {
+        const Scene scene = sun_through_strands(k, 1.0f);
+        const Vec3 origin{0.05f, 0.004f, 1.0f}, down{0, 0, -1};
+        const std::optional<Hit> hit = scene.intersect(origin, down, 0.0f, INFINITY);
+        ASSERT_TRUE(hit.has_value());
+        const SurfacePoint sp = scene.surface_point(origin, down, *hit);
+        ASSERT_TRUE(sp.is_curve);
+        const HairMaterial &material = std::get<HairMaterial>(scene.materials()[sp.material]);
+        DualVertex v;
+        v.point = &sp;
+        v.material = &material;
+        v.wo = -down;
+        v.frame = FiberFrame::from_tangent_and_view(sp.tangent, v.wo);
+        ScratchBuffer scratch;
+        const float h = std::clamp(dot(cross(sp.normal, v.frame.x), v.frame.z), -1.0f, 1.0f);
+        const HairBsdf bsdf = material.shading.at({v.frame.to_local(v.wo), h}, scratch);
+        v.bsdf = &bsdf;
+        DualWork work;
+        DualRandom u;
+        u.table_u0 = u.table_u1 = u.table_u2 = 0.5f;
+        const Rgb l = dual_scattering_light(scene, v, u, work);
+        EXPECT_EQ(work.last_probe_strands, k);
+        EXPECT_EQ(material.multiple->n_h_values()[std::size_t(work.last_strand_index)],
+                  material.multiple->n_h_values()[std::size_t(nearest_strand_index(*material.multiple, k))]);
+        // The sun's probe ray is the light sample's shadow ray: traced once (and the table's).
+        EXPECT_EQ(work.rays, 2u);
+        EXPECT_GT(l.r, 0.0f);
+    }
+}
+
+TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter) {
+    // No strand under the hair: F = f_s + d_b f_back^direct. Over the hair's width (h uniform,
+    // samples that miss it left out) f_s averages to the far field f_cos.
+    const float strength = 2.0f;
+    std::vector<Vec3> centres{{0, 0, 0}};
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs(centres, {0.02f})};
+    SunLight sun;
+    sun.to_sun = {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))};
+    sun.strength = strength;
+    d.suns = {sun};
+    d.camera = looking_down(0.4f, 0.03f, 1, 1);
+    const Scene scene = build(std::move(d));
+    // Fiber frame at the hit: x = +X; ω_o = +Z; ω_i = to_sun.
+    const FiberFrame frame = FiberFrame::from_tangent_and_view({1, 0, 0}, {0, 0, 1});
+    const Vec3 wi = frame.to_local({float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))});
+    const Vec3 wo = frame.to_local({0, 0, 1});
+    const Rgb want = (blonde().fiber->f_cos(wi, wo) + blonde().dual->local_f_cos(0.4f, 0.0f)) * strength;
+    const RenderSettings s = dual_settings(0);
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    int hits = 0;
+    for (std::uint64_t i = 0; i < 40000; ++i) {
+        float alpha = 0;
+        const Rgb l = render_sample(scene, s, 0, 0, i, &alpha);
+        if (alpha == 0.0f) continue;
+        ++hits;
+        for (int ch = 0; ch < 3; ++ch) {
+            sum[ch] += l[ch];
+            sum2[ch] += double(l[ch]) * l[ch];
+        }
+    }
+    ASSERT_GT(hits, 20000);
+    for (int ch = 0; ch < 3; ++ch) {
+        const double mean = sum[ch] / hits;
+        const double sigma = std::sqrt(std::max(0.0, sum2[ch] / hits - mean * mean) / hits);
+        EXPECT_NEAR(mean, want[ch], 5.0 * sigma + 1e-4 * want[ch]) << "ch " << ch;
+    }
+}
+
+// The same sample's radiance minus the path tracer's, over n samples of pixel (0, 0): at depth
+// 0 both draw the same light sample and continuation with the same numbers, so the difference
+// is the multiple-scattering term M alone.
+struct Estimate {
+    double mean[3] = {0, 0, 0}, sigma[3] = {0, 0, 0};
+};
+Estimate multiple_part(const Scene &scene, int n) {
+    RenderSettings dual = dual_settings(0), path = dual_settings(0);
+    path.integrator = int(Integrator::Path);
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    int hits = 0;
+    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+        float alpha = 0;
+        const Rgb a = render_sample(scene, dual, 0, 0, i, &alpha);
+        if (alpha == 0.0f) continue;
+        const Rgb b = render_sample(scene, path, 0, 0, i);
+        ++hits;
+        for (int ch = 0; ch < 3; ++ch) {
+            const double v = double(a[ch]) - double(b[ch]);
+            sum[ch] += v;
+            sum2[ch] += v * v;
+        }
+    }
+    Estimate e;
+    for (int ch = 0; ch < 3; ++ch) {
+        e.mean[ch] = sum[ch] / hits;
+        e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / hits - e.mean[ch] * e.mean[ch]) / hits);
+    }
+    return e;
+}
+
+// One hair at z = 0 seen straight down (θ_o = 0) through a 2 cm window.
+SceneDesc single_hair() {
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs({{0, 0, 0}}, {0.02f})};
+    d.camera = looking_down(0.01f, 0.01f, 1, 1);
+    return d;
+}
+
+TEST(DualScatteringRender, ConstantWorldMultipleScatteringMatchesQuadrature) {
+    // A constant world of radiance L is not light-sampled: M comes from the multiple table
+    // alone and must integrate to L·2π ∫ local_f_cos(θ_i, 0) cos θ_i dθ_i (nothing is crossed).
+    SceneDesc d = single_hair();
+    d.world = {Rgb(1.0f, 0.8f, 0.5f), 1.5f};
+    const Scene scene = build(std::move(d));
+    const QuadratureRule q = QuadratureRule::composite(-kHalfPi, kHalfPi, 64, 8);
+    double want[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < q.x.size(); ++i) {
+        const Rgb m = blonde().dual->local_f_cos(float(q.x[i]), 0.0f);
+        for (int ch = 0; ch < 3; ++ch) want[ch] += kTwoPi * q.w[i] * std::cos(q.x[i]) * m[ch];
+    }
+    const Rgb world = Rgb(1.0f, 0.8f, 0.5f) * 1.5f;
+    const Estimate e = multiple_part(scene, 20000);
+    for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_GT(want[ch], 0.0);
+        EXPECT_NEAR(e.mean[ch], want[ch] * world[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "ch " << ch;
+    }
+}
+
+TEST(DualScatteringRender, AreaLightMultipleScatteringMisMatchesQuadrature) {
+    // A 6 m × 6 m area light 1 m above the hair, facing down, radiance L: light sampling and
+    // table sampling of M, weighted by the power heuristic, integrate to
+    //   ∫_light local_f_cos(θ_i(ω), 0) L dω = ∫∫ local_f_cos L h / d³ dx dy,
+    // computed by Gauss–Legendre over the light's area.
+    SceneDesc d = single_hair();
+    AreaLight a;
+    a.light_to_world = Mat4::translation({0, 0, 1});
+    a.shape = AreaShape::Rectangle;
+    a.size_x = 6.0f;
+    a.size_y = 6.0f;
+    const float radiance = 1.7f;
+    a.power = radiance * 4.0f * 36.0f;  // Cycles 3.4: L = P/(4·area)
+    d.area_lights = {a};
+    const Scene scene = build(std::move(d));
+    const QuadratureRule q = QuadratureRule::composite(-3.0, 3.0, 48, 8);
+    double want[3] = {0, 0, 0};
+    const FiberFrame frame = FiberFrame::from_tangent_and_view({1, 0, 0}, {0, 0, 1});
+    for (std::size_t i = 0; i < q.x.size(); ++i)
+        for (std::size_t j = 0; j < q.x.size(); ++j) {
+            // The hits' mean height on the tube: √(r² − y²) averaged over |y| ≤ 0.01 (r = 0.02).
+            const double x = q.x[i], y = q.x[j], h = 1.0 - 0.01936;
+            const double dist = std::sqrt(x * x + y * y + h * h);
+            const Vec3 wi = frame.to_local(safe_normalize(Vec3{float(x), float(y), float(h)}));
+            const Rgb m = blonde().dual->local_f_cos(std::asin(wi.x), 0.0f);
+            for (int ch = 0; ch < 3; ++ch) want[ch] += q.w[i] * q.w[j] * h / (dist * dist * dist) * m[ch] * radiance;
+        }
+    const Estimate e = multiple_part(scene, 20000);
+    for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 3e-3 * want[ch]) << "ch " << ch;
+}
+
+// A tuft of wavy hairs standing on the XY plane: `count` curves of `points` points.
+HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
+    std::uint32_t state = seed;
+    auto u = [&] {  // uniform in [−1, 1)
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / float(1u << 23) - 1.0f;
+    };
+    HairCurves c;
+    c.first.push_back(0);
+    for (int i = 0; i < count; ++i) {
+        const Vec3 root{0.3f * u(), 0.3f * u(), 0.0f};
+        const Vec3 lean{0.3f * u(), 0.3f * u(), 1.0f};
+        for (int k = 0; k < points; ++k) {
+            const float t = float(k) / float(points - 1);
+            const Vec3 wiggle{0.03f * std::sin(9.0f * t + float(i)), 0.03f * std::cos(7.0f * t + float(i)), 0.0f};
+            c.points.push_back(root + lean * t + wiggle);
+            c.radii.push_back(radius);
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    return c;
+}
+
+TEST(DualScatteringRender, AUniformMultipleTableGivesTheSameMeanWithMoreNoise) {
+    // The multiple table drives the sampling of M: replaced by a uniform one (the uniform
+    // sphere, same strand counts and nodes), the image's expectation stays (both estimators are
+    // unbiased for the same integral) and its noise grows. A blonde tuft in a constant world:
+    // M comes from table samples alone, and everything else draws the same numbers in both, so
+    // the per-sample difference of the two renders is the difference of their M estimates.
+    const Blonde &b = blonde();
+    const MultipleTable &baked = *b.table;
+    const auto uniform = std::make_shared<const MultipleTable>(
+        MultipleTable::create(baked.theta_r_nodes(), baked.n_h_values(), baked.theta_i_count(),
+                              std::vector<float>(baked.values().size(), 1.0f))
+            .value());
+    auto scene_with = [&](std::shared_ptr<const MultipleTable> table) {
+        SceneDesc d;
+        d.materials = {dual_hair(b, std::move(table))};
+        d.curves = {tuft(400, 6, 0.004f)};
+        d.world = {Rgb(1.0f), 1.0f};
+        CameraDesc c;
+        // At (0, −3, 0.6) looking along +Y, +Z up.
+        const float m[16] = {1, 0, 0, 0, 0, 0, -1, -3, 0, 1, 0, 0.6f, 0, 0, 0, 1};
+        c.camera_to_world = Mat4::from_row_major(m);
+        c.frame = {Vec3{0.12f, 0.12f, -1}, Vec3{0.12f, -0.12f, -1}, Vec3{-0.12f, -0.12f, -1}, Vec3{-0.12f, 0.12f, -1}};
+        c.width = 8;
+        c.height = 8;
+        d.camera = c;
+        return build(std::move(d));
+    };
+    const Scene with_baked = scene_with(b.table), with_uniform = scene_with(uniform);
+    RenderSettings s = dual_settings(4);
+    s.film_transparent = false;
+    const int n = 128;
+    double diff_sum = 0, diff_sum2 = 0, var_baked = 0, var_uniform = 0, mean_baked = 0;
+    int count = 0;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            double sb = 0, sb2 = 0, su = 0, su2 = 0;
+            for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+                const double lb = luminance(render_sample(with_baked, s, x, y, i));
+                const double lu = luminance(render_sample(with_uniform, s, x, y, i));
+                sb += lb;
+                sb2 += lb * lb;
+                su += lu;
+                su2 += lu * lu;
+                diff_sum += lu - lb;
+                diff_sum2 += (lu - lb) * (lu - lb);
+                ++count;
+            }
+            var_baked += (sb2 - sb * sb / n) / (n - 1);
+            var_uniform += (su2 - su * su / n) / (n - 1);
+            mean_baked += sb / n;
+        }
+    mean_baked /= 64.0;
+    const double diff_mean = diff_sum / count;
+    const double diff_sigma = std::sqrt((diff_sum2 / count - diff_mean * diff_mean) / count);
+    std::printf("mean %.5f, uniform − baked %.2e ± %.2e, per-sample variance baked %.3e uniform %.3e\n",
+                mean_baked, diff_mean, diff_sigma, var_baked / 64, var_uniform / 64);
+    EXPECT_GT(mean_baked, 0.05);
+    EXPECT_LT(std::fabs(diff_mean), 4.0 * diff_sigma);
+    EXPECT_GT(var_uniform, 1.5 * var_baked);
+}
+
+}  // namespace
+}  // namespace hairis
