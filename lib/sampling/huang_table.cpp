@@ -1,8 +1,10 @@
 #include "sampling/huang_table.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "core/frame.h"
 #include "sampling/table_set.h"
 
 namespace hairis {
@@ -33,7 +35,27 @@ float unit(float u) {
     return u < kOneMinusEpsilon ? u : kOneMinusEpsilon;
 }
 
+// sin(slope·d)/sin(d) for d ≥ 0: cos of the warped angle over cos of the angle, both d from
+// the same pole.
+double pole_ratio(double slope, double d) { return d > 1e-12 ? std::sin(slope * d) / std::sin(d) : slope; }
+
 }  // namespace
+
+ThetaWarp ThetaWarp::between(double theta_o, double theta_node) {
+    // Both strictly inside the poles, so that both slopes are positive.
+    const double inside = kHalfPi * (1.0 - 1e-9);
+    ThetaWarp w;
+    w.anchor = -std::clamp(theta_o, -inside, inside);
+    w.node_anchor = -std::clamp(theta_node, -inside, inside);
+    w.below = (w.node_anchor + kHalfPi) / (w.anchor + kHalfPi);
+    w.above = (kHalfPi - w.node_anchor) / (kHalfPi - w.anchor);
+    return w;
+}
+
+double ThetaWarp::jacobian(double theta_i) const {
+    return theta_i < anchor ? below * pole_ratio(below, theta_i + kHalfPi)
+                            : above * pole_ratio(above, kHalfPi - theta_i);
+}
 
 long long HuangTable::bytes_needed(long long theta_o_count, long long phi_o_count, long long theta_i_count,
                                    long long phi_count) {
@@ -88,6 +110,9 @@ Expected<HuangTable> HuangTable::create(const std::vector<float> &theta_o_nodes,
     Expected<ThetaRNodes> phi_nodes = ThetaRNodes::create(phi_o_nodes);  // already checked: within [0, π/2]
     if (!phi_nodes) return prefixed(phi_nodes.error());
     t.phi_nodes_ = std::move(phi_nodes).value();
+    const double outer = std::max(std::fabs(double(theta_o_nodes.front())), std::fabs(double(theta_o_nodes.back())));
+    t.theta_limit_ = 0.5 * (std::min(outer, kHalfPi) + kHalfPi);
+    if (!(t.theta_limit_ < kHalfPi)) t.theta_limit_ = std::nextafter(kHalfPi, 0.0);
     t.slices_.reserve(std::size_t(n_q));
     const std::size_t block = std::size_t(n_r) * std::size_t(slice);
     for (std::size_t q = 0; q < std::size_t(n_q); ++q) {
@@ -111,15 +136,27 @@ HuangTableQuery HuangTable::locate(Vec3 wo) const {
         q.cos_phi_o = y / r;
         q.sin_phi_o = z / r;
     }
-    q.theta = slices_.front().locate(safe_asin(wo.x));
+    const float theta_o = safe_asin(wo.x);
+    q.theta = slices_.front().locate(theta_o);
     q.phi = phi_nodes_.locate(std::atan2(q.sin_phi_o, q.cos_phi_o));
+    const std::vector<float> &nodes = theta_o_nodes_;
+    const double anchor_theta = std::clamp(double(theta_o), -theta_limit_, theta_limit_);
+    q.warp[0] = ThetaWarp::between(anchor_theta, nodes[std::size_t(q.theta.lower)]);
+    q.warp[1] = nodes.size() > 1 ? ThetaWarp::between(anchor_theta, nodes[std::size_t(q.theta.lower) + 1]) : q.warp[0];
     return q;
 }
 
-float HuangTable::slice_pdf(const HuangTableQuery &q, float sin_theta_i, float phi) const {
+namespace {
+
+// θ_o node k (0 lower, 1 upper) of a blend, as a blend that selects it alone.
+NodeBlend only(NodeBlend b, int k) { return {b.lower, k ? 1.0f : 0.0f}; }
+
+}  // namespace
+
+float HuangTable::slice_pdf(const HuangTableQuery &q, NodeBlend theta_node, float sin_theta_i, float phi) const {
     // (1 − s)·pdf(q) + s·pdf(q + 1), skipping the node without weight (its term is exactly 0).
     const NodeBlend b = q.phi;
-    auto node = [&](int k) { return slices_[std::size_t(k)].pdf_sin(q.theta, sin_theta_i, phi); };
+    auto node = [&](int k) { return slices_[std::size_t(k)].pdf_sin(theta_node, sin_theta_i, phi); };
     if (b.t <= 0.0f) return node(b.lower);
     if (b.t >= 1.0f) return node(b.lower + 1);
     return (1.0f - b.t) * node(b.lower) + b.t * node(b.lower + 1);
@@ -128,19 +165,36 @@ float HuangTable::slice_pdf(const HuangTableQuery &q, float sin_theta_i, float p
 std::optional<DirectionSample> HuangTable::sample(const HuangTableQuery &q, float u0, float u1, float u2) const {
     // u2 < s picks the upper φ_o node; its remainder, rescaled to [0, 1), picks the θ_o node.
     const float u = unit(u2), s = q.phi.t;
-    const bool upper = u < s;
-    const float rest = unit(upper ? u / s : (u - s) / (1.0f - s));
-    const TableSample t = slices_[std::size_t(q.phi.lower + (upper ? 1 : 0))].sample(q.theta, u0, u1, rest);
-    const float pdf = slice_pdf(q, t.sin_theta_i, t.phi);
-    if (!(pdf > 0.0f)) return std::nullopt;
-    const Vec3 folded = t.local_direction(q.cos_phi_o, q.sin_phi_o);
-    return DirectionSample{{folded.x, q.sign_y * folded.y, q.sign_z * folded.z}, pdf};
+    const bool upper_phi = u < s;
+    const float rest = unit(upper_phi ? u / s : (u - s) / (1.0f - s)), t = q.theta.t;
+    const int k = rest < t ? 1 : 0;
+    const TableSample ts = slices_[std::size_t(q.phi.lower + (upper_phi ? 1 : 0))].sample(only(q.theta, k), u0, u1, 0.0f);
+    // Back from the node's θ_i axis; off the fiber axis like every table sample.
+    const double theta_i = q.warp[k].from_node(std::asin(std::clamp(double(ts.sin_theta_i), -1.0, 1.0)));
+    const float sin_theta_i = off_axis(float(std::sin(theta_i)));
+    const float cos_theta_i = std::sqrt((1.0f - sin_theta_i) * (1.0f + sin_theta_i));
+    const float c = q.cos_phi_o * ts.cos_phi - q.sin_phi_o * ts.sin_phi, sn = q.sin_phi_o * ts.cos_phi + q.cos_phi_o * ts.sin_phi;
+    const Vec3 wi{sin_theta_i, q.sign_y * cos_theta_i * c, q.sign_z * cos_theta_i * sn};
+    const float density = pdf(q, wi);
+    if (!(density > 0.0f)) return std::nullopt;
+    return DirectionSample{wi, density};
 }
 
 float HuangTable::pdf(const HuangTableQuery &q, Vec3 wi) const {
+    if (!(wi.x >= -1.0f && wi.x <= 1.0f)) return 0.0f;
     const float y = q.sign_y * wi.y, z = q.sign_z * wi.z;
     const float phi = std::atan2(z * q.cos_phi_o - y * q.sin_phi_o, y * q.cos_phi_o + z * q.sin_phi_o);
-    return slice_pdf(q, wi.x, phi);
+    const double theta_i = std::asin(double(wi.x));
+    // (1 − t)·pdf(lower) + t·pdf(upper), each through its warp.
+    auto node = [&](int k) {
+        const ThetaWarp &w = q.warp[k];
+        const float density = slice_pdf(q, only(q.theta, k), float(std::sin(w.to_node(theta_i))), phi);
+        return density > 0.0f ? float(double(density) * w.jacobian(theta_i)) : 0.0f;
+    };
+    const float t = q.theta.t;
+    if (t <= 0.0f) return node(0);
+    if (t >= 1.0f) return node(1);
+    return (1.0f - t) * node(0) + t * node(1);
 }
 
 std::vector<std::pair<std::string, double>> huang_parameters(const HuangParams &p) {

@@ -14,11 +14,23 @@
 // their mixture is close to the density between them. Each node's slice is a DirectTable over
 // the θ_o nodes (sampling_table.h: equal θ_i cells sampled uniformly in sin θ_i, equal φ cells).
 //
+// Longitudinal alignment. Huang's lobes (R, TT, TRT off the tilted cuticle, TRRT+'s d'Eon
+// cone) sit near the specular cone θ_i = −θ_o and move with θ_o, one degree per degree. A node's
+// slice is therefore read through a warp of θ_i: the piecewise-linear map of [−π/2, π/2] onto
+// itself that fixes ±π/2 and takes the view's −θ_o to the node's −θ_node (ThetaWarp). Drawing
+// from node r at a view θ_o means drawing ω' from the slice and mapping its θ' back; the density
+// per steradian is the slice's at the warped direction times the warp's Jacobian
+// dΩ'/dΩ = T'(θ_i)·cos θ'/cos θ_i. On a node the warp is the identity. (For smooth fibers the
+// lobes are narrower than the node spacing, and mixing unaligned neighbouring slices would
+// put most samples where neither lobe is.)
+//
 // Between nodes: exact stochastic mixing. For a view between φ_o nodes q and q + 1 at
 // s = (φ_o − φ_q)/(φ_q+1 − φ_q), u2 < s picks node q + 1, and the rest of u2 (rescaled) picks
-// the θ_o node as DirectTable does: the sampled density is the bilinear mixture of the four
-// neighbouring slices, and pdf() returns exactly that mixture. Outside the node ranges the
-// outer nodes are used. O(1): guide tables per slice, no per-query tables.
+// the θ_o node the same way: the sampled density is the bilinear mixture of the four
+// neighbouring slices (each through its warp), and pdf() returns exactly that mixture.
+// Outside the node ranges the outer nodes are used (warped to the view's cone, whose anchor is
+// clamped halfway from the outer θ_o node to the pole). O(1): guide tables per slice, no
+// per-query tables; a pdf costs an asin, an atan2 and a sin per θ_o node.
 #pragma once
 
 #include <cstddef>
@@ -39,6 +51,24 @@ namespace hairis {
 /// Refuses more φ_o nodes than this.
 inline constexpr int kMaxPhiONodes = 256;
 
+/// The warp of θ_i at a view onto a θ_o node's θ_i axis (see the file comment): piecewise
+/// linear on [−π/2, anchor] and [anchor, π/2], anchor ↦ node_anchor, ±π/2 fixed.
+struct ThetaWarp {
+    double anchor = 0, node_anchor = 0;  ///< −θ_o and −θ_node
+    double below = 1, above = 1;         ///< the slopes of the two pieces
+
+    /// The warp from a view at θ_o to the node θ_node (both clamped into (−π/2, π/2)).
+    static ThetaWarp between(double theta_o, double theta_node);
+    double to_node(double theta_i) const {
+        return theta_i < anchor ? -kHalfPi + (theta_i + kHalfPi) * below : kHalfPi - (kHalfPi - theta_i) * above;
+    }
+    double from_node(double theta) const {
+        return theta < node_anchor ? -kHalfPi + (theta + kHalfPi) / below : kHalfPi - (kHalfPi - theta) / above;
+    }
+    /// dΩ_node/dΩ at θ_i: the slope × cos(to_node(θ_i)) / cos θ_i (the slope squared at ±π/2).
+    double jacobian(double theta_i) const;
+};
+
 /// Where a view falls in a HuangTable (HuangTable::locate).
 struct HuangTableQuery {
     /// The fold: ω ↦ (ω.x, sign_y·ω.y, sign_z·ω.z) takes ω_o to φ_o ∈ [0, π/2] (its own
@@ -48,6 +78,7 @@ struct HuangTableQuery {
     float cos_phi_o = 1, sin_phi_o = 0;
     NodeBlend theta;  ///< among the θ_o nodes
     NodeBlend phi;    ///< among the φ_o nodes
+    ThetaWarp warp[2];  ///< onto the lower and the upper θ_o node
 };
 
 /// The tables of one Huang fiber.
@@ -62,7 +93,8 @@ class HuangTable {
     static Expected<HuangTable> create(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes,
                                        int theta_i_count, int phi_count, const std::vector<float> &values);
 
-    /// Where ω_o (Huang's frame, unit) falls: its fold and neighbouring nodes. One asin and one atan2.
+    /// Where ω_o (Huang's frame, unit) falls: its fold, neighbouring nodes and warps. One asin
+    /// and one atan2.
     HuangTableQuery locate(Vec3 wo) const;
 
     /// ω_i in Huang's frame from three uniform numbers in [0, 1): u0 picks θ_i, u1 φ, u2 the
@@ -87,7 +119,11 @@ class HuangTable {
 
   private:
     HuangTable() = default;
-    float slice_pdf(const HuangTableQuery &q, float sin_theta_i, float phi) const;
+    float slice_pdf(const HuangTableQuery &q, NodeBlend theta_node, float sin_theta_i, float phi) const;
+
+    // The anchor −θ_o of a warp is clamped to ±theta_limit_, halfway from the outer nodes to
+    // the poles, so that the slopes stay bounded for views along the fiber.
+    double theta_limit_ = kHalfPi;
 
     std::vector<float> theta_o_nodes_, phi_o_nodes_;
     ThetaRNodes phi_nodes_;  // the φ_o nodes' lookup

@@ -124,12 +124,16 @@ TEST_P(HuangTableChi2, SamplesThePdfItReports) {
     ScratchBuffer scratch;
     const HuangPoint &point = static_cast<const HuangPoint &>(b.fiber->prepare(hit, scratch));
     const SamplerPoint &at = b.sampler->at(hit, &point, scratch);
-    // Split the quadrature at the table's cell edges, mapped into the renderer's frame.
+    // Split the quadrature at the table's cell edges, mapped into the renderer's frame (θ_i edges
+    // through each θ_o node's warp).
     const HuangTable &table = b.sampler->table();
     const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
     Chi2Options options;
     options.test_count = kFamily;
-    for (int k = 0; k <= table.theta_i_count(); ++k) options.theta_breaks.push_back(-kHalfPi + kPi * k / table.theta_i_count());
+    for (const ThetaWarp &w : q.warp)
+        for (int k = 0; k <= table.theta_i_count(); ++k)
+            options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
+    options.theta_breaks.push_back(q.warp[0].anchor);
     for (int k = 0; k <= table.phi_count(); ++k) {
         const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
         const Vec3 edge{0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))};

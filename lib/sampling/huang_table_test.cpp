@@ -1,11 +1,13 @@
 // HuangTable on synthetic values (no fiber): χ² between nodes and in every quadrant, the fold,
-// the bilinear mixture, a one-node (circular) table, a one-cell table against its closed form,
-// and validation.
+// the bilinear mixture of warped slices (against a formula computed here), the warp itself,
+// lobes that follow the view between nodes, a one-node (circular) table, a one-cell table
+// against its closed form, and validation.
 #include "sampling/huang_table.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -21,7 +23,7 @@ using testing::Chi2Options;
 using testing::Sample3;
 
 constexpr int kThetaO = 5, kPhiO = 3, kThetaI = 12, kPhi = 16;
-constexpr int kChi2Tests = 7;  // Chi2InEveryQuadrant 6 + SingleNode 1
+constexpr int kChi2Tests = 7;  // Chi2InEveryQuadrant 6 + SingleNodeTurnsWithTheView 1
 
 std::vector<float> theta_o_nodes() {
     std::vector<float> n;
@@ -68,7 +70,11 @@ void expect_chi2(const HuangTable &t, Vec3 wo, const std::string &what) {
     const HuangTableQuery q = t.locate(wo);
     Chi2Options options;
     options.test_count = kChi2Tests;
-    for (int k = 0; k <= kThetaI; ++k) options.theta_breaks.push_back(-kHalfPi + kPi * k / kThetaI);
+    // The density jumps at each weighted node's cell edges, mapped back through its warp, and
+    // its Jacobian at the warp's anchor.
+    for (int n = 0; n < 2; ++n)
+        for (int k = 0; k <= kThetaI; ++k) options.theta_breaks.push_back(q.warp[n].from_node(-kHalfPi + kPi * k / kThetaI));
+    options.theta_breaks.push_back(q.warp[0].anchor);
     for (int k = 0; k <= kPhi; ++k) options.phi_breaks.push_back(unfolded_azimuth(q, -kPi + kTwoPi * k / kPhi));
     const auto r = testing::chi2_direction_test(
         [&](Sample3 u) -> std::optional<Vec3> {
@@ -78,6 +84,7 @@ void expect_chi2(const HuangTable &t, Vec3 wo, const std::string &what) {
             return s->wi;
         },
         [&](Vec3 wi) { return double(t.pdf(q, wi)); }, options);
+    std::printf("[chi2] %s: %s\n", what.c_str(), r.message.c_str());
     EXPECT_TRUE(r.passed) << what << ": " << r.message;
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what;
     EXPECT_EQ(r.failed_samples, 0) << what;
@@ -139,27 +146,88 @@ TEST(HuangTable, MirroredViewsSampleMirroredDirections) {
         }
 }
 
+// The warp of θ_i from a view at θ_o onto the node θ_n, and its Jacobian dΩ_n/dΩ, written out
+// here: piecewise linear, −π/2 ↦ −π/2, −θ_o ↦ −θ_n, π/2 ↦ π/2.
+double warp(double theta_o, double theta_n, double theta_i) {
+    return theta_i < -theta_o ? -kHalfPi + (theta_i + kHalfPi) * (kHalfPi - theta_n) / (kHalfPi - theta_o)
+                              : kHalfPi - (kHalfPi - theta_i) * (kHalfPi + theta_n) / (kHalfPi + theta_o);
+}
+double warp_jacobian(double theta_o, double theta_n, double theta_i) {
+    const double slope = theta_i < -theta_o ? (kHalfPi - theta_n) / (kHalfPi - theta_o) : (kHalfPi + theta_n) / (kHalfPi + theta_o);
+    return slope * std::cos(warp(theta_o, theta_n, theta_i)) / std::cos(theta_i);
+}
+
 // Between nodes the density is the bilinear mixture of the four neighbouring node views'
-// densities at the same θ_i and relative azimuth, with weights from the node positions.
-TEST(HuangTable, BetweenNodesThePdfIsTheBilinearMixture) {
+// densities, each at the direction warped onto its θ_o node (same relative azimuth) times the
+// warp's Jacobian, with weights from the node positions.
+TEST(HuangTable, BetweenNodesThePdfIsTheBilinearMixtureOfWarpedNodes) {
     const HuangTable &t = table();
-    const double theta_o = radians(-20.0), phi_o = radians(27.0);
-    const double tt = (theta_o - radians(-30.0)) / radians(30.0), ss = phi_o / (kHalfPi / 2);
+    const double theta_o = double(float(radians(-20.0))), phi_o = radians(27.0);
+    const double tt = (theta_o - double(float(radians(-30.0)))) / (double(float(radians(0.0))) - double(float(radians(-30.0))));
+    const double ss = phi_o / (kHalfPi / 2);
     const HuangTableQuery q = t.locate(direction_of(float(theta_o), float(phi_o)));
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int k = 0; k < 200; ++k) {
         const float sin_i = 2.0f * u(rng) - 1.0f, rel = float(kTwoPi) * (u(rng) - 0.5f);
-        const float theta_i = std::asin(sin_i);
+        const double theta_i = std::asin(double(sin_i));
         double mixture = 0.0;
         for (int a = 0; a < 2; ++a)
             for (int b = 0; b < 2; ++b) {
-                const double node_theta = radians(-30.0 + 30.0 * a), node_phi = kHalfPi / 2 * b;
+                const double node_theta = double(float(radians(-30.0 + 30.0 * a))), node_phi = kHalfPi / 2 * b;
                 const HuangTableQuery n = t.locate(direction_of(float(node_theta), float(node_phi)));
                 const double w = (a ? tt : 1 - tt) * (b ? ss : 1 - ss);
-                mixture += w * t.pdf(n, direction_of(theta_i, float(node_phi + rel)));
+                const double warped = warp(theta_o, node_theta, theta_i);
+                mixture += w * t.pdf(n, direction_of(float(warped), float(node_phi + rel))) *
+                           warp_jacobian(theta_o, node_theta, theta_i);
             }
-        EXPECT_NEAR(t.pdf(q, direction_of(theta_i, float(phi_o + rel))), mixture, 1e-5 * mixture + 1e-7) << k;
+        EXPECT_NEAR(t.pdf(q, direction_of(float(theta_i), float(phi_o + rel))), mixture, 2e-4 * mixture + 1e-6) << k;
+    }
+}
+
+TEST(HuangTable, WarpFixesThePolesMapsTheConeAndKeepsSolidAngle) {
+    const ThetaWarp w = ThetaWarp::between(0.3, 0.5);
+    EXPECT_NEAR(w.to_node(-kHalfPi), -kHalfPi, 1e-12);
+    EXPECT_NEAR(w.to_node(kHalfPi), kHalfPi, 1e-12);
+    EXPECT_NEAR(w.to_node(-0.3), -0.5, 1e-12);
+    for (double x : {-1.5, -0.9, -0.31, 0.2, 1.4}) {
+        EXPECT_NEAR(w.from_node(w.to_node(x)), x, 1e-12);
+        EXPECT_NEAR(w.jacobian(x), warp_jacobian(0.3, 0.5, x), 1e-12);
+    }
+    // A bijection of the sphere: ∫ (dΩ_node/dΩ) dΩ = 4π, i.e. ∫ J cos θ dθ = 2.
+    double integral = 0.0;
+    const int n = 200000;
+    for (int k = 0; k < n; ++k) {
+        const double x = -kHalfPi + kPi * (k + 0.5) / n;
+        integral += w.jacobian(x) * std::cos(x) * kPi / n;
+    }
+    EXPECT_NEAR(integral, 2.0, 1e-5);
+    // Views along the fiber keep bounded slopes (the anchor is clamped inside the poles).
+    const HuangTableQuery q = table().locate(direction_of(float(kHalfPi), 0.3f));
+    EXPECT_LT(q.warp[0].below, 10.0);
+    EXPECT_LT(q.warp[0].above, 10.0);
+}
+
+// A narrow lobe on each node's specular cone θ_i = −θ_node: between two nodes the sampled θ_i
+// follow the view's cone −θ_o, not the nodes'.
+TEST(HuangTable, LobesFollowTheViewBetweenNodes) {
+    std::vector<float> values;
+    const int cells = 90;
+    for (int q = 0; q < 2; ++q)
+        for (int r = 0; r < kThetaO; ++r)
+            for (int i = 0; i < cells; ++i)
+                for (int j = 0; j < 8; ++j) {
+                    const double theta = -kHalfPi + kPi * (i + 0.5) / cells;
+                    values.push_back(float(std::exp(-sqr(theta + theta_o_nodes()[size_t(r)]) / (2 * sqr(0.02)))));
+                }
+    const HuangTable t = HuangTable::create(theta_o_nodes(), phi_o_nodes(2), cells, 8, values).value();
+    for (double theta_o : {-0.4, 0.1, 0.7}) {
+        const HuangTableQuery q = t.locate(direction_of(float(theta_o), 0.4f));
+        std::mt19937 rng(21);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        int near_cone = 0;
+        for (int k = 0; k < 4000; ++k) near_cone += std::fabs(std::asin(t.sample(q, u(rng), u(rng), u(rng))->wi.x) + theta_o) < 0.08;
+        EXPECT_GT(near_cone, 0.95 * 4000) << theta_o;
     }
 }
 
@@ -174,7 +242,7 @@ TEST(HuangTable, OneCellIsUniformOverItsSolidAngle) {
     const double s0 = std::sin(-kHalfPi + kPi * i / kThetaI), s1 = std::sin(-kHalfPi + kPi * (i + 1) / kThetaI);
     const double expected = 1.0 / ((s1 - s0) * kTwoPi / kPhi);
     const double phi_o = 0.3;
-    const HuangTableQuery query = t.locate(direction_of(0.1f, float(phi_o)));
+    const HuangTableQuery query = t.locate(direction_of(0.0f, float(phi_o)));  // on a θ_o node: no warp
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int k = 0; k < 1000; ++k) {

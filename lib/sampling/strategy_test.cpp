@@ -221,7 +221,10 @@ TEST(HuangStrategy, TableIsExact) {
         const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
         Chi2Options options;
         options.test_count = kHuangFamily;
-        for (int k = 0; k <= table.theta_i_count(); ++k) options.theta_breaks.push_back(-kHalfPi + kPi * k / table.theta_i_count());
+        for (const ThetaWarp &w : q.warp)
+            for (int k = 0; k <= table.theta_i_count(); ++k)
+                options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
+        options.theta_breaks.push_back(q.warp[0].anchor);
         for (int k = 0; k <= table.phi_count(); ++k) {
             const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
             options.phi_breaks.push_back(
