@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -66,6 +67,14 @@ void print(const char *format, ...) {
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// CPU seconds of this process (all threads) or of the calling thread: what the work costs,
+// whatever else shares the cores.
+double cpu_seconds(clockid_t clock = CLOCK_PROCESS_CPUTIME_ID) {
+    timespec t{};
+    clock_gettime(clock, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 double median(std::vector<double> v) {
@@ -256,15 +265,17 @@ std::shared_ptr<const HuangFiber> make_fiber(const HuangParams &p) {
 
 struct TableStrategy {
     HuangSamplingTable table;
-    double bake_seconds = 0;
+    double bake_seconds = 0, bake_cpu_seconds = 0;
     HuangTableSet set;
 };
 
 TableStrategy bake(const HuangFiber &fiber, HuangBakeOptions o) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_seconds();
     TableStrategy s;
     s.set = bake_huang_table(fiber, o).value();
     s.bake_seconds = seconds_since(t0);
+    s.bake_cpu_seconds = cpu_seconds() - c0;
     s.table = HuangSamplingTable::from(s.set).value();
     return s;
 }
@@ -291,8 +302,9 @@ void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
     print("## 1. Bake evaluator and resolution (Blender's default Huang node)\n\n"
           "Aspect 0.85, roughness 0.3, IOR 1.55, offset 2°, σ_a from the default colour at β = 0.3. Relative variance of the "
           "table strategy (uniform weight %.3g) at 8 views (θ_o, φ_o) = (−60, 11), (−26, 37), (0, 69), (20, 160), (46, −20), "
-          "(69, −115), (−78, 52), (33, 83)°; bake time on 1 and 2 threads (this machine's 2 cores are shared with other jobs: "
-          "treat times as upper bounds); memory = HuangTable::memory_bytes.\n\n",
+          "(69, −115), (−78, 52), (33, 83)°. Bake CPU = the CPU seconds of the 1-thread bake (the work, whatever shares "
+          "the cores); wall times on 1 and 2 threads are upper bounds: this machine's 2 cores were shared with other jobs "
+          "(load average up to 10) while the study ran. Memory = HuangTable::memory_bytes.\n\n",
           double(kHuangUniformWeight));
     // f on grids aligned with each cell structure, computed once per structure.
     std::map<std::pair<int, int>, std::vector<ViewF>> views;
@@ -325,31 +337,34 @@ void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
         return o;
     };
     const HuangBakeOptions d{};
-    std::vector<Config> configs = {
-        {"expectation (1,1)", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 1, 1)},
-        {"expectation (3,1)", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 3, 1)},
-        {"expectation (3,2)", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 3, 2)},
-        {"expectation (4,3)", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 4, 3)},
-        {"expectation (5,3)", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 5, 3)},
-        {"expectation (3,2), 2×2 points", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 3, 2, 2)},
-        {"expectation (4,3), 2×2 points", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "expectation", 4, 3, 2)},
-        {"Cycles eval ×1, 2×2 points", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "estimate", 3, 2, 2, 1)},
-        {"Cycles eval ×1", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "estimate", 3, 2, 1, 1)},
-        {"Cycles eval ×4", with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, "estimate", 3, 2, 1, 4)},
+    auto at_default = [&](const std::string &evaluator, int first, int second, int points = 1, int estimates = 1) {
+        return with(d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count, evaluator, first, second, points, estimates);
     };
-    const int resolutions[][4] = {{12, 3, 32, 48}, {18, 3, 32, 48}, {24, 2, 32, 48}, {24, 3, 32, 48}, {24, 6, 32, 48},
-                                  {36, 4, 32, 48}, {24, 4, 24, 32}, {24, 4, 48, 64}, {24, 4, 64, 96}, {18, 3, 48, 64},
-                                  {36, 3, 48, 64}};
+    std::vector<Config> configs = {
+        {"expectation (1,1)", at_default("expectation", 1, 1)},
+        {"expectation (3,1)", at_default("expectation", 3, 1)},
+        {"expectation (3,2)", at_default("expectation", 3, 2)},
+        {"expectation (4,3) (default)", at_default("expectation", 4, 3)},
+        {"expectation (5,3)", at_default("expectation", 5, 3)},
+        {"expectation (3,2), 2×2 points", at_default("expectation", 3, 2, 2)},
+        {"expectation (4,3), 2×2 points", at_default("expectation", 4, 3, 2)},
+        {"Cycles eval ×1", at_default("estimate", 3, 2, 1, 1)},
+        {"Cycles eval ×4", at_default("estimate", 3, 2, 1, 4)},
+        {"Cycles eval ×1, 2×2 points", at_default("estimate", 3, 2, 2, 1)},
+    };
+    const int resolutions[][4] = {{12, 4, 48, 64}, {18, 4, 48, 64}, {36, 4, 48, 64}, {24, 2, 48, 64}, {24, 3, 48, 64},
+                                  {24, 6, 48, 64}, {24, 4, 24, 32}, {24, 4, 32, 48}, {24, 4, 64, 96}};
     for (const auto &r : resolutions)
         configs.push_back({std::to_string(r[0]) + " × " + std::to_string(r[1]) + " × " + std::to_string(r[2]) + " × " +
-                               std::to_string(r[3]) + ", (3,2)",
-                           with(r[0], r[1], r[2], r[3], "expectation", 3, 2)});
-    configs.push_back({"24 × 4 × 48 × 64, (4,3)", with(24, 4, 48, 64, "expectation", 4, 3)});
-    configs.push_back({"36 × 4 × 48 × 64, (4,3)", with(36, 4, 48, 64, "expectation", 4, 3)});
+                               std::to_string(r[3]) + ", (4,3)",
+                           with(r[0], r[1], r[2], r[3], "expectation", 4, 3)});
     if (quick) configs.resize(3);
 
-    print("| evaluator; θ_o × φ_o nodes × θ_i × φ cells | bake 1 thread (s) | bake 2 threads (s) | memory (MB) | median relative "
-          "variance | max |\n|---|---|---|---|---|---|\n");
+    print("First the evaluator at the default resolution (%d × %d × %d × %d), then the resolution θ_o nodes × φ_o nodes × "
+          "θ_i cells × φ cells with the default evaluator.\n\n",
+          d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count);
+    print("| evaluator; θ_o × φ_o nodes × θ_i × φ cells | bake CPU (s) | bake 1 thread (s) | bake 2 threads (s) | memory (MB) | "
+          "median relative variance | max |\n|---|---|---|---|---|---|---|\n");
     for (Config &c : configs) {
         c.o.threads = 1;
         const TableStrategy one = bake(*fiber, c.o);
@@ -358,7 +373,7 @@ void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
         const HairShading shading = shading_of(fiber, StrategyKind::Table, &two.table);
         std::vector<double> v;
         for (const ViewF &view : views_for(*two.table.table)) v.push_back(grid_variance(view, shading).relative);
-        print("| %s | %.2f | %.2f | %.2f | %s | %s |\n", c.label.c_str(), one.bake_seconds, two.bake_seconds,
+        print("| %s | %.2f | %.2f | %.2f | %.2f | %s | %s |\n", c.label.c_str(), one.bake_cpu_seconds, one.bake_seconds, two.bake_seconds,
               double(two.table.table->memory_bytes()) / 1e6, number(median(v)).c_str(),
               number(*std::max_element(v.begin(), v.end())).c_str());
     }
@@ -379,8 +394,8 @@ void section_strategies() {
     print("## 2. Strategies over θ_o, φ_o, aspect ratio and roughness\n\n"
           "Per fiber the median over θ_o ∈ {−70, −35, 0, 30, 65}° × φ_o ∈ {10, 40, 75}° (circular fibers: θ_o only) of the "
           "relative variance per sample of the luminance estimate of ∫ f cos dω_i. TABLE = the policy's table strategy "
-          "(default bake, uniform weight %.3g); Cycles = Cycles' own sampler with its own weight (%lld samples per view), "
-          "whose mean is Cycles' sampled energy: the last column is its median mean / ∫ f (eval's energy). Bake time on 2 threads.\n\n",
+          "(default bake, uniform weight %.3g; bake = its CPU seconds; grid: 2 points per table cell and axis); Cycles = Cycles' own sampler with its own weight (%lld samples per view), "
+          "whose mean is Cycles' sampled energy: the last column is its median mean / ∫ f (eval's energy).\n\n",
           double(kHuangUniformWeight), quick ? 20000LL : 200000LL);
     print("| aspect | roughness | bake (s) | UNIFORM | Cycles | TABLE | TABLE / Cycles | Cycles mean / ∫ f |\n"
           "|---|---|---|---|---|---|---|---|\n");
@@ -399,7 +414,7 @@ void section_strategies() {
             for (double phi : kPhiO) {
                 if (c.aspect == 1.0f && phi != kPhiO[0]) continue;
                 const FiberHit hit = hit_at(theta, phi);
-                const ViewF v = view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, quick ? 2 : 4));
+                const ViewF v = view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 2));
                 const CyclesMoments cy = cycles_moments(*fiber, hit, quick ? 20000 : 200000);
                 vu.push_back(grid_variance(v, uniform).relative);
                 vt.push_back(grid_variance(v, table).relative);
@@ -413,7 +428,7 @@ void section_strategies() {
                               number(vt.back()).c_str(), mean_ratio.back(), v.integral);
                 detail.push_back(line);
             }
-        print("| %.2f | %.2f | %.1f | %s | %s | %s | %s | %.3f |\n", c.aspect, c.roughness, t.bake_seconds,
+        print("| %.2f | %.2f | %.1f | %s | %s | %s | %s | %.3f |\n", c.aspect, c.roughness, t.bake_cpu_seconds,
               number(median(vu)).c_str(), number(median(vc)).c_str(), number(median(vt)).c_str(),
               number(median(ratio)).c_str(), median(mean_ratio));
     }
@@ -433,9 +448,11 @@ void section_strategies() {
     print("Monte Carlo check (default fiber, TABLE, %d samples each): ", quick ? 2000 : 20000);
     for (const ViewAngles &a : {ViewAngles{-35, 40}, ViewAngles{0, 10}, ViewAngles{30, 75}, ViewAngles{65, 40}}) {
         const FiberHit hit = hit_at(a.theta_o, a.phi_o);
-        const double q = grid_variance(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, quick ? 2 : 4)), table).relative;
+        const double q2 = grid_variance(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 2)), table).relative;
+        const double q4 = grid_variance(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 4)), table).relative;
         const double mc = mc_variance(*fiber, table, hit, quick ? 2000 : 20000);
-        print("(%.0f°, %.0f°) quadrature %s, Monte Carlo %s; ", a.theta_o, a.phi_o, number(q).c_str(), number(mc).c_str());
+        print("(%.0f°, %.0f°) quadrature %s (2 points per cell and axis) and %s (4), Monte Carlo %s; ", a.theta_o, a.phi_o,
+              number(q2).c_str(), number(q4).c_str(), number(mc).c_str());
     }
     print("\n\n");
 }
@@ -462,7 +479,7 @@ void section_uniform_weight() {
         std::vector<ViewF> views;
         for (const ViewAngles &a : kSweepViews) {
             const FiberHit hit = hit_at(a.theta_o, a.phi_o);
-            views.push_back(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, quick ? 2 : 4)));
+            views.push_back(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 2)));
         }
         print("| aspect %.2f, roughness %.2f |", c.aspect, c.roughness);
         double uncovered = 0;
@@ -525,7 +542,7 @@ void section_near_field() {
 
 // ---------------------------------------------------------------------------------------------
 
-// Nanoseconds per sample on one thread, best of three passes over random hits.
+// Nanoseconds (thread CPU time) per sample on one thread, best of three passes over random hits.
 template <typename PerHit>
 double time_per_sample(PerHit &&per_hit) {
     const int n = quick ? 1 << 12 : 1 << 15;
@@ -542,9 +559,9 @@ double time_per_sample(PerHit &&per_hit) {
     volatile float sink = 0;
     for (int pass = 0; pass < 3; ++pass) {
         float checksum = 0;
-        const auto t0 = std::chrono::steady_clock::now();
+        const double t0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
         for (int k = 0; k < n; ++k) checksum += per_hit(hits[size_t(k)], &us[size_t(3) * k]);
-        best = std::min(best, seconds_since(t0) * 1e9 / n);
+        best = std::min(best, (cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - t0) * 1e9 / n);
         sink = sink + checksum;
     }
     return best;
@@ -552,7 +569,7 @@ double time_per_sample(PerHit &&per_hit) {
 
 void section_time() {
     print("## 5. Time per sample\n\n"
-          "One thread, random views (θ_o, φ_o) over the sphere, best of three passes. TABLE and UNIFORM: prepare the hit "
+          "One thread (its CPU time), random views (θ_o, φ_o) over the sphere, best of three passes. TABLE and UNIFORM: prepare the hit "
           "(fiber point and sampler point), sample (the direction and its pdf), f there (one Cycles eval: HuangPoint::f) "
           "and one more pdf query; also sample + pdf alone. Cycles: prepare the fiber point and Cycles' sampler (its weight "
           "replaces f/pdf). In a path tracer with next-event estimation the light sample needs f (one Cycles eval) either "

@@ -20,12 +20,12 @@ struct HuangBakeOptions {
     int theta_o_count = 24;  ///< θ_o nodes at the centres of equal cells of [−π/2, π/2]
     /// φ_o nodes over [0, π/2], ends included (1: the node π/2). Circular fibers get one node.
     int phi_o_count = 4;
-    int theta_i_count = 32;  ///< θ_i cells over [−π/2, π/2]
-    int phi_count = 48;      ///< cells of φ_i − φ_o over [−π, π]
+    int theta_i_count = 48;  ///< θ_i cells over [−π/2, π/2]
+    int phi_count = 64;      ///< cells of φ_i − φ_o over [−π, π]
     int points = 1;          ///< evaluation points per cell and axis (midpoints in sin θ_i and φ)
     /// "expectation" (HuangExpectation with the orders below) or "estimate" (Cycles' eval).
     std::string evaluator = "expectation";
-    int first_order = 3, second_order = 2;  ///< the expectation's rule (HuangQuadrature)
+    int first_order = 4, second_order = 3;  ///< the expectation's rule (HuangQuadrature)
     int estimates = 1;                      ///< Cycles evals per point ("estimate")
     int threads = 0;                        ///< 0: all cores
 
