@@ -1,6 +1,6 @@
-// Google Benchmark of the Huang pieces (not yet in bench/CMakeLists.txt): the far-field
-// expectation per ω_o and per ω_i, and per renderer hit prepare, f (one Cycles eval) and
-// Cycles' sampler, for default, rough and smooth roughness and aspect 1, 0.85, 0.5.
+// Google Benchmark of the Huang pieces: the far-field expectation per ω_o and per ω_i, and per
+// renderer hit prepare, f (one Cycles eval) and Cycles' sampler, for default, rough and smooth
+// roughness and aspect 1, 0.85, 0.5.
 #include <benchmark/benchmark.h>
 
 #include <vector>

@@ -1,6 +1,7 @@
 #include "fiber/huang.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -550,19 +551,23 @@ Rgb HuangExpectation::f(Vec3 wi) const {
 }
 
 HuangFarField::HuangFarField(const HuangFiber &fiber, Vec3 wo, const HuangQuadrature &quadrature)
-    : expectation_(fiber.expectation({wo, 0.0f, 1.0f}, quadrature)) {}
+    : expectation_(fiber.expectation({wo, 0.0f, 1.0f}, quadrature)) {
+    static std::atomic<std::uint64_t> next_id{1};
+    id_ = next_id.fetch_add(1, std::memory_order_relaxed);
+}
 
 Rgb HuangFarField::lobe_f_cos(int p, Vec3 wi) const {
     if (p < 0 || p > 3) return {};
-    // Sweeps ask for the lobes of one ω_i in turn: keep the last ω_i's four per thread.
+    // Sweeps ask for the lobes of one ω_i in turn: keep the last ω_i's four per thread, keyed
+    // by the view's id (not its address, which a later view may reuse).
     struct Last {
-        const HuangFarField *view = nullptr;
+        std::uint64_t view = 0;
         Vec3 wi;
         std::array<Rgb, 4> lobes{};
     };
     thread_local Last last;
-    if (last.view != this || std::memcmp(&last.wi, &wi, sizeof(Vec3)) != 0) {
-        last.view = this;
+    if (last.view != id_ || std::memcmp(&last.wi, &wi, sizeof(Vec3)) != 0) {
+        last.view = id_;
         last.wi = wi;
         last.lobes = expectation_.lobes(wi);
     }

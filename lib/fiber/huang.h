@@ -203,6 +203,7 @@ class HuangFarField final : public FarFieldView {
 
   private:
     HuangExpectation expectation_;
+    std::uint64_t id_;  // unique per view: keys the per-thread cache of the last ω_i's lobes
 };
 
 /// The Huang 2022 fiber (Cycles 4.5/5.0 "Principled Hair BSDF", model Huang).

@@ -395,3 +395,28 @@ TEST(Huang, CyclesSamplerConservesEnergyOfClearFiber) {
 
 }  // namespace
 }  // namespace hairis
+
+namespace hairis {
+namespace {
+
+// A far-field view remembers the last ω_i's lobes per thread; a new view must never see the
+// lobes of a destroyed one, even when it is allocated at the same address.
+TEST(Huang, FarFieldViewsNeverShareCachedLobes) {
+    HuangQuadrature rule;
+    rule.first_order = 3;
+    rule.second_order = 2;
+    const HuangFiber fiber = HuangFiber::create(HuangParams{}, rule).value();
+    const Vec3 wi = direction_of(-0.3f, 0.4f + float(kPi));  // forward scattering: all lobes
+    const Vec3 first = direction_of(0.3f, 0.4f), second = direction_of(0.2f, 0.1f);
+    const std::array<Rgb, 4> a = fiber.expectation({first, 0.0f, 1.0f}, rule).lobes(wi);
+    const std::array<Rgb, 4> b = fiber.expectation({second, 0.0f, 1.0f}, rule).lobes(wi);
+    for (int p = 0; p < 4; ++p) ASSERT_NE(luminance(a[size_t(p)]), luminance(b[size_t(p)])) << p;
+    for (int k = 0; k < 4; ++k) {
+        fiber.view(first)->lobe_f_cos(0, wi);  // destroyed at once
+        const std::unique_ptr<const FarFieldView> v = fiber.view(second);
+        for (int p = 0; p < 4; ++p) EXPECT_EQ(luminance(v->lobe_f_cos(p, wi)), luminance(b[size_t(p)])) << k << " lobe " << p;
+    }
+}
+
+}  // namespace
+}  // namespace hairis

@@ -4,6 +4,7 @@
 
 #include "fiber/fiber_spec.h"
 #include "sampling/analytic_sampler.h"
+#include "sampling/huang_table_sampler.h"
 #include "sampling/mixture_sampler.h"
 #include "sampling/seed_samplers.h"
 #include "sampling/table_samplers.h"
@@ -34,6 +35,24 @@ Expected<std::shared_ptr<const Sampler>> mixture(Expected<std::shared_ptr<const 
 
 Error table_error(std::string message) { return Error{std::move(message), ErrorKind::InvalidTable}; }
 
+// TABLE for a Huang fiber: its baked table, mixed with the uniform sphere.
+Expected<std::shared_ptr<const Sampler>> huang_table_sampler(const StrategyInputs &in) {
+    if (Status s = check::in_range("huang_uniform_weight", in.huang_uniform_weight, 0.0, 1.0)) return *s;
+    if (!(in.huang_uniform_weight < 1.0f))
+        return Error{"huang_uniform_weight must be below 1 (got 1): the table would never be sampled"};
+    if (in.multiple_weight > 0.0f)
+        return Error{"multiple_weight must be 0 for a Huang fiber (got " + std::to_string(in.multiple_weight) +
+                     "): the multiple-scattering table is not part of the single-fiber f a path tracer samples"};
+    if (!in.huang_table || !in.huang_table->table)
+        return table_error("the table strategy for a Huang fiber needs a baked Huang table (none was given)");
+    const std::string parameters = canonical_parameters(huang_parameters(in.huang->params()));
+    if (in.huang_table->parameters != parameters)
+        return table_error("the Huang table was baked for \"" + in.huang_table->parameters + "\", not for " +
+                           in.huang->name() + " \"" + parameters + "\"; bake a table for this fiber");
+    return mixture(shared(HuangTableSampler::create(in.huang, in.huang_table->table)),
+                   std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>()), in.huang_uniform_weight);
+}
+
 }  // namespace
 
 const char *strategy_name(StrategyKind kind) {
@@ -59,6 +78,7 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
 
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &input) {
     if (Status s = check::in_range("multiple_weight", input.multiple_weight, 0.0, 1.0)) return *s;
+    if ((input.chiang || input.strands) && input.huang) return Error{"give either a Chiang or a Huang fiber, not both"};
     if (input.strands && input.chiang && input.chiang != input.strands->fiber())
         return Error{"strategy inputs: chiang must be null or the strands' own fiber"};
     StrategyInputs in = input;
@@ -67,6 +87,9 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
         case StrategyKind::Uniform:
             return std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>());
         case StrategyKind::Analytic:
+            if (in.huang)
+                return Error{"the analytic strategy has no exact sampler for a Huang fiber (Cycles' own Huang sampler "
+                             "has no density); use table (with a baked Huang table), uniform or gaussian"};
             if (in.strands) return std::shared_ptr<const Sampler>(std::make_shared<const AnalyticSampler>(in.strands));
             if (!in.chiang) return Error{"the analytic strategy needs a Chiang (Principled Hair) fiber"};
             return std::shared_ptr<const Sampler>(std::make_shared<const AnalyticSampler>(in.chiang));
@@ -74,6 +97,7 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
             return mixture(shared(SeedDirectSampler::create(in.seed)), shared(SeedMultipleSampler::create(in.seed, in.n_h)),
                            in.multiple_weight);
         case StrategyKind::Table: {
+            if (in.huang) return huang_table_sampler(in);
             if (!in.tables || !in.tables->direct || !in.tables->multiple)
                 return table_error("the table strategy needs baked tables (none were given)");
             const SamplingTables &t = *in.tables;

@@ -8,7 +8,9 @@
 #include "core/expected.h"
 #include "fiber/chiang.h"
 #include "fiber/chiang_strands.h"
+#include "fiber/huang.h"
 #include "fiber/seed_pdfs.h"
+#include "sampling/huang_table.h"
 #include "sampling/near_field_table.h"
 #include "sampling/sampler.h"
 #include "sampling/sampling_table.h"
@@ -52,6 +54,10 @@ void describe(Fields &f, SamplerOptions &o) {
     f.field("n_h", o.n_h, 1, 1024);
 }
 
+/// The weight of the uniform sphere in TABLE's mixture for a Huang fiber: it keeps the density
+/// positive wherever f is, also in cells the bake saw as zero (bench/results/huang_study.md).
+inline constexpr float kHuangUniformWeight = 0.01f;
+
 /// What a strategy may need.
 struct StrategyInputs {
     /// The material's fiber: ANALYTIC samples it; TABLE samples its near field from it.
@@ -73,6 +79,13 @@ struct StrategyInputs {
     /// A near-field table to use instead of the tables' near-field part (studies of other
     /// resolutions; TABLE with a fiber).
     std::shared_ptr<const NearFieldTable> near_field;
+    /// A Huang fiber instead of `chiang`: TABLE samples `huang_table`, UNIFORM and GAUSSIAN
+    /// work as for any fiber, ANALYTIC is refused.
+    std::shared_ptr<const HuangFiber> huang;
+    /// The Huang table (TABLE with `huang`): it must have been baked for `huang`'s parameters.
+    const HuangSamplingTable *huang_table = nullptr;
+    /// TABLE with `huang`: the uniform sphere's weight in the mixture, in [0, 1).
+    float huang_uniform_weight = kHuangUniformWeight;
 };
 
 /// The sampler of `kind`:
@@ -80,7 +93,11 @@ struct StrategyInputs {
 ///   ANALYTIC  Chiang's lobe sampling (needs the fiber);
 ///   GAUSSIAN  (1 − w)·seed direct + w·seed multiple(n_h);
 ///   TABLE     (1 − w)·single + w·multiple table(n_h), single = the tables' near-field part
-///             for the fiber when a fiber is given, else the tables' far-field direct table.
+///             for the fiber when a fiber is given, else the tables' far-field direct table;
+///             with a Huang fiber (1 − u)·Huang table + u·uniform, u = huang_uniform_weight,
+///             and w must be 0 (a path tracer samples the single-fiber f, which the
+///             multiple-scattering table does not describe).
+/// ANALYTIC with a Huang fiber is refused: Huang has no sampler with a known density.
 /// Errors name what is missing or out of range; tables baked for another fiber, or without
 /// n_h, are refused with ErrorKind::InvalidTable.
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &inputs);

@@ -1,7 +1,8 @@
 // Every strategy the policy makes samples the density it reports: χ² at θ_r on table nodes,
 // between nodes and near grazing, for the far-field direct table, each n_h of the multiple
-// table, their mixture, the near-field mixture, the analytic sampler and the uniform one; and
-// the policy refuses what it cannot build, naming it.
+// table, their mixture, the near-field mixture, the analytic sampler and the uniform one, and
+// for a Huang fiber the table strategy (its table mixed with the uniform sphere); and the
+// policy refuses what it cannot build, naming it.
 #include "sampling/strategy.h"
 
 #include <gtest/gtest.h>
@@ -11,8 +12,11 @@
 #include "fiber/fiber_spec.h"
 #include "sampler_at.h"
 #include "fiber/chiang_strands.h"
+#include "fiber/principled_hair.h"
+#include "sampling/huang_table_sampler.h"
 #include "sampling/mixture_sampler.h"
 #include "tables/bake.h"
+#include "tables/huang_bake.h"
 
 namespace hairis {
 namespace {
@@ -283,6 +287,163 @@ TEST(Strategy, ASamplerForStrandsPairsOnlyWithThoseStrands) {
     auto stale = make_sampler(StrategyKind::Table, other);
     ASSERT_FALSE(stale.ok());
     EXPECT_EQ(stale.error().kind, ErrorKind::InvalidTable);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Huang
+
+constexpr int kHuangFamily = 4;
+
+struct HuangFixture {
+    std::shared_ptr<const HuangFiber> fiber;
+    HuangSamplingTable table;
+};
+
+std::shared_ptr<const HuangFiber> huang_fiber(float roughness = 0.3f) {
+    HuangParams p;  // Blender's default node, the default colour mapped with Huang's roughness
+    p.roughness = roughness;
+    p.sigma_a = principled_hair::sigma_from_reflectance({0.017513f, 0.005763f, 0.002059f}, roughness);
+    return std::make_shared<const HuangFiber>(HuangFiber::create(p).value());
+}
+
+const HuangFixture &huang_fixture() {
+    static const HuangFixture f = [] {
+        auto fiber = huang_fiber();
+        HuangBakeOptions o;
+        o.theta_o_count = 8;
+        o.phi_o_count = 3;
+        o.theta_i_count = 16;
+        o.phi_count = 24;
+        o.evaluator = "estimate";
+        return HuangFixture{fiber, HuangSamplingTable::from(bake_huang_table(*fiber, o).value()).value()};
+    }();
+    return f;
+}
+
+StrategyInputs huang_inputs(const HuangSamplingTable *table, float uniform_weight = kHuangUniformWeight) {
+    StrategyInputs in;
+    in.huang = huang_fixture().fiber;
+    in.huang_table = table;
+    in.huang_uniform_weight = uniform_weight;
+    return in;
+}
+
+// A renderer hit at θ_o (degrees) whose curve normal puts the major axis at ψ from y.
+FiberHit huang_hit(double theta_o_deg, double psi) {
+    const double t = radians(theta_o_deg);
+    FiberHit hit;
+    hit.wo = {float(std::sin(t)), 0.0f, float(-std::cos(t))};
+    hit.normal = {0.2f, float(std::cos(psi)), float(std::sin(psi))};
+    return hit;
+}
+
+TEST(HuangStrategy, TableIsExact) {
+    const auto s = made(StrategyKind::Table, huang_inputs(&huang_fixture().table));
+    EXPECT_EQ(s->model(), huang_fixture().fiber.get());
+    const HuangTable &table = *huang_fixture().table.table;
+    // θ_o on a node (33.75°), between nodes, grazing; the major axis in several directions.
+    const std::pair<double, double> views[] = {{33.75, 0.0}, {-20.0, 0.7}, {86.0, 2.5}, {-60.0, -1.9}};
+    for (const auto &[theta_o, psi] : views) {
+        const FiberHit hit = huang_hit(theta_o, psi);
+        ScratchBuffer scratch;
+        const HuangPoint &point = static_cast<const HuangPoint &>(s->model()->prepare(hit, scratch));
+        const SamplerPoint &at = s->at(hit, &point, scratch);
+        const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
+        Chi2Options options;
+        options.test_count = kHuangFamily;
+        for (const ThetaWarp &w : q.warp)
+            for (int k = 0; k <= table.theta_i_count(); ++k)
+                options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
+        options.theta_breaks.push_back(q.warp[0].anchor);
+        for (int k = 0; k <= table.phi_count(); ++k) {
+            const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
+            options.phi_breaks.push_back(
+                angles_of(point.from_huang({0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))})).phi);
+        }
+        const auto r = testing::chi2_direction_test(
+            [&](Sample3 u) -> std::optional<Vec3> {
+                auto d = at.sample(u.u0, u.u1, u.u2);
+                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
+            },
+            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        std::printf("[chi2] Huang table strategy at theta_o %.2f, psi %.1f: %s\n", theta_o, psi, r.message.c_str());
+        EXPECT_TRUE(r.passed) << theta_o << ": " << r.message;
+        EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << theta_o;
+        EXPECT_EQ(r.failed_samples, 0) << theta_o;
+    }
+}
+
+// Cells whose baked value is zero while f is not would never be sampled by the table alone;
+// the uniform part keeps the density at least u/(4π) everywhere.
+TEST(HuangStrategy, TheUniformPartCoversCellsBakedAsZero) {
+    const HuangTable &full = *huang_fixture().table.table;
+    HuangTableSet set;
+    set.parameters = huang_parameters(huang_fixture().fiber->params());
+    set.theta_o_nodes = full.theta_o_nodes();
+    set.phi_o_nodes = full.phi_o_nodes();
+    set.theta_i_count = full.theta_i_count();
+    set.phi_count = full.phi_count();
+    // The baked values with every other φ cell zeroed.
+    for (int q = 0; q < int(set.phi_o_nodes.size()); ++q)
+        for (int r = 0; r < int(set.theta_o_nodes.size()); ++r)
+            for (int i = 0; i < set.theta_i_count; ++i)
+                for (int j = 0; j < set.phi_count; ++j) set.values.push_back(j % 2 ? 0.0f : full.value(q, r, i, j));
+    const HuangSamplingTable holes = HuangSamplingTable::from(set).value();
+    const auto bare = made(StrategyKind::Table, huang_inputs(&holes, 0.0f));
+    const auto guarded = made(StrategyKind::Table, huang_inputs(&holes));
+    const FiberHit hit = huang_hit(10.0, 0.4);
+    ScratchBuffer scratch;
+    const FiberPoint &point = huang_fixture().fiber->prepare(hit, scratch);
+    const SamplerPoint &b = bare->at(hit, &point, scratch), &g = guarded->at(hit, &point, scratch);
+    int uncovered = 0;
+    for (int k = 0; k < 2000; ++k) {
+        const Vec3 wi = direction_of(float(-1.5 + 3.0 * ((k * 37) % 2000) / 2000.0), float(-kPi + kTwoPi * k / 2000.0));
+        const bool f_positive = luminance(point.f(wi)) > 0.0f;
+        if (f_positive && b.pdf(wi) == 0.0f) ++uncovered;
+        EXPECT_GE(g.pdf(wi), kHuangUniformWeight * float(kInvFourPi) * (1.0f - 1e-6f));
+    }
+    EXPECT_GT(uncovered, 100);
+}
+
+TEST(HuangStrategy, UniformAndGaussianSampleHuangToo) {
+    for (StrategyKind kind : {StrategyKind::Uniform, StrategyKind::Gaussian}) {
+        StrategyInputs in = huang_inputs(nullptr);
+        const auto s = made(kind, in);
+        EXPECT_EQ(s->model(), nullptr);
+        EXPECT_TRUE(HairShading::create(huang_fixture().fiber, s).ok()) << strategy_name(kind);
+    }
+}
+
+TEST(HuangStrategy, RefusesWhatItCannotBuildByName) {
+    auto error = [](StrategyKind kind, const StrategyInputs &in) {
+        const auto s = make_sampler(kind, in);
+        return s.ok() ? Error{"(accepted)"} : s.error();
+    };
+    const Error analytic = error(StrategyKind::Analytic, huang_inputs(nullptr));
+    EXPECT_NE(analytic.message.find("no exact sampler for a Huang fiber"), std::string::npos) << analytic.message;
+    EXPECT_NE(analytic.message.find("use table (with a baked Huang table), uniform or gaussian"), std::string::npos);
+    const Error none = error(StrategyKind::Table, huang_inputs(nullptr));
+    EXPECT_EQ(none.kind, ErrorKind::InvalidTable);
+    EXPECT_NE(none.message.find("needs a baked Huang table"), std::string::npos) << none.message;
+    // A table baked for another Huang fiber.
+    HuangParams other = huang_fixture().fiber->params();
+    other.aspect_ratio = 0.6f;
+    StrategyInputs stale = huang_inputs(&huang_fixture().table);
+    stale.huang = std::make_shared<const HuangFiber>(HuangFiber::create(other).value());
+    const Error mismatch = error(StrategyKind::Table, stale);
+    EXPECT_EQ(mismatch.kind, ErrorKind::InvalidTable);
+    EXPECT_NE(mismatch.message.find("aspect_ratio=0.600000024"), std::string::npos) << mismatch.message;
+    StrategyInputs multiple = huang_inputs(&huang_fixture().table);
+    multiple.multiple_weight = 0.25f;
+    EXPECT_NE(error(StrategyKind::Table, multiple).message.find("multiple_weight must be 0 for a Huang fiber"),
+              std::string::npos);
+    EXPECT_NE(error(StrategyKind::Table, huang_inputs(&huang_fixture().table, 1.0f)).message.find("huang_uniform_weight"),
+              std::string::npos);
+    EXPECT_NE(error(StrategyKind::Table, huang_inputs(&huang_fixture().table, -0.1f)).message.find("huang_uniform_weight"),
+              std::string::npos);
+    StrategyInputs both = huang_inputs(&huang_fixture().table);
+    both.chiang = fixture().fiber;
+    EXPECT_NE(error(StrategyKind::Uniform, both).message.find("either a Chiang or a Huang fiber"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,141 @@
+#include "tables/huang_bake.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/frame.h"
+
+namespace hairis {
+
+namespace {
+
+// splitmix64's finalizer: a per-cell LCG seed from the cell's index.
+std::uint32_t cell_seed(std::uint64_t index) {
+    std::uint64_t z = index + 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return std::uint32_t((z ^ (z >> 31)) >> 32);
+}
+
+// What f is evaluated from at one view node.
+struct NodeView {
+    std::optional<HuangExpectation> expectation;
+    std::optional<HuangPoint> point;  // Huang's frame = this point's frame (normal on y)
+};
+
+}  // namespace
+
+Status HuangBakeOptions::validate() const {
+    if (Status s = first_error(check::count_in_range("theta_o_count", theta_o_count, 1, kMaxThetaRNodes),
+                               check::count_in_range("phi_o_count", phi_o_count, 1, kMaxPhiONodes),
+                               check::count_in_range("theta_i_count", theta_i_count, 1, kMaxTableAxisCells),
+                               check::count_in_range("phi_count", phi_count, 1, kMaxTableAxisCells),
+                               check::count_in_range("points", points, 1, 16),
+                               check::count_in_range("first_order", first_order, 1, 32),
+                               check::count_in_range("second_order", second_order, 1, 32),
+                               check::count_in_range("estimates", estimates, 1, 1024),
+                               check::count_in_range("threads", threads, 0, 1024)))
+        return s;
+    if (evaluator != "expectation" && evaluator != "estimate")
+        return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};
+    const long long cells = (long long)theta_o_count * phi_o_count * theta_i_count * phi_count;
+    if (cells > kMaxTableCells)
+        return Error{"theta_o_count × phi_o_count × theta_i_count × phi_count = " + std::to_string(cells) +
+                     " cells; at most " + std::to_string(kMaxTableCells) + " are allowed"};
+    return std::nullopt;
+}
+
+std::vector<float> huang_phi_o_nodes(int count) {
+    if (count <= 1) return {float(kHalfPi)};
+    std::vector<float> nodes(static_cast<std::size_t>(count));
+    for (int k = 0; k < count; ++k) nodes[std::size_t(k)] = float(kHalfPi * k / (count - 1));
+    return nodes;
+}
+
+namespace {
+
+Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOptions &o, const ProgressFn &progress) {
+    HuangTableSet t;
+    t.parameters = huang_parameters(fiber.params());
+    t.theta_o_nodes = theta_r_nodes(o.theta_o_count);
+    t.phi_o_nodes = huang_phi_o_nodes(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count);
+    t.theta_i_count = o.theta_i_count;
+    t.phi_count = o.phi_count;
+    const int n_r = o.theta_o_count, n_q = int(t.phi_o_nodes.size()), n_i = o.theta_i_count, n_j = o.phi_count;
+    t.values.assign(std::size_t(n_q) * n_r * n_i * n_j, 0.0f);
+    const bool expectation = o.evaluator == "expectation";
+    HuangQuadrature rule;
+    rule.first_order = o.first_order;
+    rule.second_order = o.second_order;
+    const int p = o.points;
+    std::atomic<bool> bad{false};
+
+    // One θ_o node at a time keeps progress and cancel responsive; every cell is computed
+    // alone (its own seed), so the result does not depend on the thread count.
+    std::vector<NodeView> views(static_cast<std::size_t>(n_q));
+    for (int r = 0; r < n_r; ++r) {
+        if (progress && !progress(float(r) / float(n_r))) return Error{"cancelled", ErrorKind::Cancelled};
+        const float theta_o = t.theta_o_nodes[std::size_t(r)];
+        tbb::parallel_for(0, n_q, [&](int q) {
+            const Vec3 wo = direction_of(theta_o, t.phi_o_nodes[std::size_t(q)]);
+            NodeView &v = views[std::size_t(q)];
+            if (expectation) {
+                v.expectation.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, rule));
+            } else {
+                FiberHit hit;
+                hit.wo = wo;
+                hit.normal = {0.0f, 1.0f, 0.0f};
+                v.point.emplace(fiber, hit);
+            }
+        });
+        tbb::parallel_for(0, n_q * n_i, [&](int row) {
+            const int q = row / n_i, i = row % n_i;
+            const NodeView &v = views[std::size_t(q)];
+            const double phi_o = t.phi_o_nodes[std::size_t(q)];
+            const double s0 = std::sin(-kHalfPi + kPi * i / n_i), s1 = std::sin(-kHalfPi + kPi * (i + 1) / n_i);
+            const std::size_t first = ((std::size_t(q) * n_r + std::size_t(r)) * n_i + std::size_t(i)) * n_j;
+            for (int j = 0; j < n_j; ++j) {
+                CyclesLcg lcg{cell_seed(first + std::size_t(j))};
+                double sum = 0.0;
+                for (int a = 0; a < p; ++a) {
+                    const double theta_i = std::asin(std::clamp(s0 + (s1 - s0) * (a + 0.5) / p, -1.0, 1.0));
+                    for (int b = 0; b < p; ++b) {
+                        const double phi = -kPi + kTwoPi * (j + (b + 0.5) / p) / n_j;
+                        const Vec3 wi = direction_of(float(theta_i), float(phi_o + phi));
+                        if (expectation) {
+                            sum += luminance(v.expectation->f(wi));
+                        } else {
+                            for (int e = 0; e < o.estimates; ++e) sum += luminance(v.point->f_estimate(wi, lcg));
+                        }
+                    }
+                }
+                const double value = sum / (double(p) * p * (expectation ? 1 : o.estimates));
+                if (!(std::isfinite(value) && value >= 0.0)) bad = true;
+                t.values[first + std::size_t(j)] = float(value);
+            }
+        });
+        if (bad) return Error{"the fiber's f is not finite and non-negative at theta_o node " + std::to_string(r) +
+                              " (a bug in the fiber model)"};
+    }
+    if (progress && !progress(1.0f)) return Error{"cancelled", ErrorKind::Cancelled};
+    return t;
+}
+
+}  // namespace
+
+Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBakeOptions &options,
+                                         const ProgressFn &progress) {
+    if (Status s = options.validate()) return *s;
+    tbb::task_arena arena(options.threads > 0 ? options.threads : int(tbb::task_arena::automatic));
+    Expected<HuangTableSet> result = Error{"not run"};
+    arena.execute([&] { result = bake_in_arena(fiber, options, progress); });
+    return result;
+}
+
+}  // namespace hairis

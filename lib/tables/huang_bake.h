@@ -1,0 +1,44 @@
+// Baking a Huang table (sampling/huang_table.h) from a HuangFiber: per view node the cell
+// averages of luminance(f·cos θ_i) over (θ_i, φ_i − φ_o) cells. The table only has to be a good
+// density (its pdf is exact whatever its values), so f is evaluated cheaply: the expectation
+// of Cycles' eval by a low-order rule, or Cycles' one-sample eval with fixed per-cell seeds
+// (both deterministic; the second unbiased per cell). The resolution and evaluator defaults
+// come from the sweep in bench/results/huang_study.md.
+#pragma once
+
+#include <string>
+
+#include "core/expected.h"
+#include "fiber/huang.h"
+#include "sampling/huang_table.h"
+#include "tables/bake.h"
+
+namespace hairis {
+
+/// How a Huang table is baked.
+struct HuangBakeOptions {
+    int theta_o_count = 24;  ///< θ_o nodes at the centres of equal cells of [−π/2, π/2]
+    /// φ_o nodes over [0, π/2], ends included (1: the node π/2). Circular fibers get one node.
+    int phi_o_count = 4;
+    int theta_i_count = 48;  ///< θ_i cells over [−π/2, π/2]
+    int phi_count = 64;      ///< cells of φ_i − φ_o over [−π, π]
+    int points = 1;          ///< evaluation points per cell and axis (midpoints in sin θ_i and φ)
+    /// "expectation" (HuangExpectation with the orders below) or "estimate" (Cycles' eval).
+    std::string evaluator = "expectation";
+    int first_order = 4, second_order = 3;  ///< the expectation's rule (HuangQuadrature)
+    int estimates = 1;                      ///< Cycles evals per point ("estimate")
+    int threads = 0;                        ///< 0: all cores
+
+    /// Names the first option out of range.
+    Status validate() const;
+};
+
+/// The φ_o nodes of a bake (see HuangBakeOptions::phi_o_count).
+std::vector<float> huang_phi_o_nodes(int count);
+
+/// Bakes the table of `fiber`. The same bytes for any thread count; progress as bake_tables'
+/// (false cancels: Error "cancelled", ErrorKind::Cancelled).
+Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBakeOptions &options = {},
+                                         const ProgressFn &progress = {});
+
+}  // namespace hairis
