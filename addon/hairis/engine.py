@@ -82,7 +82,9 @@ def light_options(light):
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``."""
     return {"samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
+            "max_transparent_bounces": int(settings.max_transparent_bounces),
             "strategy": settings.strategy.lower(),
+            "huang_sampling": settings.huang_sampling.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads)}
 
@@ -109,7 +111,7 @@ def build_native_scene(library, data, hair_tables):
         remap = np.array(indices or [0], dtype=np.int32)
         for curves in data.curves:
             scene.add_curves(int(remap[curves.material]), curves.first, curves.positions,
-                             curves.radii)
+                             curves.radii, curves.normals)
         for mesh in data.meshes:
             scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
         for light in data.lights:
@@ -229,6 +231,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             return found
         try:
             for index, material in data.hair_materials():
+                if material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES":
+                    continue  # Cycles' own Huang sampler needs no tables
                 node = tables.principled_struct(library, material.hair)
                 try:
                     fiber = library.fiber_principled(node)

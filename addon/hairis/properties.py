@@ -29,9 +29,23 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     max_bounces: IntProperty(
         name="Max Bounces", description="Total maximum number of bounces (as Cycles)",
         default=12, min=0, max=1024)
+    max_transparent_bounces: IntProperty(
+        name="Transparent Max Bounces",
+        description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "
+                    "through outside its elliptical cross-section",
+        default=8, min=0, max=1024)
     strategy: EnumProperty(
         name="Strategy", description="How hair scattering directions are sampled",
         items=STRATEGY_ITEMS, default="TABLE")
+    huang_sampling: EnumProperty(
+        name="Huang Sampling",
+        description="How Huang hair is sampled",
+        items=(("STRATEGY", "Strategy",
+                "The strategy above, with its exact density (converges to Cycles' Huang eval)", 0),
+               ("CYCLES", "Cycles",
+                "Cycles' own Huang sampler with its weight and pdf 1 for MIS (converges to what "
+                "Cycles renders, which mixes that sampler with its eval)", 1)),
+        default="STRATEGY")
     multiple_weight: FloatProperty(
         name="Multiple Weight",
         description="One-sample mixture weight of the multiple-scattering distribution "

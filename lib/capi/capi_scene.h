@@ -115,15 +115,22 @@ void describe(Fields &f, WorldOptions &o) {
     f.field("map_resolution", o.map_resolution, 1, EnvironmentMap::kMaxMapWidth);
 }
 
-/// A hair material as the C API keeps it until a render: its fiber and, optionally, tables
-/// (shared with the hairis_tables they came from). The sampler is made by hairis_render from
-/// its settings.
+/// A hair material as the C API keeps it until a render: its fiber (Chiang or Huang) and,
+/// optionally, tables (shared with the hairis_tables they came from). The sampler is made by
+/// hairis_render from its settings.
 struct SceneHairMaterial {
     std::shared_ptr<const ChiangFiber> fiber;
+    std::shared_ptr<const HuangFiber> huang;
     std::optional<SamplingTables> tables;
 };
 
 using SceneMaterial = std::variant<SceneHairMaterial, DiffuseMaterial>;
+
+/// The options of hairis_scene_add_curves_with_normals: none yet (every name is refused, so a
+/// name added later is never silently ignored by an older library).
+struct CurveOptions {};
+template <typename Fields>
+void describe(Fields &, CurveOptions &) {}
 
 /// "type=diffuse": a Lambertian surface with an emission (radiance).
 struct DiffuseOptions {

@@ -14,6 +14,7 @@ thread_local std::string t_defaults;
 
 std::string defaults_of(const std::string &kind) {
     if (kind == "chiang") return default_fiber_spec(FiberKind::Chiang).options();
+    if (kind == "huang") return default_fiber_spec(FiberKind::Huang).options();
     if (kind == "marschner") return default_fiber_spec(FiberKind::Marschner).options();
     if (kind == "bake") return write_options(BakeOptions{});
     if (kind == "sampler") return write_options(SamplerOptions{});
@@ -25,8 +26,9 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "area") return "type=area;" + write_options(AreaOptions{});
     if (kind == "world") return write_options(WorldOptions{});
     if (kind == "camera") return write_options(CameraOptions{});
-    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, sun, point, "
-            "spot, area, world, camera (got \"" + kind + "\")");
+    if (kind == "curves") return write_options(CurveOptions{});
+    invalid("kind must be one of chiang, huang, marschner, bake, sampler, render, diffuse, sun, point, "
+            "spot, area, world, camera, curves (got \"" + kind + "\")");
 }
 
 }  // namespace

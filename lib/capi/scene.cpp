@@ -32,6 +32,56 @@ int add_material(hairis_scene &scene, SceneMaterial material) {
 
 Vec3 vec3(const float *v) { return {v[0], v[1], v[2]}; }
 
+// Checks and adds a curve set (hairis_scene_add_curves and ..._with_normals); normals may be
+// NULL (the curves have none).
+int add_curves(hairis_scene *scene, int material, size_t curve_count, const uint32_t *first,
+               size_t point_count, const float *positions, const float *radii, const float *normals) {
+    require(scene, "scene");
+    require(first, "first");
+    require_array(positions, point_count, "positions");
+    require_array(radii, point_count, "radii");
+    if (material < 0 || size_t(material) >= scene->materials.size())
+        invalid("material must be the index of a material added to the scene, in [0, " +
+                std::to_string(scene->materials.size()) + ") (got " + std::to_string(material) + ")");
+    if (point_count > kMaxCurvePoints)
+        invalid("point_count must be at most 2^31 per call (got " + std::to_string(point_count) + ")");
+    if (curve_count > point_count / 2)
+        invalid("curve_count (" + std::to_string(curve_count) +
+                ") needs at least 2 points per curve, but point_count is " + std::to_string(point_count));
+    if (first[0] != 0) invalid("first[0] must be 0 (got " + std::to_string(first[0]) + ")");
+    for (size_t c = 0; c < curve_count; ++c)
+        if (!(first[c + 1] >= first[c] && first[c + 1] - first[c] >= 2))
+            invalid("curve " + std::to_string(c) + ": first[" + std::to_string(c + 1) + "] = " +
+                    std::to_string(first[c + 1]) + " must be at least first[" + std::to_string(c) +
+                    "] + 2 = " + std::to_string(size_t(first[c]) + 2) + " (a curve has at least 2 points)");
+    if (first[curve_count] != point_count)
+        invalid("first[curve_count] must equal point_count (" + std::to_string(point_count) + "; got " +
+                std::to_string(first[curve_count]) + ")");
+    for (size_t i = 0; i < point_count; ++i) {
+        for (size_t k = 0; k < 3; ++k) require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
+        require_non_negative(radii[i], indexed("radii", i));
+        if (normals)
+            for (size_t k = 0; k < 3; ++k) require_finite(normals[3 * i + k], indexed("normals", 3 * i + k));
+    }
+    if (curve_count == 0) return HAIRIS_OK;  // nothing to add
+    HairCurves curves;
+    curves.material = std::uint32_t(material);
+    curves.first.assign(first, first + curve_count + 1);
+    curves.points.resize(point_count);
+    for (size_t i = 0; i < point_count; ++i) curves.points[i] = vec3(positions + 3 * i);
+    curves.radii.assign(radii, radii + point_count);
+    if (normals) {
+        curves.normals.resize(point_count);
+        for (size_t i = 0; i < point_count; ++i) curves.normals[i] = vec3(normals + 3 * i);
+    }
+    const size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
+                         point_count * (sizeof(Vec3) + sizeof(float)) + curves.normals.size() * sizeof(Vec3);
+    scene->desc.curves.push_back(std::move(curves));
+    scene->curve_count += curve_count;
+    scene->geometry_bytes += bytes;
+    return HAIRIS_OK;
+}
+
 // The world of `o` around an environment image (already read): the Mapping and the matrix
 // composed into world_to_texture, the sampling settings, colour (default 1 with an image)
 // and strength; refusals name the option.
@@ -112,10 +162,12 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
     return guard_value<int>("hairis_scene_add_hair_material", -1, [&] {
         require(scene, "scene");
         require(fiber, "fiber");
-        if (!fiber->chiang)
-            invalid("fiber must be a chiang2016 fiber (the renderer shades Principled Hair), got " + fiber->model_name);
+        if (!fiber->chiang && !fiber->huang)
+            invalid("fiber must be a chiang2016 or huang2022 fiber (the renderer shades the Principled Hair BSDF), "
+                    "got " + fiber->model_name);
         SceneHairMaterial hair;
         hair.fiber = fiber->chiang;
+        hair.huang = fiber->huang;
         if (tables) hair.tables = tables->sampling;
         return add_material(*scene, std::move(hair));
     });
@@ -139,49 +191,20 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
                                        const uint32_t *first, size_t point_count,
                                        const float *positions, const float *radii) {
     return guard_status("hairis_scene_add_curves", [&] {
+        return add_curves(scene, material, curve_count, first, point_count, positions, radii, nullptr);
+    });
+}
+
+HAIRIS_API int hairis_scene_add_curves_with_normals(hairis_scene *scene, int material, size_t curve_count,
+                                                    const uint32_t *first, size_t point_count,
+                                                    const float *positions, const float *radii,
+                                                    const float *normals, const char *options) {
+    return guard_status("hairis_scene_add_curves_with_normals", [&] {
         require(scene, "scene");
-        require(first, "first");
-        require_array(positions, point_count, "positions");
-        require_array(radii, point_count, "radii");
-        if (material < 0 || size_t(material) >= scene->materials.size())
-            invalid("material must be the index of a material added to the scene, in [0, " +
-                    std::to_string(scene->materials.size()) + ") (got " +
-                    std::to_string(material) + ")");
-        if (point_count > kMaxCurvePoints)
-            invalid("point_count must be at most 2^31 per call (got " +
-                    std::to_string(point_count) + ")");
-        if (curve_count > point_count / 2)
-            invalid("curve_count (" + std::to_string(curve_count) +
-                    ") needs at least 2 points per curve, but point_count is " +
-                    std::to_string(point_count));
-        if (first[0] != 0) invalid("first[0] must be 0 (got " + std::to_string(first[0]) + ")");
-        for (size_t c = 0; c < curve_count; ++c)
-            if (!(first[c + 1] >= first[c] && first[c + 1] - first[c] >= 2))
-                invalid("curve " + std::to_string(c) + ": first[" + std::to_string(c + 1) + "] = " +
-                        std::to_string(first[c + 1]) + " must be at least first[" +
-                        std::to_string(c) + "] + 2 = " + std::to_string(size_t(first[c]) + 2) +
-                        " (a curve has at least 2 points)");
-        if (first[curve_count] != point_count)
-            invalid("first[curve_count] must equal point_count (" + std::to_string(point_count) +
-                    "; got " + std::to_string(first[curve_count]) + ")");
-        for (size_t i = 0; i < point_count; ++i) {
-            for (size_t k = 0; k < 3; ++k)
-                require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
-            require_non_negative(radii[i], indexed("radii", i));
-        }
-        if (curve_count == 0) return HAIRIS_OK;  // nothing to add
-        HairCurves curves;
-        curves.material = std::uint32_t(material);
-        curves.first.assign(first, first + curve_count + 1);
-        curves.points.resize(point_count);
-        for (size_t i = 0; i < point_count; ++i) curves.points[i] = vec3(positions + 3 * i);
-        curves.radii.assign(radii, radii + point_count);
-        const size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
-                             point_count * (sizeof(Vec3) + sizeof(float));
-        scene->desc.curves.push_back(std::move(curves));
-        scene->curve_count += curve_count;
-        scene->geometry_bytes += bytes;
-        return HAIRIS_OK;
+        require_array(normals, point_count, "normals");
+        CurveOptions o;
+        read_options(options, "curve options", o);
+        return add_curves(scene, material, curve_count, first, point_count, positions, radii, normals);
     });
 }
 

@@ -21,6 +21,7 @@
 #include "core/frame.h"
 #include "core/rng.h"
 #include "core/scratch.h"
+#include "fiber/huang.h"
 
 namespace hairis {
 
@@ -53,15 +54,44 @@ struct Counters {
     std::uint64_t rays = 0, shadow_rays = 0, dropped = 0;
 };
 
+// What a hair BSDF needs besides the hit point: whether the ray is a camera ray (Cycles'
+// PATH_RAY_CAMERA, kept through transparent crossings), its footprint there, and the seed of
+// the point's random numbers.
+struct HitContext {
+    bool camera_ray = false;
+    float footprint = 0;
+    std::uint32_t seed = 0;
+    bool cycles_huang = false;  // RenderSettings::huang_sampling == Cycles
+};
+
+FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context) {
+    FiberHit hit;
+    hit.wo = frame.to_local(wo);
+    hit.h = std::clamp(dot(cross(sp.normal, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
+    const Vec3 axis = HuangFiber::major_axis(sp.tangent, sp.curve_normal);
+    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(sp.tangent));
+    hit.pixel_coverage = context.camera_ray ? cycles_pixel_coverage(context.footprint, sp.curve_radius) : 1.0f;
+    hit.seed = context.seed;
+    return hit;
+}
+
 // A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
 // Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`.
 class Bsdf {
   public:
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, ScratchBuffer &scratch) {
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
+         ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-            const float h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
-            hair_.emplace(hair->shading.at({frame_.to_local(wo), h}, scratch));
+            const FiberHit hit = fiber_hit(sp, wo, frame_, context);
+            const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
+            if (huang) {
+                huang_ = &scratch.make<HuangPoint>(*huang, hit);
+                lcg_.state = hit.seed ^ 0x9e3779b9u;
+            } else {
+                hair_.emplace(hair->shading.at(hit, scratch));
+            }
         } else {
             const auto &d = std::get<DiffuseMaterial>(material);
             albedo_ = d.albedo;
@@ -70,11 +100,18 @@ class Bsdf {
         }
     }
 
-    bool black() const { return !hair_ && is_black(albedo_); }
-    bool is_hair() const { return hair_.has_value(); }
+    bool black() const { return !is_hair() && is_black(albedo_); }
+    bool is_hair() const { return hair_.has_value() || huang_; }
+    // The ray passes without scattering (Huang outside its ellipse).
+    bool transparent() const { return (hair_ && hair_->transparent()) || (huang_ && huang_->transparent()); }
 
-    // f·|cos θ_i| and the density with which sample() draws wi.
+    // f·|cos θ_i| and the density with which sample() draws wi (Cycles' Huang: its eval and
+    // pdf 1, what Cycles' MIS weighs with).
     Rgb eval(Vec3 wi, float &pdf) const {
+        if (huang_) {
+            pdf = 1.0f;
+            return huang_->f(frame_.to_local(wi));
+        }
         if (hair_) {
             return hair_->f_and_pdf(frame_.to_local(wi), pdf);
         }
@@ -87,8 +124,17 @@ class Bsdf {
         return albedo_ * (c * float(kInvPi));
     }
 
-    // Draws wi; returns false when there is none. weight = f·|cos|/pdf.
+    // Draws wi; returns false when there is none. weight = f·|cos|/pdf (Cycles' Huang: its
+    // sampler's weight, with pdf 1).
     bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf) const {
+        if (huang_) {
+            const std::optional<HuangCyclesSample> s = huang_->sample_cycles(u0, u1, u2, lcg_);
+            if (!s) return false;
+            wi = safe_normalize(frame_.to_world(s->wi));
+            pdf = 1.0f;
+            weight = s->weight;
+            return dot(wi, wi) > 0.0f;
+        }
         if (hair_) {
             const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
             if (!s || !(s->pdf > 0.0f)) return false;
@@ -110,10 +156,17 @@ class Bsdf {
 
   private:
     std::optional<HairBsdf> hair_;
+    const HuangPoint *huang_ = nullptr;  // Cycles' Huang sampling
+    mutable CyclesLcg lcg_;              // its sampler's numbers beyond the path's three
     FiberFrame frame_;
     Rgb albedo_;
     Vec3 n_, a_, b_;
 };
+
+// The seed of the random numbers of the point at vertex `depth` of a path (Huang's eval).
+std::uint32_t vertex_seed(const SampleRng &key, int depth) {
+    return std::uint32_t(mix64(key.key() ^ (std::uint64_t(depth + 1) * 0xd1b54a32d192ed03ull)) >> 32);
+}
 
 // One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
 Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
@@ -124,6 +177,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     // Stratified per pixel (jitter, light and BSDF pairs): hair is thinner than a pixel, and
     // stratifying where a sample lands in the pixel is what Cycles' Sobol patterns buy it.
     const SobolSampleRng rng(settings.seed, pixel, sample);
+    const SampleRng seeds(settings.seed, pixel, sample);
 
     const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
     Vec3 origin = cr.origin, dir = cr.direction;
@@ -132,7 +186,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     Rgb beta(1.0f), radiance;
     float bsdf_pdf = 0.0f;
     bool use_mis = false;  // camera rays take emission at full weight
-    int diffuse_bounces = 0, transmission_bounces = 0;
+    int diffuse_bounces = 0, transmission_bounces = 0, transparent_bounces = 0;
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     alpha = 1.0f;
 
@@ -144,7 +198,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         radiance += contribution;
     };
 
-    for (int depth = 0;; ++depth) {
+    // depth counts scattering vertices; a transparent crossing keeps it (and the camera ray).
+    for (int depth = 0;;) {
         const std::optional<Hit> hit = scene.intersect(origin, dir, tmin, tmax, skip);
         ++counters.rays;
         const float t_end = hit ? hit->t : tmax;
@@ -177,7 +232,25 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             }
         }
 
+        // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
+        // transparency does not apply either).
         if (depth > settings.max_bounces || last_segment) break;
+
+        scratch.reset();  // the previous vertex's BSDF is done with
+        HitContext context;
+        context.camera_ray = depth == 0;
+        context.footprint = cr.footprint_at(hit->t);
+        context.seed = vertex_seed(seeds, depth);
+        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles);
+        const Bsdf bsdf(material, sp, wo, context, scratch);
+        if (bsdf.transparent()) {
+            // The same ray goes on beyond this curve.
+            last_segment = ++transparent_bounces > settings.max_transparent_bounces;
+            tmin = hit->t;
+            skip = sp.self;
+            continue;
+        }
+        if (bsdf.black()) break;
 
         // Russian roulette.
         if (depth >= settings.rr_start_bounce) {
@@ -185,10 +258,6 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             if (!(rng.get(dim(depth, kDimRoulette)) < q)) break;
             beta = beta / q;
         }
-
-        scratch.reset();  // the previous vertex's BSDF is done with
-        const Bsdf bsdf(material, sp, wo, scratch);
-        if (bsdf.black()) break;
 
         // Next-event estimation.
         if (!lights.empty()) {
@@ -236,6 +305,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         skip = sp.self;
         bsdf_pdf = pdf;
         use_mis = true;
+        ++depth;
     }
     return radiance;
 }
@@ -247,9 +317,12 @@ Status validate(const RenderSettings &s) {
                                              1024),
                        check::count_in_range("max_transmission_bounces",
                                              s.max_transmission_bounces, 0, 1024),
+                       check::count_in_range("max_transparent_bounces",
+                                             s.max_transparent_bounces, 0, 1024),
                        check::count_in_range("threads", s.threads, 0, 1024),
                        check::count_in_range("tile_size", s.tile_size, 1, 4096),
-                       check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024));
+                       check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024),
+                       check::count_in_range("huang_sampling", s.huang_sampling, 0, 1));
 }
 
 struct Tile {
@@ -261,6 +334,35 @@ struct Tile {
 float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo) {
     const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);
     return std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);
+}
+
+float cycles_pixel_coverage(float footprint, float curve_radius) {
+    return curve_radius > 0.0f ? 0.5f * footprint / curve_radius : INFINITY;
+}
+
+FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
+                          std::uint32_t seed) {
+    return fiber_hit(sp, wo, FiberFrame::from_tangent_and_view(sp.tangent, wo),
+                     HitContext{camera_ray, footprint, seed});
+}
+
+std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v) {
+    const CameraRay cr = scene.camera().generate_ray(x, y, u, v);
+    float tmin = cr.tmin;
+    PrimRef skip;
+    ScratchBuffer scratch;
+    for (;;) {
+        const std::optional<Hit> hit = scene.intersect(cr.origin, cr.direction, tmin, cr.tmax, skip);
+        if (!hit) return std::nullopt;
+        const SurfacePoint sp = scene.surface_point(cr.origin, cr.direction, *hit);
+        const auto *hair = std::get_if<HairMaterial>(&scene.materials()[sp.material]);
+        if (!hair) return std::nullopt;
+        const FiberHit fh = cycles_fiber_hit(sp, -cr.direction, true, cr.footprint_at(hit->t), 0);
+        scratch.reset();
+        if (!hair->shading.at(fh, scratch).transparent()) return fh;
+        tmin = hit->t;
+        skip = sp.self;
+    }
 }
 
 Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int y,

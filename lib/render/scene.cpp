@@ -30,6 +30,7 @@ struct alignas(16) Float4 {
 
 struct CurveGeometry {
     std::vector<Float4> cvs;              // n + 2 control points per curve (ends duplicated)
+    std::vector<Vec3> normals;            // empty, or the normal of each control point
     std::vector<std::uint32_t> segments;  // first control point of each segment
     std::vector<std::uint32_t> curve_of;  // the curve of each segment
     std::uint32_t material = 0;
@@ -232,6 +233,14 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                          std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
         if (hc.points.size() > (std::size_t(1) << 31))
             return Error{set + ": too many points (at most 2^31)"};
+        if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
+            return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
+                         " entries but points has " + std::to_string(hc.points.size()) +
+                         " (one normal per point, or none)"};
+        for (std::size_t k = 0; k < hc.normals.size(); ++k)
+            if (!finite3(hc.normals[k]))
+                return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
+                             describe(hc.normals[k]) + ")"};
         CurveGeometry geo;
         geo.material = hc.material;
         std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
@@ -273,6 +282,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             geo.cvs.push_back(cv(b));
             for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
             geo.cvs.push_back(cv(e - 1));
+            if (!hc.normals.empty()) {
+                geo.normals.push_back(hc.normals[b]);
+                geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
+                geo.normals.push_back(hc.normals[e - 1]);
+            }
             const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
             for (std::uint32_t k = 0; k + 1 < n; ++k) {
                 geo.segments.push_back(base + k);
@@ -293,6 +307,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         hc.points = {};
         hc.radii = {};
         hc.first = {};
+        hc.normals = {};
         if (!geo.segments.empty()) impl->curves.push_back(std::move(geo));
     }
 
@@ -442,7 +457,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                         impl->geometries.capacity() * sizeof(GeometryInfo);
     for (const auto &c : impl->curves)
         bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
-                 c.curve_of.capacity() * 4;
+                 c.curve_of.capacity() * 4 + c.normals.capacity() * sizeof(Vec3);
     for (const auto &m : impl->meshes)
         bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
                  m.materials.capacity() * 4 + m.emissive.capacity();
@@ -551,6 +566,11 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         sp.material = geo.material;
         const Vec3 n = safe_normalize(sp.position - centre);
         sp.normal = dot(n, n) > 0.0f ? n : -dir;
+        // Per-point attributes between the segment's two points (Cycles' curve_attribute).
+        const std::uint32_t key = geo.segments[hit.prim.primitive] + 1;
+        const float u = hit.u;
+        sp.curve_radius = (1.0f - u) * geo.cvs[key].w + u * geo.cvs[key + 1].w;
+        if (!geo.normals.empty()) sp.curve_normal = geo.normals[key] * (1.0f - u) + geo.normals[key + 1] * u;
         sp.tangent = safe_normalize(dpdu);
         if (dot(sp.tangent, sp.tangent) == 0.0f) {
             // dP/du vanishes (repeated points): the chord, or any direction across the normal.
