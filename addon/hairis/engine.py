@@ -248,8 +248,14 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                     if status.ok:
                         found[index] = status.tables
                     elif settings.auto_bake:
-                        found[index] = self._auto_bake(library, material, fiber, settings,
-                                                       status)
+                        try:
+                            found[index] = self._auto_bake(library, material, fiber, settings,
+                                                           status)
+                        except native.HairisCancelled:
+                            raise
+                        except native.HairisError as error:
+                            raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                                from error
                     else:
                         problems.append(status.message)
         except BaseException:

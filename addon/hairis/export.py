@@ -436,17 +436,16 @@ def _huang_checks(values, material_name, warnings):
         return ("material %r: the Principled Hair BSDF's Aspect Ratio is %g; Hairis needs a "
                 "finite value above 0 (values above 1 render as their inverse, as in Cycles)"
                 % (material_name, aspect))
-    for field, label in zip(HUANG_LOBES, ("Reflection", "Transmission",
-                                          "Secondary Reflection")):
-        value = values[field]
+    for name, label in zip(HUANG_LOBES, ("Reflection", "Transmission", "Secondary Reflection")):
+        value = values[name]
         if not math.isfinite(value):
             return ("material %r: the Principled Hair BSDF's %s is %g; it must be finite"
                     % (material_name, label, value))
         if value < 0.0:
             warnings.append("material %r: %s is %g; Cycles uses 0 for a negative lobe "
                             "multiplier, and so does hairis" % (material_name, label, value))
-            values[field] = 0.0
-    if all(values[field] <= 0.0 for field in HUANG_LOBES):
+            values[name] = 0.0
+    if all(values[name] <= 0.0 for name in HUANG_LOBES):
         warnings.append("material %r: Reflection, Transmission and Secondary Reflection are all "
                         "0: Cycles makes no closure for this Principled Hair BSDF, so the strands "
                         "are black and block light; hairis renders them the same" % material_name)

@@ -1153,6 +1153,7 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
                         i, strategies[r.strategy]);
     if (r.strategy == 3)
         for (int i = 0; i < s->material_count; ++i) {
+            if (s->material_is_huang[i]) continue; /* Cycles' own Huang sampler: no tables */
             if (s->material_is_hair[i] && !s->material_has_tables[i])
                 return fail(HAIRIS_ERROR_INVALID_TABLE,
                             "material %d (hair): strategy=table needs sampling tables, but the "

@@ -317,8 +317,8 @@ def test_hair_node_models_and_missing_sockets():
     params, _warnings, error = export.read_hair_node(node, "Identifier")
     assert error is None and params.coat == 0.5, (error, params)
     # Huang reads the lobes by identifier; a Huang node without one is named.
-    params, _warnings, error = export.read_hair_node(stub_hair_node("HUANG", leave_out=("TT lobe",)),
-                                                     "NoLobe")
+    params, _warnings, error = export.read_hair_node(
+        stub_hair_node("HUANG", leave_out=("TT lobe",)), "NoLobe")
     assert params is None and "'TT lobe'" in error and "'NoLobe'" in error, error
 
 
@@ -375,7 +375,8 @@ def test_huang_materials_export():
     options = native.principled_options(hair.hair.as_dict())
     assert options["model"] == "huang" and "radial_roughness" not in options \
         and "coat" not in options and "cycles" not in options, options
-    assert options["aspect_ratio"] == 0.5 and options["secondary_reflection"] == 0.2, options
+    assert options["aspect_ratio"] == 0.5, options
+    assert math.isclose(options["secondary_reflection"], 0.2, rel_tol=1e-6), options
     # Particle hair has no normals (Cycles' fallback frame).
     assert particle_curves(data).normals is None
     for name in ("R lobe", "TT lobe", "TRT lobe"):
@@ -400,16 +401,17 @@ def test_curves_normals_for_huang():
     node = material.node_tree.nodes["Principled Hair BSDF"]
     node.model = "HUANG"
     helpers.socket(node, "Aspect Ratio").default_value = 0.6
-    obj, _positions, _radii = helpers.make_curves(scene, material, rotation=(0.0, 0.0, 0.0))
-    curves = obj.data
-    offsets = np.empty(len(curves.curves) + 1, np.int32)
-    curves.curve_offset_data.foreach_get("value", offsets)
-    planar = np.empty((len(curves.points), 3), np.float32)
-    curves.position_data.foreach_get("vector", planar.reshape(-1))
-    curve_of_point = np.repeat(np.arange(len(curves.curves)), np.diff(offsets))
-    planar[:, 2] = 0.01 * curve_of_point  # each curve in its own plane z = const
+    # New curves whose points are set before anything asks for their normals: Blender caches
+    # normals and does not drop the cache when positions are written through position_data.
+    curves = bpy.data.hair_curves.new("Planar")
+    count, points = 30, 8
+    curves.add_curves([points] * count)
+    planar = np.random.default_rng(5).uniform(-0.5, 0.5, (count * points, 3)).astype(np.float32)
+    planar[:, 2] = 0.01 * np.repeat(np.arange(count), points)  # each curve in a plane z = const
     curves.position_data.foreach_set("vector", planar.reshape(-1))
-    curves.update_tag()
+    curves.materials.append(material)
+    obj = bpy.data.objects.new("Curls", curves)
+    scene.collection.objects.link(obj)
     bpy.context.view_layer.update()
     data = export.export_context()
     (exported,) = data.curves
@@ -418,7 +420,7 @@ def test_curves_normals_for_huang():
     first = exported.first.astype(np.int64)
     spread = max(float(np.ptp(np.abs(exported.normals[first[c]:first[c + 1], 2])))
                  for c in range(exported.curve_count))
-    assert spread < 1e-4, spread
+    assert spread < 5e-3, spread  # float rounding over the evaluated points; a misread is O(1)
     assert not any("rotated" in w for w in data.warnings), data.warnings
     obj.rotation_euler = (0.0, 0.0, 1.2)
     bpy.context.view_layer.update()
