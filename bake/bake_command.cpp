@@ -48,6 +48,11 @@ int run_bake(const BakeFlags &flags) {
         std::cerr << "hairis-bake bake: " << spec.error().message << "\n";
         return kExitFailure;
     }
+    if (spec.value().kind == FiberKind::Huang) {
+        std::cerr << "hairis-bake bake: model = huang: this version bakes no tables for Huang fibers (the "
+                     "renderer samples them with strategy=uniform)\n";
+        return kExitFailure;
+    }
     Expected<std::unique_ptr<FiberModel>> model = spec.value().create_model();
     auto parameters = spec.value().parameters();
     if (!model || !parameters) {

@@ -84,7 +84,9 @@ def render_settings(settings):
     Cycles traces curves (:func:`compat.curve_backfaces`)."""
     return {"integrator": settings.integrator.lower(),
             "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
+            "max_transparent_bounces": int(settings.max_transparent_bounces),
             "strategy": settings.strategy.lower(),
+            "huang_sampling": settings.huang_sampling.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces()}
@@ -150,7 +152,7 @@ def build_native_scene(library, data, hair_tables):
                                              curves.positions, curves.radii, curves.inputs)
             else:
                 scene.add_curves(int(remap[curves.material]), curves.first, curves.positions,
-                                 curves.radii)
+                                 curves.radii, curves.normals)
         for mesh in data.meshes:
             scene.add_mesh(mesh.positions, mesh.indices, remap[mesh.materials])
             if mesh.normals is not None:
@@ -277,6 +279,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             return found
         try:
             for index, material in data.hair_materials():
+                if material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES":
+                    continue  # Cycles' own Huang sampler needs no tables
                 node = tables.principled_struct(library, material.hair)
                 try:
                     fiber = library.fiber_principled(node)
@@ -292,8 +296,14 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                     if status.ok:
                         found[index] = status.tables
                     elif settings.auto_bake:
-                        found[index] = self._auto_bake(library, material, fiber, settings,
-                                                       status)
+                        try:
+                            found[index] = self._auto_bake(library, material, fiber, settings,
+                                                           status)
+                        except native.HairisCancelled:
+                            raise
+                        except native.HairisError as error:
+                            raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                                from error
                     else:
                         problems.append(status.message)
         except BaseException:

@@ -13,12 +13,19 @@ Rules follow Cycles 3.4 (``intern/cycles/blender/curves.cpp``, ``object.cpp``, `
   parents; radius ``radius_scale·0.5·(tip + (root − tip)·shape(1 − t))`` with t the
   object-space arc-length fraction, 0 at the tip with ``use_close_tip``; material slot
   ``settings.material``;
-- Curves objects: the ``radius`` point attribute, 0.005 without it; material slot 1;
+- Curves objects: the ``radius`` point attribute, 0.005 without it; material slot 1; for Huang
+  materials the curve normals (``Curves.normals``: Blender's ``curves_normals_point_domain_calc``,
+  which Cycles reads into its normal attribute), in object space as Cycles uses them;
 - curve radii scale with the cube root of the object matrix's determinant (Hair::apply_transform);
 - hair inputs fed by node chains (node_eval): evaluated per curve (Hair Info Random, Length)
   or per point (Intercept: the object-space arc-length fraction) and sent as curve inputs;
   an unlinked Random is the per-strand random number (a hash of the curve's index within its
-  object, uniform in [0, 1]) wherever Random Color or Random Roughness reads it.
+  object, uniform in [0, 1]) wherever Random Color or Random Roughness reads it (Chiang; Huang
+  hair takes each input's unlinked value).
+
+The Principled Hair BSDF's Huang model (Blender 4.0+) follows Cycles 4.5/5.0
+(``kernel/svm/closure.h``): its inputs by identifier, Aspect Ratio above 1 as its inverse,
+negative lobe multipliers as 0, and all three ≤ 0 as no closure at all (black, opaque strands).
 """
 
 import math
@@ -40,22 +47,32 @@ PARAMETRIZATIONS = {"ABSORPTION": 0, "MELANIN": 1, "COLOR": 2}
 """Principled Hair BSDF ``parametrization`` → hairis_parametrization."""
 
 HAIR_INPUTS = (
-    # (hairis_principled_hair field, node input name, number of components)
-    ("color", "Color", 3),
-    ("melanin", "Melanin", 1),
-    ("melanin_redness", "Melanin Redness", 1),
-    ("tint", "Tint", 3),
-    ("absorption_coefficient", "Absorption Coefficient", 3),
-    ("roughness", "Roughness", 1),
-    ("radial_roughness", "Radial Roughness", 1),
-    ("coat", "Coat", 1),
-    ("ior", "IOR", 1),
-    ("offset", "Offset", 1),
-    ("random_color", "Random Color", 1),
-    ("random_roughness", "Random Roughness", 1),
-    ("random", "Random", 1),
+    # (HairParameters field, node input identifier, number of components, models reading it)
+    ("color", "Color", 3, ("CHIANG", "HUANG")),
+    ("melanin", "Melanin", 1, ("CHIANG", "HUANG")),
+    ("melanin_redness", "Melanin Redness", 1, ("CHIANG", "HUANG")),
+    ("tint", "Tint", 3, ("CHIANG", "HUANG")),
+    ("absorption_coefficient", "Absorption Coefficient", 3, ("CHIANG", "HUANG")),
+    ("aspect_ratio", "Aspect Ratio", 1, ("HUANG",)),
+    ("roughness", "Roughness", 1, ("CHIANG", "HUANG")),
+    ("radial_roughness", "Radial Roughness", 1, ("CHIANG",)),
+    ("coat", "Coat", 1, ("CHIANG",)),
+    ("ior", "IOR", 1, ("CHIANG", "HUANG")),
+    ("offset", "Offset", 1, ("CHIANG", "HUANG")),
+    ("random_color", "Random Color", 1, ("CHIANG", "HUANG")),
+    ("random_roughness", "Random Roughness", 1, ("CHIANG", "HUANG")),
+    ("random", "Random", 1, ("CHIANG", "HUANG")),
+    ("reflection", "R lobe", 1, ("HUANG",)),
+    ("transmission", "TT lobe", 1, ("HUANG",)),
+    ("secondary_reflection", "TRT lobe", 1, ("HUANG",)),
 )
-"""Every input of the Principled Hair BSDF node and the C struct field it fills."""
+"""Every input of the Principled Hair BSDF node the models read, by socket identifier (the
+lobe multipliers are shown as Reflection, Transmission and Secondary Reflection)."""
+
+HUANG_LOBES = ("reflection", "transmission", "secondary_reflection")
+
+HUANG_CYCLES = (4, 5, 0)
+"""Hairis' Huang is Cycles 4.5's (5.0's is the same); 4.0 to 4.4 integrate it differently."""
 
 HAIR_NODE_IDNAME = "ShaderNodeBsdfHairPrincipled"
 
@@ -87,8 +104,10 @@ class ExportError(Exception):
 
 @dataclass
 class HairParameters:
-    """A Principled Hair BSDF node's values, field for field as ``hairis_principled_hair``."""
+    """A Principled Hair BSDF node's values: the model ('CHIANG' or 'HUANG') and its inputs
+    (the other model's inputs keep their defaults and are not passed to the library)."""
 
+    model: str = "CHIANG"
     parametrization: int = PARAMETRIZATIONS["COLOR"]
     color: tuple = (0.017513, 0.005763, 0.002059)
     melanin: float = 0.8
@@ -103,6 +122,10 @@ class HairParameters:
     random_color: float = 0.0
     random_roughness: float = 0.0
     random: float = 0.0
+    aspect_ratio: float = 0.85
+    reflection: float = 1.0
+    transmission: float = 1.0
+    secondary_reflection: float = 1.0
     cycles: str = "3.4"
     """The Blender version whose Cycles evaluates the node (compat.cycles_version)."""
     strand_inputs: dict = field(default_factory=dict, compare=False, repr=False)
@@ -113,6 +136,18 @@ class HairParameters:
         """The fiber's values keyed by C field name."""
         return {name: getattr(self, name) for name in self.__dataclass_fields__
                 if name != "strand_inputs"}
+
+    @property
+    def scatters(self):
+        """False for a Huang node whose three lobe multipliers are <= 0: Cycles makes no
+        closure for it (the strands are black and opaque)."""
+        return self.model != "HUANG" or any(getattr(self, name) > 0.0 for name in HUANG_LOBES)
+
+    @property
+    def oriented(self):
+        """True when the fiber's cross-section is elliptical (Huang with Aspect Ratio != 1):
+        its major axis follows the curve normals."""
+        return self.model == "HUANG" and self.aspect_ratio != 1.0
 
 
 @dataclass
@@ -146,6 +181,8 @@ class CurvesData:
     inputs: dict = field(default_factory=dict)
     """Node inputs varying per curve or point: C API name → ('curve' | 'point', float32 array
     of (curves or points, components))."""
+    normals: np.ndarray = None
+    """(points, 3) curve normals (Curves objects with a Huang material), or None."""
 
     @property
     def curve_count(self):
@@ -280,6 +317,8 @@ class SceneData:
             arrays["curves%d_material" % i] = np.array(curves.material)
             arrays["curves%d_name" % i] = np.array(curves.name)
             arrays["curves%d_source" % i] = np.array(curves.source)
+            if curves.normals is not None:
+                arrays["curves%d_normals" % i] = curves.normals
         for i, mesh in enumerate(self.meshes):
             arrays["mesh%d_positions" % i] = mesh.positions
             arrays["mesh%d_indices" % i] = mesh.indices
@@ -444,34 +483,60 @@ def _clamped(values, field_name, material_name, input_name, warnings):
     return clamped
 
 
+def _huang_checks(values, material_name, warnings):
+    """Cycles' rules for the Huang inputs: an error (or None), warnings appended."""
+    aspect = values["aspect_ratio"]
+    if not (math.isfinite(aspect) and aspect > 0.0):
+        return ("material %r: the Principled Hair BSDF's Aspect Ratio is %g; Hairis needs a "
+                "finite value above 0 (values above 1 render as their inverse, as in Cycles)"
+                % (material_name, aspect))
+    for name, label in zip(HUANG_LOBES, ("Reflection", "Transmission", "Secondary Reflection")):
+        value = values[name]
+        if not math.isfinite(value):
+            return ("material %r: the Principled Hair BSDF's %s is %g; it must be finite"
+                    % (material_name, label, value))
+        if value < 0.0:
+            warnings.append("material %r: %s is %g; Cycles uses 0 for a negative lobe "
+                            "multiplier, and so does hairis" % (material_name, label, value))
+            values[name] = 0.0
+    if all(values[name] <= 0.0 for name in HUANG_LOBES):
+        warnings.append("material %r: Reflection, Transmission and Secondary Reflection are all "
+                        "0: Cycles makes no closure for this Principled Hair BSDF, so the strands "
+                        "are black and block light; hairis renders them the same" % material_name)
+    if compat.running_version() < HUANG_CYCLES:
+        warnings.append("material %r: Blender %s's Cycles integrates the Huang model differently "
+                        "from Cycles 4.5, which hairis follows; expect small differences"
+                        % (material_name, compat.version_string()))
+    return None
+
+
 def read_hair_node(node, material_name="?"):
     """Reads a Principled Hair BSDF node: returns (HairParameters, warnings, error or None).
 
-    Reads every input's unlinked value, by name or identifier; a missing input or a model
-    other than Chiang (Blender 4.x's ``model`` setting) is an error for this material. A
-    linked input the parametrization reads is compiled (node_eval): a chain of one value is
-    folded into the parameters, one that reads Hair Info goes into ``strand_inputs``, and one
-    with an unsupported node is a warning naming it (the input's unlinked value is used). An
-    unlinked Random is Cycles' per-strand random number wherever Random Color or Random
-    Roughness can use it; the fiber's own Random is then 0.5 (the middle strand).
+    Reads the inputs of the node's model (Blender 4.x's ``model``: Chiang or Huang) by
+    identifier; a missing input or an unknown model is an error for this material. For
+    Chiang, a linked input the parametrization reads is compiled (node_eval): a chain of one
+    value is folded into the parameters, one that reads Hair Info goes into
+    ``strand_inputs``, and one with an unsupported node is a warning naming it (the input's
+    unlinked value is used). An unlinked Random is Cycles' per-strand random number wherever
+    Random Color or Random Roughness can use it; the fiber's own Random is then 0.5 (the
+    middle strand). Huang takes every input's unlinked value, with a warning for a linked one.
     """
     warnings = []
     model = compat.hair_model(node)
-    if model == "HUANG":
-        return None, warnings, ("material %r: its Principled Hair BSDF uses the Huang model, which "
-                                "Hairis cannot render yet (Huang support is coming); set the "
-                                "node's model to Chiang to render it with Hairis" % material_name)
-    if model != "CHIANG":
+    if model not in ("CHIANG", "HUANG"):
         return None, warnings, ("material %r: the Principled Hair BSDF model %r is not supported "
-                                "(Hairis implements the Chiang model)" % (material_name, model))
+                                "(Hairis implements Chiang and Huang)" % (material_name, model))
     parametrization = getattr(node, "parametrization", None)
     if parametrization not in PARAMETRIZATIONS:
         return None, warnings, ("material %r: unknown Principled Hair parametrization %r"
                                 % (material_name, parametrization))
-    values = {"parametrization": PARAMETRIZATIONS[parametrization],
+    values = {"model": model, "parametrization": PARAMETRIZATIONS[parametrization],
               "cycles": compat.cycles_version()}
     sockets = {}
-    for field_name, input_name, components in HAIR_INPUTS:
+    for field_name, input_name, components, models in HAIR_INPUTS:
+        if model not in models:
+            continue
         socket = _input(node, input_name)
         if socket is None:
             return None, warnings, ("material %r: the Principled Hair BSDF has no %r input in "
@@ -483,8 +548,27 @@ def read_hair_node(node, material_name="?"):
         except (TypeError, ValueError) as error:
             return None, warnings, "material %r: %s" % (material_name, error)
         sockets[field_name] = socket
+    if model == "HUANG":
+        error = _huang_checks(values, material_name, warnings)
+        if error is not None:
+            return None, warnings, error
+        for field_name, socket in sockets.items():
+            if (getattr(socket, "is_linked", False)
+                    and parametrization in READ_BY.get(field_name, {parametrization})):
+                warnings.append("material %r: input %r of the Principled Hair BSDF is linked; "
+                                "hairis uses its unlinked value for Huang hair"
+                                % (material_name, socket.name))
+        randomized = values["random_roughness"] > 0.0 or (
+            values["random_color"] > 0.0 and parametrization == "MELANIN")
+        if randomized and not getattr(sockets["random"], "is_linked", False):
+            warnings.append("material %r: Cycles varies Random Color/Random Roughness per strand "
+                            "when Random is unlinked; hairis uses Random = %g for every Huang "
+                            "strand" % (material_name, values["random"]))
+        return HairParameters(**values), warnings, None
     strand_inputs = {}
-    for field_name, input_name, components in HAIR_INPUTS:
+    for field_name, input_name, components, _ in HAIR_INPUTS:
+        if field_name not in sockets:
+            continue
         socket = sockets[field_name]
         if parametrization not in READ_BY.get(field_name, {parametrization}):
             continue  # hidden by the parametrization: Cycles does not read it either
@@ -736,8 +820,12 @@ class _Exporter:
                     self.data.warn(warning)
                 if error is not None:
                     raise ExportError(error)
-                data = MaterialData(name=material.name, kind="HAIR", hair=params,
-                                    material_name=material.name, source=material.original)
+                if params.scatters:
+                    data = MaterialData(name=material.name, kind="HAIR", hair=params,
+                                        material_name=material.name, source=material.original)
+                else:  # Cycles makes no closure: black, opaque strands
+                    data = MaterialData(name=material.name, kind="DIFFUSE", albedo=(0.0, 0.0, 0.0),
+                                        material_name=material.name, source=material.original)
         else:
             nodes = read_surface_nodes(material, self.data.warn, self.texture)
             if for_hair:
@@ -760,7 +848,7 @@ class _Exporter:
             return {}
         strands = node_eval.strands_of(first, positions_object,
                                        node_eval.strand_random(curve_indices))
-        labels = {name: label for name, label, _ in HAIR_INPUTS}
+        labels = {name: label for name, label, _, _ in HAIR_INPUTS}
         inputs = {}
         for field_name, compiled in material.hair.strand_inputs.items():
             warnings = []
@@ -771,6 +859,7 @@ class _Exporter:
             inputs[CURVE_INPUT_NAMES.get(field_name, field_name)] = (
                 compiled.domain, values.astype(np.float32))
         return inputs
+
     def texture(self, texture):
         """The position of a surfaces.TextureData in the scene's textures (shared when equal)."""
         key = texture.key()
@@ -1050,10 +1139,45 @@ class _Exporter:
             return
         world = _transform_points(matrix, local)
         material = self.material(self.slot_material(obj, 0), for_hair=True)
+        normals = None
+        hair = self.data.materials[material].hair
+        if hair is not None and hair.oriented:
+            normals = curve_normals(obj, curves, point_count, offsets, self.data)
         self.data.curves.append(CurvesData(
             name=obj.name, source="CURVES", material=material, first=first,
             positions=world.astype(np.float32), radii=radii.astype(np.float32),
-            inputs=self.strand_inputs(material, first, local, kept)))
+            inputs=self.strand_inputs(material, first, local, kept), normals=normals))
+
+
+def curve_normals(obj, curves, point_count, offsets, data):
+    """The Curves' point normals as Cycles reads them, (kept points, 3) float32, or None.
+
+    ``Curves.normals`` is Blender's ``curves_normals_point_domain_calc`` (the curves' normal
+    mode), the array Cycles' ``export_hair_curves`` stores as the normal attribute. It is read
+    by iterating the collection: its ``foreach_get`` copies from an array Blender has already
+    freed (4.5 and 5.0: the first two normals come back as garbage), while an iteration keeps
+    the array alive until it ends. Cycles uses the normals in object space, without the
+    object's rotation, and so does hairis (a warning says so when the object is rotated).
+    """
+    source = getattr(curves, "normals", None)
+    if source is None or len(source) != point_count:
+        data.warn("object %r: its curve normals cannot be read in Blender %s; elliptical Huang "
+                  "fibers on it use Cycles' fallback frame" % (obj.name, compat.version_string()))
+        return None
+    normals = np.fromiter((c for item in source for c in item.vector), np.float32,
+                          count=3 * point_count).reshape(-1, 3)
+    if not np.all(np.isfinite(normals)):
+        data.warn("object %r: Blender gives non-finite curve normals; hairis uses zero (Cycles' "
+                  "fallback frame) there" % obj.name)
+        normals = np.where(np.isfinite(normals), normals, 0.0).astype(np.float32)
+    keep = np.repeat(np.diff(np.asarray(offsets, np.int64)) >= 2, np.diff(offsets))
+    matrix = _matrix(obj.matrix_world)
+    scale = _uniform_scale(matrix)
+    if scale > 0.0 and not np.allclose(matrix[:3, :3] / scale, np.eye(3), atol=1e-6):
+        data.warn("object %r is rotated: Cycles orients elliptical Huang fibers by its curve "
+                  "normals in object space (it does not rotate them with the object), and so "
+                  "does hairis" % obj.name)
+    return np.ascontiguousarray(normals[keep], np.float32)
 
 
 def _drop_short_curves(offsets, positions, radii):

@@ -101,6 +101,8 @@ PROTOTYPES = {
                                         _F, _F]),
     "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32),
                                                     c_size_t, _F, _F, c_char_p, c_size_t, _F]),
+    "hairis_scene_add_curves_with_normals": (c_int, [c_void_p, c_int, c_size_t, POINTER(c_uint32),
+                                                     c_size_t, _F, _F, _F, c_char_p]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, _F, c_size_t, POINTER(c_uint32),
                                       POINTER(c_int32)]),
     "hairis_scene_set_mesh_attribute": (c_int, [c_void_p, c_char_p, _F, c_size_t]),
@@ -179,11 +181,22 @@ class RenderStats:
         return "<RenderStats %s>" % ", ".join("%s=%r" % (n, getattr(self, n)) for n in self.names)
 
 
+CHIANG_ONLY = ("radial_roughness", "coat", "cycles")
+"""Principled Hair values only the Chiang model reads."""
+
+HUANG_ONLY = ("aspect_ratio", "reflection", "transmission", "secondary_reflection")
+"""Principled Hair values only the Huang model reads (Blender 4.0+)."""
+
+
 def principled_options(params):
     """Fiber options of a Principled Hair node from a dict of ``export.HairParameters``'
-    fields (parametrization as an index into PARAMETRIZATIONS or a name, angles in radians)."""
+    fields (model 'CHIANG' (default) or 'HUANG'; parametrization as an index into
+    PARAMETRIZATIONS or a name; angles in radians). The other model's values are left out."""
     values = dict(params)
-    out = {"model": "chiang"}
+    model = str(values.pop("model", "CHIANG")).lower()
+    for name in (CHIANG_ONLY if model == "huang" else HUANG_ONLY):
+        values.pop(name, None)
+    out = {"model": model}
     if "cycles" in values:
         out["cycles"] = values.pop("cycles")
     parametrization = values.pop("parametrization", "COLOR")
@@ -426,7 +439,8 @@ class Library:
         return Fiber(self, self._handle("hairis_fiber_create", pointer))
 
     def fiber_principled(self, params):
-        """A Chiang fiber from a Principled Hair node's values (see :func:`principled_options`)."""
+        """A Chiang or Huang fiber from a Principled Hair node's values (see
+        :func:`principled_options`)."""
         return self.fiber(principled_options(params))
 
     def bake_tables(self, fiber, values=None, progress=None):
@@ -697,8 +711,9 @@ class Scene(_Handle):
             self, options({"name": name}).encode(), _ptr(values, c_float), values.size)
         self._library._status("hairis_scene_set_mesh_attribute", status)
 
-    def add_curves(self, material, first, positions, radii):
-        """Adds curves: ``first`` (curves+1) offsets, world ``positions`` (p, 3), ``radii`` (p)."""
+    def add_curves(self, material, first, positions, radii, normals=None):
+        """Adds curves: ``first`` (curves+1) offsets, world ``positions`` (p, 3), ``radii`` (p)
+        and optionally the curve ``normals`` (p, 3) that orient elliptical Huang fibers."""
         first = _array(first, np.uint32, (), "first").reshape(-1)
         positions = _array(positions, np.float32, (3,), "positions")
         radii = _array(radii, np.float32, (), "radii").reshape(-1)
@@ -706,10 +721,20 @@ class Scene(_Handle):
             raise ValueError("first needs curve_count + 1 entries")
         if radii.size != positions.shape[0]:
             raise ValueError("radii needs %d values, got %d" % (positions.shape[0], radii.size))
-        status = self._library.raw.hairis_scene_add_curves(
+        if normals is None:
+            status = self._library.raw.hairis_scene_add_curves(
+                self, int(material), first.size - 1, _ptr(first, c_uint32), positions.shape[0],
+                _ptr(positions, c_float), _ptr(radii, c_float))
+            self._library._status("hairis_scene_add_curves", status)
+            return
+        normals = _array(normals, np.float32, (3,), "normals")
+        if normals.shape[0] != positions.shape[0]:
+            raise ValueError("normals needs %d rows, got %d"
+                             % (positions.shape[0], normals.shape[0]))
+        status = self._library.raw.hairis_scene_add_curves_with_normals(
             self, int(material), first.size - 1, _ptr(first, c_uint32), positions.shape[0],
-            _ptr(positions, c_float), _ptr(radii, c_float))
-        self._library._status("hairis_scene_add_curves", status)
+            _ptr(positions, c_float), _ptr(radii, c_float), _ptr(normals, c_float), b"")
+        self._library._status("hairis_scene_add_curves_with_normals", status)
 
     def add_curves_with_inputs(self, material, first, positions, radii, inputs):
         """Adds curves as :meth:`add_curves` whose hair material's node inputs vary:

@@ -42,9 +42,23 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     integrator: EnumProperty(
         name="Integrator", description="How light reaching hair is computed",
         items=INTEGRATOR_ITEMS, default="PATH")
+    max_transparent_bounces: IntProperty(
+        name="Transparent Max Bounces",
+        description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "
+                    "through outside its elliptical cross-section",
+        default=8, min=0, max=1024)
     strategy: EnumProperty(
         name="Strategy", description="How hair scattering directions are sampled",
         items=STRATEGY_ITEMS, default="TABLE")
+    huang_sampling: EnumProperty(
+        name="Huang Sampling",
+        description="How Huang hair is sampled",
+        items=(("STRATEGY", "Strategy",
+                "The strategy above, with its exact density (converges to Cycles' Huang eval)", 0),
+               ("CYCLES", "Cycles",
+                "Cycles' own Huang sampler with its weight and pdf 1 for MIS (converges to what "
+                "Cycles renders, which mixes that sampler with its eval)", 1)),
+        default="STRATEGY")
     multiple_weight: FloatProperty(
         name="Multiple Weight",
         description="One-sample mixture weight of the multiple-scattering distribution "

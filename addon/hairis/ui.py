@@ -140,6 +140,7 @@ class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
         column.prop(settings, "samples")
         column.prop(settings, "seed")
         column.prop(settings, "max_bounces")
+        column.prop(settings, "max_transparent_bounces")
         column.prop(settings, "threads")
 
 
@@ -157,6 +158,7 @@ class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
         settings = context.scene.hairis
         column = layout.column()
         column.prop(settings, "strategy")
+        column.prop(settings, "huang_sampling")
         sub = column.column()
         sub.active = settings.strategy in {"TABLE", "GAUSSIAN"}
         sub.prop(settings, "multiple_weight")

@@ -24,6 +24,7 @@
 #include "core/expected.h"
 #include "fiber/fiber.h"
 #include "fiber/fiber_spec.h"
+#include "fiber/huang.h"
 #include "core/options.h"
 #include "hairis/hairis.h"
 #include "sampling/hair_bsdf.h"
@@ -192,7 +193,7 @@ void for_each_item(size_t n, const F &f) {
 /// The canonical "name=value;..." string of a fiber spec (what table metadata records).
 std::string spec_parameters(const FiberSpec &spec);
 /// What hairis_fiber_create starts from for a model (hairis_defaults lists it): the node's
-/// defaults for Chiang, the seed's blonde parameters for Marschner.
+/// defaults for Chiang and Huang, the seed's blonde parameters for Marschner.
 FiberSpec default_fiber_spec(FiberKind kind);
 
 }  // namespace hairis::capi
@@ -205,6 +206,7 @@ struct hairis_fiber {
     hairis::FiberSpec spec;
     std::shared_ptr<const hairis::FiberModel> model;
     std::shared_ptr<const hairis::ChiangFiber> chiang;  // the same object, for Chiang fibers
+    std::shared_ptr<const hairis::HuangFiber> huang;    // the same object, for Huang fibers
     std::string model_name;
     std::string parameters;  // canonical_parameters(spec.parameters())
 };

@@ -117,12 +117,13 @@ void describe(Fields &f, WorldOptions &o) {
     f.field("map_resolution", o.map_resolution, 1, EnvironmentMap::kMaxMapWidth);
 }
 
-/// A hair material as the C API keeps it until a render: its fiber and, optionally, tables
-/// (shared with the hairis_tables they came from). The sampler is made by hairis_render from
-/// its settings.
+/// A hair material as the C API keeps it until a render: its fiber (Chiang or Huang) and,
+/// optionally, tables (shared with the hairis_tables they came from). The sampler is made by
+/// hairis_render from its settings.
 struct SceneHairMaterial {
     std::shared_ptr<const ChiangFiber> fiber;
     PrincipledHairNode node;  ///< the fiber's node: what curve inputs vary
+    std::shared_ptr<const HuangFiber> huang;
     std::optional<SamplingTables> tables;
 };
 
@@ -138,6 +139,12 @@ void describe(Fields &f, CurveInputOptions &o) {
 }
 
 using SceneMaterial = std::variant<SceneHairMaterial, SurfaceMaterial>;
+
+/// The options of hairis_scene_add_curves_with_normals: none yet (every name is refused, so a
+/// name added later is never silently ignored by an older library).
+struct CurveOptions {};
+template <typename Fields>
+void describe(Fields &, CurveOptions &) {}
 
 /// The most textures a scene holds (indices are ints).
 inline constexpr int kMaxTextures = 1 << 20;

@@ -14,6 +14,7 @@ thread_local std::string t_defaults;
 
 std::string defaults_of(const std::string &kind) {
     if (kind == "chiang") return default_fiber_spec(FiberKind::Chiang).options();
+    if (kind == "huang") return default_fiber_spec(FiberKind::Huang).options();
     if (kind == "marschner") return default_fiber_spec(FiberKind::Marschner).options();
     if (kind == "bake") return write_options(BakeOptions{});
     if (kind == "sampler") return write_options(SamplerOptions{});
@@ -32,9 +33,10 @@ std::string defaults_of(const std::string &kind) {
     if (kind == "world") return write_options(WorldOptions{});
     if (kind == "camera") return write_options(CameraOptions{});
     if (kind == "curve_inputs") return write_options(CurveInputOptions{});
-    invalid("kind must be one of chiang, marschner, bake, sampler, render, diffuse, principled, "
-            "glossy, emission, mix, add, texture, sun, point, spot, area, world, camera, "
-            "curve_inputs (got \"" + kind + "\")");
+    if (kind == "curves") return write_options(CurveOptions{});
+    invalid("kind must be one of chiang, huang, marschner, bake, sampler, render, diffuse, "
+            "principled, glossy, emission, mix, add, texture, sun, point, spot, area, world, "
+            "camera, curve_inputs, curves (got \"" + kind + "\")");
 }
 
 }  // namespace

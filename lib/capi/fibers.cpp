@@ -27,13 +27,13 @@ FiberSpec default_fiber_spec(FiberKind kind) {
 namespace {
 
 // The names hairis_fiber_create reads for a model: those default_fiber_spec(kind).options()
-// lists (hairis_defaults), and offset_deg for Chiang.
+// lists (hairis_defaults), and offset_deg for Chiang and Huang.
 std::vector<std::string> fiber_option_names(FiberKind kind) {
     std::vector<std::string> names;
     Expected<OptionItems> items = parse_options(default_fiber_spec(kind).options(), "defaults");
     if (!items) invalid(items.error().message);
     for (const auto &item : items.value()) names.push_back(item.first);
-    if (kind == FiberKind::Chiang) names.push_back("offset_deg");
+    if (kind != FiberKind::Marschner) names.push_back("offset_deg");
     return names;
 }
 
@@ -49,7 +49,9 @@ FiberSpec fiber_spec_of(const char *options) {
     for (const auto &[key, value] : items.value())
         if (key == "model") ok_or_invalid(spec.set(key, value), "fiber options: ");
     spec = default_fiber_spec(spec.kind);
-    const char *model = spec.kind == FiberKind::Marschner ? "marschner" : "chiang";
+    const char *model = spec.kind == FiberKind::Marschner ? "marschner"
+                        : spec.kind == FiberKind::Huang   ? "huang"
+                                                          : "chiang";
     const std::vector<std::string> known = fiber_option_names(spec.kind);
     bool offset = false, offset_deg = false;
     for (const auto &[key, value] : items.value()) {
@@ -82,6 +84,7 @@ HAIRIS_API hairis_fiber *hairis_fiber_create(const char *options) {
         auto fiber = std::make_unique<hairis_fiber>();
         std::shared_ptr<const FiberModel> shared(std::move(model).value());
         fiber->chiang = std::dynamic_pointer_cast<const ChiangFiber>(shared);
+        fiber->huang = std::dynamic_pointer_cast<const HuangFiber>(shared);
         fiber->model_name = shared->name();
         fiber->model = std::move(shared);
         fiber->parameters = spec_parameters(spec);

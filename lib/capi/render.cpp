@@ -16,11 +16,35 @@ namespace {
 
 thread_local std::string t_last_stats;
 
+// The shading of a Huang material: the samplers that need no tables (UNIFORM, GAUSSIAN); with
+// Cycles' own sampling (huang_sampling=cycles) the renderer samples the fiber itself and the
+// strategy is not used.
+HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name, StrategyKind kind,
+                          const SamplerOptions &o, bool cycles_sampling) {
+    if (cycles_sampling) kind = StrategyKind::Uniform;
+    if (kind == StrategyKind::Analytic)
+        invalid(name + "strategy=analytic has no sampler with a known density for a huang2022 fiber (Cycles' "
+                       "own Huang sampler has none); render with strategy=uniform");
+    if (kind == StrategyKind::Table)
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "strategy=table has no tables for huang2022 fibers in this "
+                                                  "version; render with strategy=uniform");
+    StrategyInputs inputs;
+    inputs.multiple_weight = o.multiple_weight;
+    inputs.n_h = o.n_h;
+    Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
+    if (!made) refuse(code_of(made.error().kind), name + made.error().message);
+    Expected<HairShading> shading = HairShading::create(hair.huang, std::move(made).value());
+    if (!shading) refuse(HAIRIS_ERROR_INTERNAL, name + shading.error().message);
+    return std::move(shading).value();
+}
+
 // The shading of hair material `index` under the settings. TABLE refuses a material without
 // tables, or with tables of other parameters, with HAIRIS_ERROR_INVALID_TABLE naming it.
-HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const SamplerOptions &o) {
+HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const SamplerOptions &o,
+                         bool cycles_huang) {
     const std::string name = "material " + std::to_string(index) + " (hair): ";
     const StrategyKind kind = StrategyKind(o.strategy);
+    if (hair.huang) return huang_shading(hair, name, kind, o, cycles_huang);
     // Every hair material shades through the strands model: curves without inputs get the
     // node's own fiber from it, the same as the fiber itself.
     Expected<ChiangStrands> strands = ChiangStrands::create(hair.node);
@@ -109,7 +133,8 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {
-                HairMaterial material{hair_shading(*hair, m, o.sampler)};
+                HairMaterial material{hair_shading(*hair, m, o.sampler,
+                                                   o.render.huang_sampling == int(HuangSampling::Cycles))};
                 if (o.render.integrator == int(Integrator::DualScattering)) add_dual_scattering(material, *hair, m);
                 desc.materials.push_back(std::move(material));
             } else

@@ -344,6 +344,7 @@ void add(hairis_scene &scene, HairCurves curves) {
     size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
                    curves.points.size() * (sizeof(Vec3) + sizeof(float));
     for (const CurveInput &in : curves.inputs) bytes += in.values.size() * sizeof(float);
+    bytes += curves.normals.size() * sizeof(Vec3);
     scene.curve_count += curves.first.size() - 1;
     scene.desc.curves.push_back(std::move(curves));
     scene.geometry_bytes += bytes;
@@ -371,11 +372,13 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
     return guard_value<int>("hairis_scene_add_hair_material", -1, [&] {
         require(scene, "scene");
         require(fiber, "fiber");
-        if (!fiber->chiang)
-            invalid("fiber must be a chiang2016 fiber (the renderer shades Principled Hair), got " + fiber->model_name);
+        if (!fiber->chiang && !fiber->huang)
+            invalid("fiber must be a chiang2016 or huang2022 fiber (the renderer shades the Principled Hair BSDF), "
+                    "got " + fiber->model_name);
         SceneHairMaterial hair;
         hair.fiber = fiber->chiang;
         hair.node = fiber->spec.node;
+        hair.huang = fiber->huang;
         if (tables) hair.tables = tables->sampling;
         return add_material(*scene, std::move(hair));
     });
@@ -485,6 +488,10 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
             if (!hair)
                 invalid(std::string("curve inputs: ") + info.name + " needs a hair material; material " +
                         std::to_string(material) + " is a surface material");
+            if (hair->huang)
+                invalid(std::string("curve inputs: ") + info.name + " per curve or point needs a chiang2016 " +
+                        "material; material " + std::to_string(material) +
+                        " is huang2022, whose inputs are the material's own in this version");
             if (!reads(hair->node.parametrization, HairInput(i)))
                 invalid(std::string("curve inputs: ") + info.name + " is not read by material " +
                         std::to_string(material) + "'s parametrization (" +
@@ -512,6 +519,25 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
             at += n * k;
         }
         if (curve_count > 0) add(*scene, std::move(curves));
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API int hairis_scene_add_curves_with_normals(hairis_scene *scene, int material, size_t curve_count,
+                                                    const uint32_t *first, size_t point_count,
+                                                    const float *positions, const float *radii,
+                                                    const float *normals, const char *options) {
+    return guard_status("hairis_scene_add_curves_with_normals", [&] {
+        HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
+        require_array(normals, point_count, "normals");
+        CurveOptions o;
+        read_options(options, "curve options", o);
+        for (size_t i = 0; i < point_count; ++i)
+            for (size_t k = 0; k < 3; ++k) require_finite(normals[3 * i + k], indexed("normals", 3 * i + k));
+        if (curve_count == 0) return HAIRIS_OK;
+        curves.normals.resize(point_count);
+        for (size_t i = 0; i < point_count; ++i) curves.normals[i] = vec3(normals + 3 * i);
+        add(*scene, std::move(curves));
         return HAIRIS_OK;
     });
 }

@@ -64,6 +64,9 @@ HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const ch
                                              hairis_progress_fn progress, void *user) {
     return guard_handle<hairis_tables>("hairis_tables_bake", [&] {
         require(fiber, "fiber");
+        if (fiber->huang)
+            invalid("fiber: tables for huang2022 fibers cannot be baked by this version (render Huang materials "
+                    "with strategy=uniform)");
         BakeOptions o;
         read_options(options, "bake options", o);
         ok_or_invalid(o.validate(), "bake options: ");

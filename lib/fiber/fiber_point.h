@@ -43,6 +43,9 @@ class FiberPoint {
   public:
     /// f(ω_i, ω_o, h)·|cos θ_i| for this hit: the value the path tracer multiplies by.
     virtual Rgb f(Vec3 wi) const = 0;
+    /// True when the ray passes the fiber without scattering (Cycles' Huang closure outside
+    /// the ellipse inscribed in the round tube): the renderer continues it unchanged.
+    virtual bool transparent() const { return false; }
     const FiberHit &hit() const { return hit_; }
 
   protected:

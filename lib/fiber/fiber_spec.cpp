@@ -1,5 +1,6 @@
 #include "fiber/fiber_spec.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -48,14 +49,35 @@ struct DoubleKey {
     bool degrees;
 };
 
-std::vector<FloatKey> float_keys(FiberSpec &spec) {
+// The node's scalar inputs a model reads (Chiang: Radial Roughness and Coat; Huang: Aspect
+// Ratio and the lobe multipliers), in the order options() writes them.
+std::vector<FloatKey> float_keys(FiberSpec &spec, FiberKind kind) {
     PrincipledHairNode &node = spec.node;
-    return {{"melanin", &node.melanin, false},       {"melanin_redness", &node.melanin_redness, false},
-            {"roughness", &node.roughness, false},   {"radial_roughness", &node.radial_roughness, false},
-            {"coat", &node.coat, false},             {"ior", &node.ior, false},
-            {"offset", &node.offset, false},         {"offset_deg", &node.offset, true},
-            {"random_color", &node.random_color, false}, {"random_roughness", &node.random_roughness, false},
-            {"random", &node.random, false}};
+    std::vector<FloatKey> keys{{"melanin", &node.melanin, false}, {"melanin_redness", &node.melanin_redness, false},
+                               {"roughness", &node.roughness, false}};
+    if (kind == FiberKind::Chiang) keys.push_back({"radial_roughness", &node.radial_roughness, false});
+    if (kind == FiberKind::Chiang) keys.push_back({"coat", &node.coat, false});
+    keys.insert(keys.end(), {{"ior", &node.ior, false},
+                             {"offset", &node.offset, false},
+                             {"offset_deg", &node.offset, true},
+                             {"random_color", &node.random_color, false},
+                             {"random_roughness", &node.random_roughness, false},
+                             {"random", &node.random, false}});
+    if (kind == FiberKind::Huang)
+        keys.insert(keys.end(), {{"aspect_ratio", &node.aspect_ratio, false},
+                                 {"reflection", &node.reflection, false},
+                                 {"transmission", &node.transmission, false},
+                                 {"secondary_reflection", &node.secondary_reflection, false}});
+    return keys;
+}
+
+// Every node key set() reads, whatever the model.
+std::vector<FloatKey> all_node_keys(FiberSpec &spec) {
+    std::vector<FloatKey> keys = float_keys(spec, FiberKind::Chiang);
+    for (const FloatKey &k : float_keys(spec, FiberKind::Huang))
+        if (std::none_of(keys.begin(), keys.end(), [&](const FloatKey &c) { return std::string(c.name) == k.name; }))
+            keys.push_back(k);
+    return keys;
 }
 
 std::vector<DoubleKey> double_keys(FiberSpec &spec) {
@@ -83,7 +105,7 @@ std::string number_text(double v) {
 }  // namespace
 
 const std::vector<std::string> &fiber_preset_names() {
-    static const std::vector<std::string> names = {"blonde", "brunette", "cycles-default"};
+    static const std::vector<std::string> names = {"blonde", "brunette", "cycles-default", "cycles-default-huang"};
     return names;
 }
 
@@ -92,6 +114,9 @@ Expected<FiberSpec> FiberSpec::preset(const std::string &name) {
     if (name == "cycles-default") {
         spec.kind = FiberKind::Chiang;
         spec.node = PrincipledHairNode::cycles_default();
+    } else if (name == "cycles-default-huang") {
+        spec.kind = FiberKind::Huang;
+        spec.node = PrincipledHairNode::cycles_default();
     } else if (name == "blonde") {
         spec.kind = FiberKind::Marschner;
         spec.marschner = MarschnerParams::blonde();
@@ -99,7 +124,8 @@ Expected<FiberSpec> FiberSpec::preset(const std::string &name) {
         spec.kind = FiberKind::Marschner;
         spec.marschner = MarschnerParams::brunette();
     } else {
-        return Error{"preset must be one of blonde, brunette, cycles-default (got \"" + name + "\")"};
+        return Error{"preset must be one of blonde, brunette, cycles-default, cycles-default-huang (got \"" + name +
+                     "\")"};
     }
     return spec;
 }
@@ -113,8 +139,9 @@ Status FiberSpec::set(const std::string &key, const std::string &value) {
     }
     if (key == "model") {
         if (value == "chiang") kind = FiberKind::Chiang;
+        else if (value == "huang") kind = FiberKind::Huang;
         else if (value == "marschner") kind = FiberKind::Marschner;
-        else return Error{"model must be chiang or marschner (got \"" + value + "\")"};
+        else return Error{"model must be chiang, huang or marschner (got \"" + value + "\")"};
         return std::nullopt;
     }
     if (key == "cycles") {
@@ -141,7 +168,7 @@ Status FiberSpec::set(const std::string &key, const std::string &value) {
         *rgb = c.value();
         return std::nullopt;
     }
-    for (const FloatKey &k : float_keys(*this))
+    for (const FloatKey &k : all_node_keys(*this))
         if (key == k.name) {
             Expected<double> v = parse_number(key, value);
             if (!v) return v.error();
@@ -160,7 +187,9 @@ Status FiberSpec::set(const std::string &key, const std::string &value) {
 
 std::string FiberSpec::options() const {
     FiberSpec copy = *this;
-    std::string out = kind == FiberKind::Marschner ? "model=marschner" : "model=chiang";
+    std::string out = kind == FiberKind::Marschner ? "model=marschner"
+                      : kind == FiberKind::Huang   ? "model=huang"
+                                                   : "model=chiang";
     if (kind == FiberKind::Marschner) {
         out += ";sigma_a=" + rgb_text(marschner.sigma_a);
         for (const DoubleKey &k : double_keys(copy))
@@ -168,11 +197,12 @@ std::string FiberSpec::options() const {
         return out;
     }
     const char *names[] = {"absorption", "melanin", "color"};
-    out += std::string(";cycles=") + (node.tilt == ChiangTilt::Outgoing ? "4.2" : "3.4");
+    if (kind == FiberKind::Chiang)
+        out += std::string(";cycles=") + (node.tilt == ChiangTilt::Outgoing ? "4.2" : "3.4");
     out += std::string(";parametrization=") + names[int(node.parametrization)];
     out += ";color=" + rgb_text(node.color) + ";tint=" + rgb_text(node.tint) +
            ";absorption=" + rgb_text(node.absorption_coefficient);
-    for (const FloatKey &k : float_keys(copy))
+    for (const FloatKey &k : float_keys(copy, kind))
         if (!k.degrees) out += std::string(";") + k.name + "=" + number_text(double(*k.field));
     return out;
 }
@@ -182,6 +212,13 @@ Expected<std::unique_ptr<FiberModel>> FiberSpec::create_model() const {
         Expected<MarschnerFiber> m = MarschnerFiber::create(marschner);
         if (!m) return m.error();
         return std::unique_ptr<FiberModel>(std::make_unique<MarschnerFiber>(std::move(m).value()));
+    }
+    if (kind == FiberKind::Huang) {
+        Expected<HuangParams> p = to_huang_params(node);
+        if (!p) return p.error();
+        Expected<HuangFiber> h = HuangFiber::create(p.value());
+        if (!h) return h.error();
+        return std::unique_ptr<FiberModel>(std::make_unique<HuangFiber>(std::move(h).value()));
     }
     Expected<ChiangParams> p = to_chiang_params(node);
     if (!p) return p.error();
@@ -201,9 +238,22 @@ Expected<std::vector<std::pair<std::string, double>>> FiberSpec::parameters() co
             {"caustic_width", m.caustic_width}, {"caustic_fade", m.caustic_fade},
             {"caustic_limit", m.caustic_limit}};
     }
+    if (kind == FiberKind::Huang) {
+        Expected<HuangParams> p = to_huang_params(node);
+        if (!p) return p.error();
+        return huang_fiber_parameters(p.value());
+    }
     Expected<ChiangParams> p = to_chiang_params(node);
     if (!p) return p.error();
     return chiang_parameters(p.value());
+}
+
+std::vector<std::pair<std::string, double>> huang_fiber_parameters(const HuangParams &p) {
+    return {{"sigma_a_r", p.sigma_a.r},  {"sigma_a_g", p.sigma_a.g},
+            {"sigma_a_b", p.sigma_a.b},  {"roughness", p.roughness},
+            {"ior", p.ior},              {"offset", p.offset},
+            {"aspect_ratio", p.aspect_ratio}, {"reflection", p.reflection},
+            {"transmission", p.transmission}, {"secondary_reflection", p.secondary_reflection}};
 }
 
 std::vector<std::pair<std::string, double>> chiang_parameters(const ChiangParams &c) {

@@ -1,8 +1,11 @@
-// Blender 3.4's Principled Hair BSDF node (Chiang model) and Cycles' mapping of its inputs
-// to the closure parameters (svm_node_closure_bsdf, CLOSURE_BSDF_HAIR_PRINCIPLED_ID).
+// Blender's Principled Hair BSDF node and Cycles' mapping of its inputs to the closure
+// parameters (svm_node_closure_bsdf): the Chiang model (CLOSURE_BSDF_HAIR_PRINCIPLED_ID in
+// 3.4, CLOSURE_BSDF_HAIR_CHIANG_ID from 4.0) and, from Blender 4.0, the Huang model
+// (CLOSURE_BSDF_HAIR_HUANG_ID).
 #pragma once
 
 #include "fiber/chiang.h"
+#include "fiber/huang.h"
 #include "core/expected.h"
 #include "core/math.h"
 
@@ -48,6 +51,13 @@ struct PrincipledHairNode {
     float random = 0.0f;
     /// Which Cycles evaluates the node (Blender's version): where Chiang's tilt goes.
     ChiangTilt tilt = ChiangTilt::Incident;
+    /// Huang only (Blender 4.0+): "Aspect Ratio", the ellipse's minor / major axis; Cycles
+    /// renders a value b > 1 as 1/b and does not guard b <= 0.
+    float aspect_ratio = 0.85f;
+    /// Huang only: the lobe multipliers "Reflection", "Transmission" and "Secondary
+    /// Reflection" (identifiers "R lobe", "TT lobe", "TRT lobe"). Cycles stores max(0, value)
+    /// and allocates no closure when all three are <= 0.
+    float reflection = 1.0f, transmission = 1.0f, secondary_reflection = 1.0f;
 
     /// The node as Blender creates it (Direct Coloring, every input at its default).
     static PrincipledHairNode cycles_default() { return {}; }
@@ -59,6 +69,16 @@ struct PrincipledHairNode {
 /// and roughness clamped into [0, 1] (ChiangFiber applies the remaining 0.001 floor).
 /// Refuses NaN/inf and out-of-range inputs with a message naming the input.
 Expected<ChiangParams> to_chiang_params(const PrincipledHairNode &node);
+
+/// Cycles' SVM mapping of the node with the Huang model: the same random factors and
+/// absorption as Chiang's, except that Direct Coloring and the Melanin tint invert the colour
+/// with the randomized Roughness (Huang has no Radial Roughness); roughness clamped into
+/// [0, 1] (HuangFiber applies the 0.001 floor); Aspect Ratio and the lobe multipliers passed
+/// on, negative multipliers as 0. Refuses what to_chiang_params refuses (Radial Roughness and
+/// Coat are not read), an aspect ratio that is not finite and > 0, a multiplier that is not
+/// finite, and all three multipliers <= 0 (Cycles then allocates no closure: the strands
+/// neither scatter nor let light through), each naming the input.
+Expected<HuangParams> to_huang_params(const PrincipledHairNode &node);
 
 namespace principled_hair {
 

@@ -280,3 +280,107 @@ TEST(PrincipledHairMapping, EveryValidNodeMakesAValidFiber) {
 
 }  // namespace
 }  // namespace hairis
+
+namespace hairis {
+namespace {
+
+HuangParams mapped_huang(const PrincipledHairNode &node) {
+    Expected<HuangParams> params = to_huang_params(node);
+    EXPECT_TRUE(params.ok()) << (params.ok() ? "" : params.error().message);
+    return params.ok() ? params.value() : HuangParams{};
+}
+
+TEST(PrincipledHairHuang, DefaultNodeMapsToCyclesHuangDefaults) {
+    const PrincipledHairNode node;  // Blender's node with model Huang: aspect 0.85, lobes 1
+    const HuangParams p = mapped_huang(node);
+    EXPECT_FLOAT_EQ(p.aspect_ratio, 0.85f);
+    EXPECT_EQ(p.reflection, 1.0f);
+    EXPECT_EQ(p.transmission, 1.0f);
+    EXPECT_EQ(p.secondary_reflection, 1.0f);
+    EXPECT_FLOAT_EQ(p.roughness, 0.3f);
+    EXPECT_FLOAT_EQ(p.ior, 1.55f);
+    EXPECT_FLOAT_EQ(p.offset, float(radians(2.0)));
+    // Direct Coloring with Huang inverts the colour with Roughness.
+    expect_rgb_near(p.sigma_a, sigma_of_colour(node.color.r, double(0.3f)), sigma_of_colour(node.color.g, double(0.3f)),
+                    sigma_of_colour(node.color.b, double(0.3f)), 1e-5, "default colour");
+    EXPECT_TRUE(HuangFiber::create(p).ok());
+}
+
+TEST(PrincipledHairHuang, ColourUsesRoughnessWhereChiangUsesRadialRoughness) {
+    for (HairParametrization parametrization : {HairParametrization::Color, HairParametrization::Melanin}) {
+        PrincipledHairNode node;
+        node.parametrization = parametrization;
+        node.tint = {0.6f, 0.5f, 0.4f};
+        node.roughness = 0.2f;
+        node.radial_roughness = 0.7f;
+        node.random_roughness = 0.5f;
+        node.random = 0.9f;  // factor 1.4
+        const HuangParams huang = mapped_huang(node);
+        // The same node for Chiang with the radial roughness set to Huang's roughness gives
+        // Huang's σ; with its own radial roughness it differs.
+        PrincipledHairNode as_chiang = node;
+        as_chiang.radial_roughness = node.roughness;
+        const Rgb expected = mapped(as_chiang).sigma_a;
+        expect_rgb_near(huang.sigma_a, expected.r, expected.g, expected.b, 1e-6, "σ from roughness");
+        EXPECT_GT(std::fabs(mapped(node).sigma_a.r - huang.sigma_a.r), 1e-3f);
+        EXPECT_NEAR(huang.roughness, 0.2 * 1.4, 1e-6);
+    }
+    // Past 1 the roughness is clamped, the colour still inverts with the randomized value.
+    PrincipledHairNode rough;
+    rough.roughness = 0.8f;
+    rough.random_roughness = 1.0f;
+    rough.random = 1.0f;  // factor 2
+    const HuangParams p = mapped_huang(rough);
+    EXPECT_EQ(p.roughness, 1.0f);
+    expect_rgb_near(p.sigma_a, sigma_of_colour(rough.color.r, 1.6), sigma_of_colour(rough.color.g, 1.6),
+                    sigma_of_colour(rough.color.b, 1.6), 1e-5, "unclamped roughness");
+}
+
+TEST(PrincipledHairHuang, LobesAndAspectRatioFollowCycles) {
+    PrincipledHairNode node;
+    node.reflection = -0.5f;  // Cycles: max(0, value)
+    node.transmission = 0.5f;
+    node.secondary_reflection = 3.0f;  // no upper clamp
+    node.aspect_ratio = 2.0f;          // passed on; the fiber renders it as 1/2
+    node.radial_roughness = 5.0f;      // Huang does not read it
+    node.coat = -1.0f;                 // nor this
+    const HuangParams p = mapped_huang(node);
+    EXPECT_EQ(p.reflection, 0.0f);
+    EXPECT_EQ(p.transmission, 0.5f);
+    EXPECT_EQ(p.secondary_reflection, 3.0f);
+    const Expected<HuangFiber> fiber = HuangFiber::create(p);
+    ASSERT_TRUE(fiber.ok()) << fiber.error().message;
+    EXPECT_DOUBLE_EQ(fiber.value().aspect_ratio(), 0.5);
+    EXPECT_EQ(fiber.value().m_r(), 0.0);
+}
+
+TEST(PrincipledHairHuang, InvalidInputsAreRefusedByName) {
+    const float nan = std::nanf("");
+    const std::vector<std::pair<std::function<void(PrincipledHairNode &)>, std::string>> cases = {
+        {[](PrincipledHairNode &n) { n.aspect_ratio = 0.0f; }, "aspect_ratio must be in (0, 1000]"},
+        {[](PrincipledHairNode &n) { n.aspect_ratio = -0.5f; }, "aspect_ratio"},
+        {[&](PrincipledHairNode &n) { n.aspect_ratio = nan; }, "aspect_ratio"},
+        {[&](PrincipledHairNode &n) { n.transmission = nan; }, "transmission"},
+        {[](PrincipledHairNode &n) { n.secondary_reflection = INFINITY; }, "secondary_reflection"},
+        {[](PrincipledHairNode &n) {
+             n.reflection = 0.0f;
+             n.transmission = -1.0f;
+             n.secondary_reflection = 0.0f;
+         },
+         "all <= 0: Cycles allocates no closure"},
+        {[](PrincipledHairNode &n) { n.roughness = 1.5f; }, "roughness"},
+        {[](PrincipledHairNode &n) { n.ior = 0.9f; }, "ior"},
+        {[](PrincipledHairNode &n) { n.color.g = 0.0f; }, "color.g"},
+    };
+    for (const auto &[spoil, name] : cases) {
+        PrincipledHairNode node;
+        spoil(node);
+        const Expected<HuangParams> params = to_huang_params(node);
+        ASSERT_FALSE(params.ok()) << name;
+        EXPECT_NE(params.error().message.find(name), std::string::npos)
+            << "message '" << params.error().message << "' does not say " << name;
+    }
+}
+
+}  // namespace
+}  // namespace hairis

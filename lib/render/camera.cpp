@@ -173,11 +173,18 @@ CameraRay Camera::ray_through_raster(float rx, float ry) const {
         ray.direction = safe_normalize(to_world_.transform_vector(d_cam));
         ray.tmin = clip_start_ * inv_cos;
         ray.tmax = clip_end_ * inv_cos;
+        // The change of the unit direction over one pixel in x and in y (camera space: the
+        // rotation to world space keeps lengths).
+        const float sx = (x1_ - x0_) / float(width_), sy = (y1_ - y0_) / float(height_);
+        const Vec3 n = d_cam * (1.0f / len);
+        ray.spread = 0.5f * (length(safe_normalize(d_cam + Vec3{sx, 0, 0}) - n) +
+                             length(safe_normalize(d_cam + Vec3{0, sy, 0}) - n));
     } else {
         ray.origin = to_world_.transform_point({cx, cy, -clip_start_});
         ray.direction = safe_normalize(to_world_.transform_vector({0, 0, -1}));
         ray.tmin = 0.0f;
         ray.tmax = clip_end_ - clip_start_;
+        ray.footprint = (x1_ - x0_) / float(width_);
     }
     return ray;
 }

@@ -25,6 +25,13 @@
 // Clipping as in Cycles (kernel/camera/camera.h): perspective rays start on the plane
 // z = −clip_start and end on z = −clip_end (t is scaled by 1/cos of the angle to the view
 // axis); orthographic rays start on the plane z = −clip_start and run clip_end − clip_start.
+//
+// Footprint: Cycles' compact ray differentials (kernel/camera/camera.h, util/differential.h).
+// A perspective ray through camera-space point d (on the frame's plane) spreads by
+// ½(|n(d + s_x) − n(d)| + |n(d + s_y) − n(d)|) per unit distance from the eye, with n() the
+// normalization and s_x, s_y one pixel's steps across the frame in x and y; its footprint at
+// distance t is that spread × t. An orthographic ray's footprint is one pixel's width in x
+// (Cycles takes the x step for both axes) and does not grow.
 #pragma once
 
 #include <array>
@@ -81,6 +88,12 @@ struct CameraRay {
     Vec3 direction;
     float tmin = 0;
     float tmax = INFINITY;
+    /// Cycles' footprint radius (ray.dP) at the origin and its growth per unit t (ray.dD).
+    float footprint = 0;
+    float spread = 0;
+
+    /// The footprint at origin + t·direction (Cycles' sd->dP of a hit at distance t).
+    float footprint_at(float t) const { return footprint + spread * t; }
 };
 
 /// A validated camera that turns raster positions into rays.

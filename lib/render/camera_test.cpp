@@ -241,6 +241,45 @@ TEST(Camera, PerspectiveClippingIsPlanar) {
     EXPECT_NEAR((r.origin + r.direction * r.tmax).z, -10.0f, 1e-4f);
 }
 
+// The chord between the unit directions (0, 0, -depth) and (step, 0, -depth).
+double chord(double step, double depth) {
+    return std::sqrt(2.0 - 2.0 * depth / std::sqrt(step * step + depth * depth));
+}
+
+TEST(Camera, PerspectiveFootprintIsCyclesRayDifferential) {
+    BlenderCamera bc;  // 50 mm on a 36 mm sensor, 8 x 4 px: square pixels of 1/8 of the frame
+    const Camera cam = make(bc, looking_along_y(), 0.1f, 100.0f);
+    const double depth = 0.5 * 50.0 / 18.0, step = 1.0 / 8.0;
+    // At the image centre both steps move the direction by the chord of atan(step / depth).
+    const CameraRay centre = cam.ray_through_raster(4.0f, 2.0f);
+    EXPECT_NEAR(centre.spread, chord(step, depth), 1e-6);
+    EXPECT_EQ(centre.footprint, 0.0f);  // from the eye: Cycles' dP is 0 there
+    EXPECT_NEAR(centre.footprint_at(7.0f), 7.0 * chord(step, depth), 1e-5);
+    // Elsewhere, the mean of the direction changes to the next pixel in x and in y, measured
+    // on the world-space rays themselves.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 50; ++i) {
+        const float rx = 7.0f * u(rng), ry = 3.0f * u(rng);
+        const Vec3 d = cam.ray_through_raster(rx, ry).direction;
+        const double dx = length(cam.ray_through_raster(rx + 1.0f, ry).direction - d);
+        const double dy = length(cam.ray_through_raster(rx, ry + 1.0f).direction - d);
+        EXPECT_NEAR(cam.ray_through_raster(rx, ry).spread, 0.5 * (dx + dy), 2e-6) << rx << " " << ry;
+    }
+    // Towards the corners a pixel subtends less: the spread falls off.
+    EXPECT_LT(cam.ray_through_raster(0.0f, 0.0f).spread, centre.spread);
+}
+
+TEST(Camera, OrthographicFootprintIsOnePixelWide) {
+    BlenderCamera bc;
+    bc.ortho = true;
+    const Camera cam = make(bc, looking_along_y(), 0.5f, 100.0f);
+    const CameraRay r = cam.generate_ray(2, 5, 0.3f, 0.6f);
+    EXPECT_NEAR(r.footprint, 4.0 / 8.0, 1e-7);  // ortho_scale 4 over 8 px
+    EXPECT_EQ(r.spread, 0.0f);
+    EXPECT_NEAR(r.footprint_at(50.0f), 0.5, 1e-7);
+}
+
 TEST(Camera, RefusesInvalidInput) {
     CameraDesc good;
     good.frame = view_frame(BlenderCamera{});

@@ -22,6 +22,7 @@
 #include "core/rng.h"
 #include "core/scratch.h"
 #include "render/dual_scattering_integrator.h"
+#include "fiber/huang.h"
 
 namespace hairis {
 
@@ -74,6 +75,28 @@ struct Counters {
     DualWork dual;
 };
 
+// What a hair BSDF needs besides the hit point: whether the ray is a camera ray (Cycles'
+// PATH_RAY_CAMERA, kept through transparent crossings), its footprint there, and the seed of
+// the point's random numbers.
+struct HitContext {
+    bool camera_ray = false;
+    float footprint = 0;
+    std::uint32_t seed = 0;
+    bool cycles_huang = false;  // RenderSettings::huang_sampling == Cycles
+};
+
+FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context) {
+    FiberHit hit;
+    hit.wo = frame.to_local(wo);
+    hit.h = std::clamp(dot(cross(sp.normal, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
+    const Vec3 axis = HuangFiber::major_axis(sp.tangent, sp.curve_normal);
+    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(sp.tangent));
+    hit.pixel_coverage = context.camera_ray ? cycles_pixel_coverage(context.footprint, sp.curve_radius) : 1.0f;
+    hit.seed = context.seed;
+    return hit;
+}
+
 // A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
 // Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`; surfaces build their
 // lobes (surface_material.h) with both normals on ω_o's side, as Cycles flips them for back
@@ -81,22 +104,26 @@ struct Counters {
 class Bsdf {
   public:
     // `inputs`: the hit's per-strand node inputs (hair), null for the material's own.
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, bool camera_hit,
+    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
          const HairInputValues *inputs, ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-            FiberHit hit;
-            hit.wo = frame_.to_local(wo);
-            hit.h = std::clamp(dot(cross(sp.normal, frame_.x), frame_.z), -1.0f, 1.0f);  // Cycles
+            FiberHit hit = fiber_hit(sp, wo, frame_, context);
             hit.inputs = inputs;
-            hair_.emplace(hair->shading.at(hit, scratch));
+            const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
+            if (huang) {
+                huang_ = &scratch.make<HuangPoint>(*huang, hit);
+                lcg_.state = hit.seed ^ 0x9e3779b9u;
+            } else {
+                hair_.emplace(hair->shading.at(hit, scratch));
+            }
             return;
         }
         const bool back = dot(sp.normal, wo) < 0.0f;
         const Vec3 ng = back ? -sp.normal : sp.normal;
         if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
             const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
-            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, camera_hit});
+            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, context.camera_ray});
         } else {
             const auto &d = std::get<DiffuseMaterial>(material);
             surface_ = SurfaceBsdf(ng, ng, wo);
@@ -108,21 +135,37 @@ class Bsdf {
         }
     }
 
-    bool black() const { return !hair_ && surface_.black(); }
-    bool is_hair() const { return hair_.has_value(); }
+    bool black() const { return !is_hair() && surface_.black(); }
+    bool is_hair() const { return hair_.has_value() || huang_; }
+    // The ray passes without scattering (Huang outside its ellipse).
+    bool transparent() const { return (hair_ && hair_->transparent()) || (huang_ && huang_->transparent()); }
     const HairBsdf *hair() const { return hair_ ? &*hair_ : nullptr; }
     const FiberFrame &frame() const { return frame_; }
 
-    // f·|cos θ_i| and the density with which sample() draws wi.
+    // f·|cos θ_i| and the density with which sample() draws wi (Cycles' Huang: its eval and
+    // pdf 1, what Cycles' MIS weighs with).
     Rgb eval(Vec3 wi, float &pdf) const {
+        if (huang_) {
+            pdf = 1.0f;
+            return huang_->f(frame_.to_local(wi));
+        }
         if (hair_) return hair_->f_and_pdf(frame_.to_local(wi), pdf);
         return surface_.eval(wi, pdf);
     }
 
-    // Draws wi; returns false when there is none. weight = f·|cos|/pdf.
+    // Draws wi; returns false when there is none. weight = f·|cos|/pdf (Cycles' Huang: its
+    // sampler's weight, with pdf 1).
     bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
                 bool &glossy) const {
         glossy = false;
+        if (huang_) {
+            const std::optional<HuangCyclesSample> s = huang_->sample_cycles(u0, u1, u2, lcg_);
+            if (!s) return false;
+            wi = safe_normalize(frame_.to_world(s->wi));
+            pdf = 1.0f;
+            weight = s->weight;
+            return dot(wi, wi) > 0.0f;
+        }
         if (hair_) {
             const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
             if (!s || !(s->pdf > 0.0f)) return false;
@@ -136,9 +179,16 @@ class Bsdf {
 
   private:
     std::optional<HairBsdf> hair_;
+    const HuangPoint *huang_ = nullptr;  // Cycles' Huang sampling
+    mutable CyclesLcg lcg_;              // its sampler's numbers beyond the path's three
     FiberFrame frame_;
     SurfaceBsdf surface_;
 };
+
+// The seed of the random numbers of the point at vertex `depth` of a path (Huang's eval).
+std::uint32_t vertex_seed(const SampleRng &key, int depth) {
+    return std::uint32_t(mix64(key.key() ^ (std::uint64_t(depth + 1) * 0xd1b54a32d192ed03ull)) >> 32);
+}
 
 // One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
 Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
@@ -149,6 +199,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     // Stratified per pixel (jitter, light and BSDF pairs): hair is thinner than a pixel, and
     // stratifying where a sample lands in the pixel is what Cycles' Sobol patterns buy it.
     const SobolSampleRng rng(settings.seed, pixel, sample);
+    const SampleRng seeds(settings.seed, pixel, sample);
 
     const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
     Vec3 origin = cr.origin, dir = cr.direction;
@@ -157,7 +208,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     Rgb beta(1.0f), radiance;
     float bsdf_pdf = 0.0f;
     bool use_mis = false;  // camera rays take emission at full weight
-    int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0;
+    int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0, transparent_bounces = 0;
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     const bool dual = settings.integrator == int(Integrator::DualScattering);
     bool from_dual_hair = false;  // the ray left a hair vertex shaded by dual scattering
@@ -171,7 +222,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         radiance += contribution;
     };
 
-    for (int depth = 0;; ++depth) {
+    // depth counts scattering vertices; a transparent crossing keeps it (and the camera ray).
+    for (int depth = 0;;) {
         const std::optional<Hit> hit = scene.intersect(origin, dir, tmin, tmax, skip);
         ++counters.rays;
         const float t_end = hit ? hit->t : tmax;
@@ -203,7 +255,30 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             add(beta * emission * w);
         }
 
+        // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
+        // transparency does not apply either).
         if (depth > settings.max_bounces || last_segment) break;
+
+        scratch.reset();  // the previous vertex's BSDF is done with
+        HitContext context;
+        context.camera_ray = depth == 0;
+        context.footprint = cr.footprint_at(hit->t);
+        context.seed = vertex_seed(seeds, depth);
+        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles);
+        const HairInputValues *inputs = nullptr;
+        if (sp.is_curve) {
+            HairInputValues values;
+            if (scene.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
+        }
+        const Bsdf bsdf(material, sp, wo, context, inputs, scratch);
+        if (bsdf.transparent()) {
+            // The same ray goes on beyond this curve.
+            last_segment = ++transparent_bounces > settings.max_transparent_bounces;
+            tmin = hit->t;
+            skip = sp.self;
+            continue;
+        }
+        if (bsdf.black()) break;
 
         // Russian roulette.
         if (depth >= settings.rr_start_bounce) {
@@ -211,15 +286,6 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             if (!(rng.get(dim(depth, kDimRoulette)) < q)) break;
             beta = beta / q;
         }
-
-        scratch.reset();  // the previous vertex's BSDF is done with
-        const HairInputValues *inputs = nullptr;
-        if (sp.is_curve) {
-            HairInputValues values;
-            if (scene.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
-        }
-        const Bsdf bsdf(material, sp, wo, depth == 0, inputs, scratch);
-        if (bsdf.black()) break;
 
         // Next-event estimation.
         // render() refuses hair without dual-scattering data; render_sample() path-traces it.
@@ -284,6 +350,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         skip = sp.self;
         bsdf_pdf = pdf;
         use_mis = true;
+        ++depth;
     }
     return radiance;
 }
@@ -298,9 +365,12 @@ Status validate(const RenderSettings &s) {
                                              1024),
                        check::count_in_range("max_transmission_bounces",
                                              s.max_transmission_bounces, 0, 1024),
+                       check::count_in_range("max_transparent_bounces",
+                                             s.max_transparent_bounces, 0, 1024),
                        check::count_in_range("threads", s.threads, 0, 1024),
                        check::count_in_range("tile_size", s.tile_size, 1, 4096),
-                       check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024));
+                       check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024),
+                       check::count_in_range("huang_sampling", s.huang_sampling, 0, 1));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.
@@ -325,6 +395,35 @@ struct Tile {
 float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo) {
     const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);
     return std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);
+}
+
+float cycles_pixel_coverage(float footprint, float curve_radius) {
+    return curve_radius > 0.0f ? 0.5f * footprint / curve_radius : INFINITY;
+}
+
+FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
+                          std::uint32_t seed) {
+    return fiber_hit(sp, wo, FiberFrame::from_tangent_and_view(sp.tangent, wo),
+                     HitContext{camera_ray, footprint, seed});
+}
+
+std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v) {
+    const CameraRay cr = scene.camera().generate_ray(x, y, u, v);
+    float tmin = cr.tmin;
+    PrimRef skip;
+    ScratchBuffer scratch;
+    for (;;) {
+        const std::optional<Hit> hit = scene.intersect(cr.origin, cr.direction, tmin, cr.tmax, skip);
+        if (!hit) return std::nullopt;
+        const SurfacePoint sp = scene.surface_point(cr.origin, cr.direction, *hit);
+        const auto *hair = std::get_if<HairMaterial>(&scene.materials()[sp.material]);
+        if (!hair) return std::nullopt;
+        const FiberHit fh = cycles_fiber_hit(sp, -cr.direction, true, cr.footprint_at(hit->t), 0);
+        scratch.reset();
+        if (!hair->shading.at(fh, scratch).transparent()) return fh;
+        tmin = hit->t;
+        skip = sp.self;
+    }
 }
 
 Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int y,

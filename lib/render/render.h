@@ -1,5 +1,6 @@
-// The hair path tracer behind the "Hairis" render engine: renders a Scene the way Cycles 3.4
-// renders the same Blender scene (same light units, curve shape, hair BSDF and bounce count).
+// The hair path tracer behind the "Hairis" render engine: renders a Scene the way Cycles
+// renders the same Blender scene (same light units, curve shape, hair BSDF and bounce count;
+// lights and Chiang as the materials' Cycles version says, Huang as Cycles 4.5/5.0).
 //
 // Integrator (per camera sample; the vertex where the camera ray lands has depth 0):
 //  - Emission: a ray that reaches an emitter adds throughput × radiance, weighted by the power
@@ -34,6 +35,16 @@
 //    Where the curve set gives node inputs per curve or point (scene.h's CurveInput), f is
 //    the strand's own fiber at the hit's interpolated inputs (chiang_strands.h), and so is
 //    what the sampler follows.
+//  - Huang hair (Cycles 4.5/5.0, kernel/svm/closure.h and bsdf_hair_huang_setup): the FiberHit
+//    carries the curve normal (the ellipse's major axis; Cycles' fallback frame around the
+//    world tangent where the curve has none, as for particle hair), pixel_coverage = half the
+//    camera ray's footprint at the hit / the curve radius for camera rays (1 for all others:
+//    the near field only where a fiber is wider than a pixel) and a per-vertex seed. Where
+//    Huang is transparent (the ray passes outside the ellipse inscribed in the round tube)
+//    the ray continues unchanged: no bounce, same camera flag, footprint and MIS state, the
+//    curve skipped, counted against max_transparent_bounces. Rays past a bounce limit and
+//    shadow rays see Huang hair opaque, as in Cycles (terminating rays evaluate no closures;
+//    curves' shadow transparency is baked per point with a view through the axis, h = 0).
 //  - Russian roulette from depth rr_start_bounce on, with Cycles' survival probability
 //    min(1, sqrt(max throughput component)) and division by it (unbiased).
 //  - integrator=dual_scattering: at hair vertices next-event estimation is replaced by the
@@ -58,8 +69,10 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 #include "core/expected.h"
+#include "fiber/fiber_point.h"
 #include "render/scene.h"
 
 namespace hairis {
@@ -68,6 +81,17 @@ namespace hairis {
 /// (render/dual_scattering_integrator.h), whose hair materials need HairMaterial::dual and
 /// ::multiple.
 enum class Integrator { Path = 0, DualScattering = 1 };
+
+/// How Huang hair draws its BSDF samples.
+enum class HuangSampling {
+    /// The material's strategy (its sampler's exact density, MIS with it, f = Cycles' eval).
+    Strategy = 0,
+    /// Cycles 4.5/5.0's chained microfacet sampler with its own weight, and pdf 1 for MIS in
+    /// both light and BSDF samples, as Cycles renders Huang. Its BSDF-sampled paths follow
+    /// the sampler's weight, which is not Cycles' eval (docs/huang.md §8): what Cycles'
+    /// images converge to, for comparing with them.
+    Cycles = 1,
+};
 
 /// How to render.
 struct RenderSettings {
@@ -91,6 +115,10 @@ struct RenderSettings {
     int max_transmission_bounces = 12;
     /// Same seed, same image.
     std::uint64_t seed = 0;
+    /// Cycles' Max Bounces: Transparent, in [0, 1024] (Blender's default 8): a path crosses at
+    /// most this many + 1 transparent surfaces (Cycles stores the setting + 1); the surface
+    /// after the last one ends it (emission only).
+    int max_transparent_bounces = 8;
     /// Threads to use, in [0, 1024]; 0 = oneTBB's default concurrency (all cores).
     int threads = 0;
     /// Tile edge in pixels, in [1, 4096].
@@ -101,6 +129,8 @@ struct RenderSettings {
     /// Blender's Film > Transparent: camera rays that miss everything add neither the world
     /// nor alpha (suns seen directly still add their disc, as in Cycles). Alpha is otherwise 1.
     bool film_transparent = false;
+    /// A HuangSampling: how Huang hair samples directions.
+    int huang_sampling = int(HuangSampling::Strategy);
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -112,11 +142,13 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("max_diffuse_bounces", s.max_diffuse_bounces, 0, 1024);
     f.field("max_glossy_bounces", s.max_glossy_bounces, 0, 1024);
     f.field("max_transmission_bounces", s.max_transmission_bounces, 0, 1024);
+    f.field("max_transparent_bounces", s.max_transparent_bounces, 0, 1024);
     f.field("seed", s.seed);
     f.field("threads", s.threads, 0, 1024);
     f.field("tile_size", s.tile_size, 1, 4096);
     f.field("rr_start_bounce", s.rr_start_bounce, 1, 1024);
     f.field("film_transparent", s.film_transparent);
+    f.choice("huang_sampling", s.huang_sampling, {"strategy", "cycles"});
 }
 
 /// What a render did.
@@ -141,6 +173,25 @@ struct RenderStats {
 /// written. `stats` may be null.
 Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
               const std::function<bool(float progress)> &progress, RenderStats *stats);
+
+/// Cycles' pixel_coverage for a camera ray (kernel/svm/closure.h, Huang): half the pixel
+/// footprint at the hit in units of the curve radius there; +inf for a radius of 0 (never
+/// near field).
+float cycles_pixel_coverage(float footprint, float curve_radius);
+
+/// The FiberHit the renderer gives a hair material at a curve hit, as Cycles sets up the
+/// Principled Hair closure: ω_o and h in the frame FiberFrame::from_tangent_and_view; the
+/// major axis from the curve normal, or, where the curve has none (or it is parallel to the
+/// tangent), Cycles' fallback frame around the world tangent (HuangFiber::fallback_major_axis);
+/// pixel_coverage from `footprint` for camera rays, 1 for every other ray; `seed` for the
+/// point's random numbers.
+FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
+                          std::uint32_t seed);
+
+/// The first hair hit of the camera ray through raster position (x + u, y + v), past hair it
+/// crosses transparently, as the renderer sets it up (for tests); nullopt when the ray meets
+/// no hair or meets something else first.
+std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v);
 
 /// Cycles' fiber offset for 3D curves (bsdf_principled_hair_setup): with the frame
 /// X = tangent, Y = normalize(cross(X, ω_o)), Z = cross(X, Y) (FiberFrame's), and Ng the

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "fiber/chiang_strands.h"
+#include "core/quadrature.h"
+#include "fiber/huang.h"
 #include "sampling/analytic_sampler.h"
 #include "sampling/near_field_table.h"
 #include "sampling/strategy.h"
@@ -532,7 +534,7 @@ TEST(Render, HairStrategiesAgree) {
         d.curves = {parallel_hairs(3, 0.14f, 0.06f)};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
         SunLight sun;
-        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
         sun.strength = 2.0f;
         sun.angle = 0.2f;
         d.suns = {sun};
@@ -650,7 +652,7 @@ TEST(Render, HairStrategiesAgreeOnDeepPaths) {
         d.curves = {parallel_hairs(9, 0.1f, 0.05f)};
         d.world = {Rgb(0.4f, 0.5f, 0.7f), 1.0f};
         SunLight sun;
-        sun.to_sun = safe_normalize({0.3f, -0.6f, 0.5f});
+        sun.to_sun = safe_normalize(Vec3{0.3f, -0.6f, 0.5f});
         sun.strength = 3.0f;
         sun.angle = 0.05f;
         d.suns = {sun};
@@ -689,6 +691,229 @@ TEST(Render, HairOffsetIsCyclesH) {
             EXPECT_LT(h * cycles_hair_offset(sm.normal, sm.tangent, -dir), 0.0f);
         }
     }
+}
+
+// ---- Huang hair: the fiber hit as Cycles sets it up ---------------------------------------
+
+std::shared_ptr<const HuangFiber> huang_fiber(float aspect_ratio) {
+    HuangParams p;
+    p.aspect_ratio = aspect_ratio;
+    auto f = HuangFiber::create(p);
+    EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
+    return std::make_shared<const HuangFiber>(std::move(f).value());
+}
+
+HairMaterial huang_hair(float aspect_ratio) {
+    return HairMaterial{
+        HairShading::create(huang_fiber(aspect_ratio), std::make_shared<const UniformSampler>()).value()};
+}
+
+void expect_vec(Vec3 got, Vec3 want, float tol, const char *what) {
+    EXPECT_NEAR(got.x, want.x, tol) << what;
+    EXPECT_NEAR(got.y, want.y, tol) << what;
+    EXPECT_NEAR(got.z, want.z, tol) << what;
+}
+
+// A straight curve along x at height z (and y), `points` evenly spaced points.
+HairCurves straight_hair(float y, float z, float radius, float half_length, int points = 4) {
+    HairCurves c;
+    c.first = {0};
+    for (int k = 0; k < points; ++k) {
+        c.points.push_back({-half_length + 2.0f * half_length * float(k) / float(points - 1), y, z});
+        c.radii.push_back(radius);
+    }
+    c.first.push_back(std::uint32_t(c.points.size()));
+    return c;
+}
+
+TEST(Render, HuangMajorAxisFollowsTheCurveNormal) {
+    // Huang's frame (x tangent, y major axis) for a view in the renderer's frame: the major axis
+    // is the normal's part across the tangent (Gram-Schmidt here; Cycles writes a double cross
+    // product), rotated into the frame built from the tangent and the view.
+    const auto fiber = huang_fiber(0.5f);
+    SurfacePoint sp;
+    sp.tangent = safe_normalize(Vec3{1.0f, 0.2f, -0.3f});
+    sp.normal = safe_normalize(cross(sp.tangent, Vec3{0.3f, 1.0f, 0.4f}));
+    const Vec3 n{0.4f, -0.7f, 1.3f};  // not unit, not perpendicular
+    sp.curve_normal = n;
+    sp.curve_radius = 0.01f;
+    const Vec3 wo = safe_normalize(Vec3{-0.2f, 0.5f, 0.9f});
+    const FiberHit hit = cycles_fiber_hit(sp, wo, false, 0.0f, 7);
+    const Vec3 x = sp.tangent;
+    const Vec3 y = safe_normalize(n - x * dot(n, x)), z = cross(x, y);
+    const HuangPoint point = fiber->at(hit);
+    const HuangHit hh = point.huang_hit();
+    expect_vec(hh.wo, {dot(wo, x), dot(wo, y), dot(wo, z)}, 2e-6f, "ω_o in Huang's frame");
+    EXPECT_EQ(hh.h, cycles_hair_offset(sp.normal, sp.tangent, wo));
+    EXPECT_EQ(hit.pixel_coverage, 1.0f);  // not a camera ray
+    EXPECT_EQ(hit.seed, 7u);
+}
+
+TEST(Render, HuangFallbackFrameWithoutCurveNormals) {
+    // Cycles' make_orthonormals(tangent): c = normalize((1, 1, 1) × t) (with (−1, 1, 1) and the
+    // middle component negated when t's components are equal), major axis t × c. Closed forms
+    // for two tangents; a normal along the tangent falls back the same way.
+    const auto fiber = huang_fiber(0.85f);
+    struct Case {
+        Vec3 tangent, axis, normal;
+    };
+    const float r2 = 1.0f / std::sqrt(2.0f), r3 = 1.0f / std::sqrt(3.0f), r6 = 1.0f / std::sqrt(6.0f);
+    const Case cases[] = {{{0, 0, 1}, {r2, r2, 0}, {0, 0, 0}},
+                          {{r3, r3, r3}, {-2 * r6, r6, r6}, {0, 0, 0}},
+                          {{0, 0, 1}, {r2, r2, 0}, {0, 0, 2}}};
+    for (const Case &c : cases) {
+        SurfacePoint sp;
+        sp.tangent = c.tangent;
+        sp.curve_normal = c.normal;
+        sp.normal = safe_normalize(cross(c.tangent, Vec3{1, 0, 0}) + cross(c.tangent, Vec3{0, 1, 0}));
+        const Vec3 wo = safe_normalize(Vec3{0.3f, -0.8f, 0.2f});
+        const FiberHit hit = cycles_fiber_hit(sp, wo, false, 0.0f, 0);
+        const Vec3 x = c.tangent, y = c.axis, z = cross(x, y);
+        expect_vec(fiber->at(hit).huang_hit().wo, {dot(wo, x), dot(wo, y), dot(wo, z)}, 2e-6f,
+                   "fallback frame");
+    }
+}
+
+TEST(Render, PixelCoverageIsHalfTheFootprintInRadii) {
+    SurfacePoint sp;
+    sp.tangent = {1, 0, 0};
+    sp.normal = {0, 0, 1};
+    sp.curve_radius = 0.004f;
+    const FiberHit camera = cycles_fiber_hit(sp, {0, 0, 1}, true, 0.002f, 0);
+    EXPECT_FLOAT_EQ(camera.pixel_coverage, 0.25f);
+    EXPECT_EQ(cycles_fiber_hit(sp, {0, 0, 1}, false, 0.002f, 0).pixel_coverage, 1.0f);
+    sp.curve_radius = 0.0f;  // a closed tip: never near field
+    EXPECT_TRUE(std::isinf(cycles_fiber_hit(sp, {0, 0, 1}, true, 0.002f, 0).pixel_coverage));
+
+    // In a scene: a fiber of radius r under a perspective camera at height 5, hit on its top by
+    // the ray through the image centre at t = 5 − r, whose footprint is the chord of one
+    // pixel's angle times t (camera_test's closed form).
+    const float r = 0.05f;
+    SceneDesc d;
+    d.materials = {huang_hair(1.0f)};
+    d.curves = {straight_hair(0.0f, 0.0f, r, 2.0f)};
+    d.camera = perspective({0, 0, 5}, 0.25f, 40, 40);
+    const Scene scene = build(std::move(d));
+    const std::optional<FiberHit> hit = camera_hair_hit(scene, 20, 20, 0.0f, 0.0f);
+    ASSERT_TRUE(hit.has_value());
+    const double step = 0.5 / 40.0;
+    const double spread = std::sqrt(2.0 - 2.0 / std::sqrt(step * step + 1.0));
+    EXPECT_NEAR(hit->pixel_coverage, 0.5 * spread * (5.0 - r) / r, 1e-4 * hit->pixel_coverage);
+    EXPECT_NEAR(hit->h, 0.0f, 1e-3f);
+}
+
+// The hair's share of an orthographic image with a transparent film: the mean alpha.
+double hair_coverage(const std::vector<HairCurves> &curves, float aspect_ratio, int max_transparent) {
+    SceneDesc d;
+    d.materials = {huang_hair(aspect_ratio)};
+    d.curves = curves;
+    d.camera = ortho_down(1.0f, 1.0f, 32, 32, {0, 0, 5});
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 32;
+    s.max_bounces = 0;
+    s.film_transparent = true;
+    s.max_transparent_bounces = max_transparent;
+    const auto img = render_ok(scene, s);
+    double alpha = 0;
+    for (std::size_t i = 3; i < img.size(); i += 4) alpha += img[i];
+    return alpha / (32.0 * 32.0);
+}
+
+TEST(Render, HuangIsTransparentOutsideItsEllipse) {
+    // Seen along its major axis (the curve normal on the view), an elliptical fiber of aspect b
+    // covers b of its round tube's width 2r (Cycles' transparent closure beyond the projected
+    // radius R = b); seen across it, all of it. Orthographic, across a frame of 2 x 2: the mean
+    // alpha is the covered width over 2.
+    const float r = 0.2f, b = 0.5f;
+    HairCurves along = straight_hair(0.0f, 0.0f, r, 3.0f);
+    along.normals.assign(along.points.size(), Vec3{0, 0, 1});
+    HairCurves across = along;
+    across.normals.assign(across.points.size(), Vec3{0, 1, 0});
+    const double tolerance = 0.01;  // stratified pixel jitter: the edges' error is far smaller
+    EXPECT_NEAR(hair_coverage({along}, b, 8), r * b, tolerance * r);
+    EXPECT_NEAR(hair_coverage({across}, b, 8), r, tolerance * r);
+    EXPECT_NEAR(hair_coverage({along}, 1.0f, 8), r, tolerance * r);
+}
+
+TEST(Render, TransparentCrossingsStopAfterTheLimit) {
+    // Three such fibers stacked under the camera: a ray outside the ellipses crosses all three
+    // (and escapes: alpha 0) when max_transparent_bounces allows 3 crossings (limit 2, Cycles'
+    // setting + 1), but ends on the third fiber (alpha 1) when it allows 2.
+    const float r = 0.2f, b = 0.5f;
+    std::vector<HairCurves> stack;
+    for (int k = 0; k < 3; ++k) {
+        HairCurves c = straight_hair(0.0f, -float(k), r, 3.0f);
+        c.normals.assign(c.points.size(), Vec3{0, 0, 1});
+        stack.push_back(c);
+    }
+    EXPECT_NEAR(hair_coverage(stack, b, 2), r * b, 0.01 * r);
+    EXPECT_NEAR(hair_coverage(stack, b, 1), r, 0.01 * r);
+}
+
+// A thin clear Huang fiber (σ = 0, α = 0.3, aspect 1, offset 2°) across the view, narrower than
+// the pixel footprint (far field), in a white world, direct light only: the radiance over the
+// alpha of the hair pixels is the far field's albedo from this view. Returns its mean over
+// `seeds` renders and the standard error of that mean.
+struct FurnaceEstimate {
+    double mean = 0, standard_error = 0;
+};
+FurnaceEstimate huang_furnace(const std::shared_ptr<const HuangFiber> &fiber, int huang_sampling, int seeds) {
+    SceneDesc d;
+    d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
+    d.curves = {straight_hair(0.0f, 0.0f, 0.01f, 3.0f)};  // pixels 0.025 wide: pixel_coverage 1.25
+    d.world = {Rgb(1.0f), 1.0f};
+    d.camera = ortho_down(0.05f, 0.05f, 4, 4, {0, 0, 5});
+    const Scene scene = build(std::move(d));
+    std::vector<double> ratios;
+    for (int seed = 0; seed < seeds; ++seed) {
+        RenderSettings s;
+        s.samples = 4096;
+        s.max_bounces = 0;
+        s.film_transparent = true;
+        s.huang_sampling = huang_sampling;
+        s.seed = std::uint64_t(seed);
+        const auto img = render_ok(scene, s);
+        double radiance = 0, alpha = 0;
+        for (std::size_t i = 0; i < img.size(); i += 4) {
+            radiance += img[i + 1];
+            alpha += img[i + 3];
+        }
+        ratios.push_back(radiance / alpha);
+    }
+    double mean = 0, var = 0;
+    for (double r : ratios) mean += r / double(seeds);
+    for (double r : ratios) var += sqr(r - mean) / double(seeds - 1);
+    return {mean, std::sqrt(var / double(seeds))};
+}
+
+TEST(Render, HuangFurnaceFollowsEvalOrCyclesSampler) {
+    // The strategy's sampling (uniform) converges to Cycles' eval: the far field's albedo by
+    // quadrature. Cycles' own sampling converges to what Cycles renders for this furnace:
+    // 1.007 (docs/huang.md §14, bpy 4.5: Cycles' sampler, whose albedo is not its eval's).
+    HuangParams p;
+    p.sigma_a = Rgb(0.0f);
+    p.aspect_ratio = 1.0f;
+    auto fiber = std::make_shared<const HuangFiber>(HuangFiber::create(p).value());
+    // ∫ f dω_i of the far field seen along −z across a fiber along x, in Huang's frame
+    // (circular: y = normalize(tangent × ω_o)), by a product Gauss rule in (sin θ_i, φ_i).
+    const HuangExpectation far = fiber->expectation({{0.0f, 0.0f, -1.0f}, 0.0f, 1.0f});
+    const QuadratureRule sin_theta = QuadratureRule::composite(-1.0, 1.0, 6, 6);
+    const QuadratureRule phi = QuadratureRule::composite(-kPi, kPi, 8, 6);
+    double albedo = 0;
+    for (std::size_t i = 0; i < sin_theta.x.size(); ++i)
+        for (std::size_t j = 0; j < phi.x.size(); ++j) {
+            const double c = std::sqrt(1.0 - sin_theta.x[i] * sin_theta.x[i]);
+            const Vec3 wi{float(sin_theta.x[i]), float(c * std::cos(phi.x[j])), float(c * std::sin(phi.x[j]))};
+            albedo += sin_theta.w[i] * phi.w[j] * double(far.f(wi).g);
+        }
+    EXPECT_GT(albedo, 1.3);  // the edges' overweight (docs/huang.md §6)
+    const FurnaceEstimate eval_mode = huang_furnace(fiber, int(HuangSampling::Strategy), 6);
+    EXPECT_NEAR(eval_mode.mean, albedo, 4.0 * eval_mode.standard_error + 0.005 * albedo)
+        << "standard error " << eval_mode.standard_error;
+    const FurnaceEstimate cycles_mode = huang_furnace(fiber, int(HuangSampling::Cycles), 6);
+    EXPECT_NEAR(cycles_mode.mean, 1.007, 4.0 * cycles_mode.standard_error + 0.01)
+        << "standard error " << cycles_mode.standard_error;
 }
 
 TEST(Render, MaxBouncesCountLikeCycles) {
@@ -758,7 +983,7 @@ Scene hair_tuft_scene(int width, int height, int curves = 64) {
     d.meshes = {quad(3.0f, 0.0f, 1)};
     d.world = {Rgb(0.2f, 0.25f, 0.3f), 1.0f};
     SunLight sun;
-    sun.to_sun = safe_normalize({0.4f, -0.3f, 1.0f});
+    sun.to_sun = safe_normalize(Vec3{0.4f, -0.3f, 1.0f});
     sun.strength = 3.0f;
     sun.angle = float(radians(2.0));
     d.suns = {sun};

@@ -32,6 +32,7 @@ struct alignas(16) Float4 {
 
 struct CurveGeometry {
     std::vector<Float4> cvs;              // n + 2 control points per curve (ends duplicated)
+    std::vector<Vec3> normals;            // empty, or the normal of each control point
     std::vector<std::uint32_t> segments;  // first control point of each segment
     std::vector<std::uint32_t> curve_of;  // the curve of each segment
     std::uint32_t material = 0;
@@ -309,6 +310,14 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         if (hc.points.size() > (std::size_t(1) << 31))
             return Error{set + ": too many points (at most 2^31)"};
         if (auto e = check_curve_inputs(hc, set, desc.materials[hc.material])) return *e;
+        if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
+            return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
+                         " entries but points has " + std::to_string(hc.points.size()) +
+                         " (one normal per point, or none)"};
+        for (std::size_t k = 0; k < hc.normals.size(); ++k)
+            if (!finite3(hc.normals[k]))
+                return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
+                             describe(hc.normals[k]) + ")"};
         CurveGeometry geo;
         geo.material = hc.material;
         for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}});
@@ -351,6 +360,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             geo.cvs.push_back(cv(b));
             for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
             geo.cvs.push_back(cv(e - 1));
+            if (!hc.normals.empty()) {
+                geo.normals.push_back(hc.normals[b]);
+                geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
+                geo.normals.push_back(hc.normals[e - 1]);
+            }
             const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
             for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
                 const std::size_t k = std::size_t(hair_input_info(hc.inputs[i].input).components);
@@ -380,6 +394,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         hc.radii = {};
         hc.first = {};
         hc.inputs = {};
+        hc.normals = {};
         if (!geo.segments.empty()) impl->curves.push_back(std::move(geo));
     }
 
@@ -547,7 +562,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                         impl->geometries.capacity() * sizeof(GeometryInfo);
     for (const auto &c : impl->curves) {
         bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
-                 c.curve_of.capacity() * 4;
+                 c.curve_of.capacity() * 4 + c.normals.capacity() * sizeof(Vec3);
         for (const CurveInput &in : c.inputs) bytes += in.values.capacity() * sizeof(float);
     }
     for (const auto &m : impl->meshes)
@@ -736,6 +751,11 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         const Vec3 n = safe_normalize(sp.position - centre);
         sp.normal = dot(n, n) > 0.0f ? n : -dir;
         sp.shading_normal = sp.normal;
+        // Per-point attributes between the segment's two points (Cycles' curve_attribute).
+        const std::uint32_t key = geo.segments[hit.prim.primitive] + 1;
+        const float u = hit.u;
+        sp.curve_radius = (1.0f - u) * geo.cvs[key].w + u * geo.cvs[key + 1].w;
+        if (!geo.normals.empty()) sp.curve_normal = geo.normals[key] * (1.0f - u) + geo.normals[key + 1] * u;
         sp.tangent = safe_normalize(dpdu);
         if (dot(sp.tangent, sp.tangent) == 0.0f) {
             // dP/du vanishes (repeated points): the chord, or any direction across the normal.

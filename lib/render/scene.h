@@ -17,7 +17,10 @@
 // Curve shading data, as Cycles' curve_shader_setup for thick curves (kernel/geom/curve.h):
 // the hit P, P_curve = the Catmull-Rom centre line at the hit's u, Ng = normalize(P − P_curve),
 // tangent = normalize(dP/du). The renderer then builds the fiber frame from the tangent and
-// ω_o and h = dot(cross(Ng, X), Z) (bsdf_principled_hair_setup).
+// ω_o and h = dot(cross(Ng, X), Z) (bsdf_principled_hair_setup). Per-point attributes are
+// interpolated linearly between the segment's two points at the hit's u, as Cycles'
+// curve_attribute does: the curve normal (Huang's major axis, kernel/svm/closure.h) and the
+// radius Cycles divides the pixel footprint by (pixel_coverage).
 //
 // Validation (errors name the object and what is allowed):
 //  - refused: NaN/inf positions or radii, negative radii, a curve with fewer than 2 points,
@@ -104,6 +107,10 @@ struct HairCurves {
     std::vector<std::uint32_t> first;
     std::uint32_t material = 0;
     std::vector<CurveInput> inputs;
+    /// The curve normal attribute, one per point, finite; or empty (particle hair: Cycles
+    /// then has zero normals). Used as given: Cycles does not transform curve normals by the
+    /// object's matrix.
+    std::vector<Vec3> normals;
 };
 
 /// A triangle mesh in world space. indices holds 3 vertex indices per triangle; materials
@@ -200,6 +207,13 @@ struct SurfacePoint {
     Vec3 shading_normal;
     /// Triangles: the UV map at the hit ((0, 0) without one).
     float u = 0.0f, v = 0.0f;
+    /// Curves: the normal attribute interpolated at the hit (not normalized; zero when the
+    /// curves have none); zero for triangles.
+    Vec3 curve_normal;
+    /// Curves: the radius interpolated linearly between the segment's points at u (Cycles'
+    /// radius for pixel_coverage; the surface itself follows the Catmull-Rom radius); 0 for
+    /// triangles.
+    float curve_radius = 0;
     std::uint32_t material = 0;
     bool is_curve = false;
     /// True for a mesh triangle whose emission is in the light set (MIS applies to it).

@@ -211,6 +211,47 @@ TEST(Scene, CurveBackfacesAreCulledOrHitAsCyclesWithEmbree3Or4) {
     EXPECT_NE(build_error(std::move(bad)).find("curve_backfaces"), std::string::npos);
 }
 
+TEST(Scene, CurveAttributesAreLinearAlongEachSegment) {
+    // Radii that bend the Catmull-Rom radius away from the straight line between two points,
+    // and a normal per point: at a hit of parameter u on segment k (from point k to k + 1)
+    // both are (1 − u)·a_k + u·a_{k+1}, as Cycles' curve_attribute reads per-point values.
+    SceneDesc d;
+    d.materials = {hair_material()};
+    HairCurves c = straight_hair();
+    c.radii = {0.05f, 0.1f, 0.2f, 0.05f};
+    c.normals = {{0, 0, 1}, {0, 1, 1}, {0, 2, -1}, {1, 0, 0}};
+    d.curves = {c};
+    d.camera = small_camera();
+    const Scene scene = build_ok(std::move(d));
+    for (const float x : {-1.2f, -0.3f, 0.1f, 0.45f, 1.1f}) {
+        const Vec3 origin{x, 0, 5};
+        const auto hit = scene.intersect(origin, {0, 0, -1}, 0.0f, INFINITY);
+        ASSERT_TRUE(hit.has_value()) << x;
+        const SurfacePoint sp = scene.surface_point(origin, {0, 0, -1}, *hit);
+        const std::uint32_t k = hit->prim.primitive;
+        const float u = hit->u;
+        EXPECT_NEAR(sp.curve_radius, (1 - u) * c.radii[k] + u * c.radii[k + 1], 1e-6f) << x;
+        const Vec3 n = c.normals[k] * (1 - u) + c.normals[k + 1] * u;
+        EXPECT_NEAR(length(sp.curve_normal - n), 0.0f, 1e-6f) << x;
+        float catmull_rom = 0;
+        scene.curve_point(hit->prim, u, nullptr, &catmull_rom);
+        if (k == 1 && u > 0.2f && u < 0.8f) {
+            EXPECT_GT(std::fabs(catmull_rom - sp.curve_radius), 1e-3f) << "the radius is not Catmull-Rom's";
+        }
+    }
+    // Without normals the attribute reads zero.
+    SceneDesc plain;
+    plain.materials = {hair_material()};
+    plain.curves = {straight_hair()};
+    plain.camera = small_camera();
+    const Scene bare = build_ok(std::move(plain));
+    const auto hit = bare.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    const SurfacePoint sp = bare.surface_point({0.3f, 0, 5}, {0, 0, -1}, *hit);
+    EXPECT_EQ(length(sp.curve_normal), 0.0f);
+    EXPECT_NEAR(sp.curve_radius, 0.1f, 1e-7f);
+}
+
 TEST(Scene, TrianglesAndSkips) {
     SceneDesc d;
     d.materials = {DiffuseMaterial{Rgb(0.5f), Rgb(0.0f)}, DiffuseMaterial{Rgb(0.0f), Rgb(2.0f)}};
@@ -389,6 +430,17 @@ TEST(Scene, InvalidScenesGiveClearErrors) {
     d.curves[0].radii.pop_back();
     e = build_error(std::move(d));
     EXPECT_NE(e.find("one radius per point"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].normals = {{0, 0, 1}, {0, 0, 1}};
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("one normal per point"), std::string::npos) << e;
+
+    d = base();
+    d.curves[0].normals.assign(4, Vec3{0, 0, 1});
+    d.curves[0].normals[3].z = INFINITY;
+    e = build_error(std::move(d));
+    EXPECT_NE(e.find("curve set 0, point 3: normal must be finite"), std::string::npos) << e;
 
     d = base();
     d.curves[0].material = 7;

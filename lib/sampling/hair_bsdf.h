@@ -26,6 +26,8 @@ class HairBsdf {
     HairBsdf(const FiberPoint *fiber, const SamplerPoint &sampler) : fiber_(fiber), sampler_(&sampler) {}
     /// f·|cos θ_i|; zero without a fiber model (a bare sampler).
     Rgb f(Vec3 wi) const { return fiber_ ? fiber_->f(wi) : Rgb{}; }
+    /// The ray passes the fiber without scattering (FiberPoint::transparent).
+    bool transparent() const { return fiber_ && fiber_->transparent(); }
     /// The density sample() draws from.
     float pdf(Vec3 wi) const { return sampler_->pdf(wi); }
     /// f(wi) and pdf(wi) together (what a light sample needs), computed in one pass where the

@@ -65,6 +65,12 @@ static const char *const kinds[][2] = {
                "absorption=0.245530993,0.519999981,1.36500001;melanin=0.800000012;"
                "melanin_redness=1;roughness=0.300000012;radial_roughness=0.300000012;coat=0;"
                "ior=1.54999995;offset=0.0349065848;random_color=0;random_roughness=0;random=0"},
+    {"huang", "model=huang;parametrization=color;"
+              "color=0.0175129995,0.00576299988,0.00205900008;tint=1,1,1;"
+              "absorption=0.245530993,0.519999981,1.36500001;melanin=0.800000012;"
+              "melanin_redness=1;roughness=0.300000012;ior=1.54999995;offset=0.0349065848;"
+              "random_color=0;random_roughness=0;random=0;aspect_ratio=0.850000024;reflection=1;"
+              "transmission=1;secondary_reflection=1"},
     {"marschner", "model=marschner;sigma_a=0.150000006,0.200000003,0.300000012;eta=1.55;"
                   "alpha_r_deg=-7.5;alpha_tt_deg=3.75;alpha_trt_deg=11.25;beta_r_deg=7.5;"
                   "beta_tt_deg=3.725;beta_trt_deg=15;eccentricity=0.9;glint_scale=0.4;"
@@ -101,13 +107,14 @@ static const char *const kinds[][2] = {
                "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
                "clip_start=0;clip_end=3.40282347e+38"},
     {"render", "integrator=path;samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
-               "max_transmission_bounces=12;"
+               "max_transmission_bounces=12;max_transparent_bounces=8;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
-               "strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
+               "huang_sampling=strategy;strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
                      "absorption=material;roughness=material;radial_roughness=material;"
                      "coat=material;ior=material;offset=material;random_color=material;"
                      "random_roughness=material;random=material"},
+    {"curves", ""},
 };
 enum { KIND_COUNT = sizeof kinds / sizeof kinds[0] };
 
@@ -345,9 +352,9 @@ const char *hairis_defaults(const char *kind)
     const char *d = defaults_of(kind);
     if (!d) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-             "kind must be one of chiang, marschner, bake, sampler, render, diffuse, principled, "
-             "glossy, emission, mix, add, texture, sun, point, spot, area, world, camera, curve_inputs "
-             "(got \"%s\")",
+             "kind must be one of chiang, huang, marschner, bake, sampler, render, diffuse, principled, "
+             "glossy, emission, mix, add, texture, sun, point, spot, area, world, camera, curve_inputs, "
+             "curves (got \"%s\")",
              kind);
         return NULL;
     }
@@ -361,7 +368,7 @@ const char *hairis_defaults(const char *kind)
 struct hairis_fiber {
     char model[32];
     char parameters[1024];
-    int chiang;
+    int chiang, huang;
 };
 
 /* Every number of a value printed as a float ("%.9g"), words as they are: equal inputs give
@@ -390,14 +397,33 @@ hairis_fiber *hairis_fiber_create(const char *text)
     char model_name[64];
     find_value(text, "model", model_name, sizeof model_name);
     const int marschner = strcmp(model_name, "marschner") == 0;
+    const int huang = strcmp(model_name, "huang") == 0;
     options o;
-    if (read_options(text, marschner ? "marschner" : "chiang", "fiber options",
+    if (read_options(text, marschner ? "marschner" : huang ? "huang" : "chiang", "fiber options",
                      marschner ? NULL : "offset_deg=2", &o) != HAIRIS_OK)
         return NULL;
-    const char *models[2] = {"chiang", "marschner"};
+    const char *models[3] = {"chiang", "marschner", "huang"};
     int model = 0;
-    if (word(&o, "model", models, 2, &model) != HAIRIS_OK) return NULL;
+    if (word(&o, "model", models, 3, &model) != HAIRIS_OK) return NULL;
     double v[3];
+    if (huang) {
+        const char *scalars[] = {"aspect_ratio", "reflection", "transmission", "secondary_reflection"};
+        double lobes = 0.0;
+        for (size_t k = 0; k < sizeof scalars / sizeof scalars[0]; ++k) {
+            if (numbers(&o, scalars[k], v, 1) != HAIRIS_OK) return NULL;
+            if (k > 0 && v[0] > 0.0) lobes += v[0];
+            if (k == 0 && !(v[0] > 0.0)) {
+                fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: aspect_ratio must be in (0, 1000] (got %g)", v[0]);
+                return NULL;
+            }
+        }
+        if (!(lobes > 0.0)) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                 "fiber options: reflection, transmission and secondary_reflection are all <= 0: Cycles "
+                 "allocates no closure then");
+            return NULL;
+        }
+    }
     if (!marschner) {
         const char *parametrizations[3] = {"absorption", "melanin", "color"};
         int p = 0;
@@ -408,8 +434,10 @@ hairis_fiber *hairis_fiber_create(const char *text)
         const char *scalars[] = {"cycles", "melanin", "melanin_redness", "roughness",
                                  "radial_roughness", "coat", "ior", "offset", "offset_deg",
                                  "random_color", "random_roughness", "random"};
-        for (size_t k = 0; k < sizeof scalars / sizeof scalars[0]; ++k)
-            if (numbers(&o, scalars[k], v, 1) != HAIRIS_OK) return NULL;
+        for (size_t k = 0; k < sizeof scalars / sizeof scalars[0]; ++k) {
+            const int chiang_only = k == 0 || k == 4 || k == 5;
+            if ((!huang || !chiang_only) && numbers(&o, scalars[k], v, 1) != HAIRIS_OK) return NULL;
+        }
         numbers(&o, "ior", v, 1);
         if (!(v[0] > 1.0)) {
             fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber options: ior: IOR must be > 1, got %g", v[0]);
@@ -441,8 +469,10 @@ hairis_fiber *hairis_fiber_create(const char *text)
         fail(HAIRIS_ERROR_INTERNAL, "hairis_fiber_create: out of memory");
         return NULL;
     }
-    snprintf(f->model, sizeof f->model, "%s", marschner ? "marschner2003" : "chiang2016");
-    f->chiang = !marschner;
+    snprintf(f->model, sizeof f->model, "%s",
+             marschner ? "marschner2003" : huang ? "huang2022" : "chiang2016");
+    f->chiang = !marschner && !huang;
+    f->huang = huang;
     /* The parameters: every name but model (offset_deg as offset), canonical numbers. */
     for (int i = 0; i < o.known_count; ++i) {
         const char *name = o.known[i].name;
@@ -495,6 +525,7 @@ int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, cons
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber, wi, wo and rgb_out must not be NULL");
     if (h && !fiber->chiang)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "h must be NULL for a %s fiber", fiber->model);
+    /* (Huang's frame has the ellipse's major axis as y: the fake ignores it.) */
     for (size_t i = 0; i < n; ++i) {
         float cos_theta = sqrtf(fmaxf(0.0f, 1.0f - wi[3 * i] * wi[3 * i]));
         float value = 0.1f * cos_theta * (h ? 1.0f - fabsf(h[i]) : 1.0f);
@@ -519,6 +550,12 @@ hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *text,
 {
     if (!fiber) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
+        return NULL;
+    }
+    if (fiber->huang) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+             "fiber: tables for huang2022 fibers cannot be baked by this version (render Huang "
+             "materials with strategy=uniform)");
         return NULL;
     }
     options o;
@@ -772,10 +809,11 @@ int hairis_pdf(const hairis_sampler *s, size_t n, const float *wi, const float *
 struct hairis_scene {
     int material_count;
     int material_is_hair[MAX_MATERIALS];
+    int material_is_huang[MAX_MATERIALS];
     int material_has_tables[MAX_MATERIALS];
     int material_tables_match[MAX_MATERIALS];
     char material_parameters[MAX_MATERIALS][1024];
-    size_t curve_sets, curve_count, curve_points;
+    size_t curve_sets, curve_count, curve_points, curve_sets_with_normals;
     size_t input_sets, input_values;  /* hairis_scene_add_curves_with_inputs */
     char inputs[512];                 /* the last call's inputs given per curve or point */
     double radius_sum, position_sum[3];
@@ -810,8 +848,9 @@ int hairis_scene_add_hair_material(hairis_scene *s, const hairis_fiber *fiber,
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and fiber must not be NULL");
         return -1;
     }
-    if (!fiber->chiang) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must be a chiang2016 fiber, got %s", fiber->model);
+    if (!fiber->chiang && !fiber->huang) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must be a chiang2016 or huang2022 fiber, got %s",
+             fiber->model);
         return -1;
     }
     if (s->material_count >= MAX_MATERIALS) {
@@ -821,6 +860,7 @@ int hairis_scene_add_hair_material(hairis_scene *s, const hairis_fiber *fiber,
     /* Whether the tables fit is hairis_render's question (TABLE only), as in the library. */
     int index = s->material_count++;
     s->material_is_hair[index] = 1;
+    s->material_is_huang[index] = fiber->huang;
     s->material_has_tables[index] = tables != NULL;
     s->material_tables_match[index] = tables && hairis_tables_match_fiber(tables, fiber);
     memcpy(s->material_parameters[index], fiber->parameters, sizeof fiber->parameters);
@@ -1108,6 +1148,25 @@ int hairis_scene_add_curves_with_inputs(hairis_scene *s, int material, size_t cu
     return HAIRIS_OK;
 }
 
+int hairis_scene_add_curves_with_normals(hairis_scene *s, int material, size_t curve_count,
+                                         const uint32_t *first, size_t point_count,
+                                         const float *positions, const float *radii,
+                                         const float *normals, const char *text)
+{
+    options o;
+    if (!s || (point_count && !normals))
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and normals must not be NULL");
+    if (read_options(text, "curves", "curve options", NULL, &o) != HAIRIS_OK)
+        return HAIRIS_ERROR_INVALID_ARGUMENT;
+    for (size_t i = 0; i < 3 * point_count; ++i)
+        if (!isfinite(normals[i]))
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "normals[%zu] must be finite", i);
+    const int status =
+        hairis_scene_add_curves(s, material, curve_count, first, point_count, positions, radii);
+    if (status == HAIRIS_OK) s->curve_sets_with_normals++;
+    return status;
+}
+
 int hairis_scene_add_mesh(hairis_scene *s, size_t vertex_count, const float *positions,
                           size_t triangle_count, const uint32_t *indices,
                           const int32_t *materials)
@@ -1257,14 +1316,15 @@ int hairis_scene_set_camera(hairis_scene *s, const char *text)
 
 typedef struct render_settings {
     long long samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
-        max_transmission_bounces, threads, tile_size, rr_start_bounce, n_h;
+        max_transmission_bounces, max_transparent_bounces, threads, tile_size, rr_start_bounce, n_h;
     unsigned long long seed;
-    int integrator, strategy, film_transparent, curve_backfaces;
+    int integrator, strategy, film_transparent, curve_backfaces, huang_sampling;
     double multiple_weight;
 } render_settings;
 
 static int read_render_settings(const char *text, render_settings *r)
 {
+    static const char *const huang_samplings[2] = {"strategy", "cycles"};
     options o;
     const char *flags[4] = {"0", "1", "false", "true"};
     const char *backfaces[2] = {"ignore", "hit"};
@@ -1276,11 +1336,13 @@ static int read_render_settings(const char *text, render_settings *r)
         integer_in(&o, "max_diffuse_bounces", 0, 1024, &r->max_diffuse_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_glossy_bounces", 0, 1024, &r->max_glossy_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_transmission_bounces", 0, 1024, &r->max_transmission_bounces) != HAIRIS_OK ||
+        integer_in(&o, "max_transparent_bounces", 0, 1024, &r->max_transparent_bounces) != HAIRIS_OK ||
         integer_in(&o, "threads", 0, 1024, &r->threads) != HAIRIS_OK ||
         integer_in(&o, "tile_size", 1, 4096, &r->tile_size) != HAIRIS_OK ||
         integer_in(&o, "rr_start_bounce", 1, 1024, &r->rr_start_bounce) != HAIRIS_OK ||
         word(&o, "film_transparent", flags, 4, &r->film_transparent) != HAIRIS_OK ||
         word(&o, "curve_backfaces", backfaces, 2, &r->curve_backfaces) != HAIRIS_OK ||
+        word(&o, "huang_sampling", huang_samplings, 2, &r->huang_sampling) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
     r->film_transparent %= 2;
@@ -1306,14 +1368,16 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     if (!f) return;
     fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
                "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
-               "tile_size=%lld film_transparent=%d curve_backfaces=%s integrator=%d\n",
+               "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
+               "integrator=%d huang_sampling=%d\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
-            r->threads, r->max_diffuse_bounces, r->max_transmission_bounces, r->tile_size,
-            r->film_transparent, r->curve_backfaces ? "hit" : "ignore", r->integrator);
+            r->threads, r->max_diffuse_bounces, r->max_transmission_bounces,
+            r->max_transparent_bounces, r->tile_size, r->film_transparent,
+            r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
-               "position_sum=%.9g,%.9g,%.9g\n",
+               "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,
-            s->position_sum[0], s->position_sum[1], s->position_sum[2]);
+            s->position_sum[0], s->position_sum[1], s->position_sum[2], s->curve_sets_with_normals);
     fprintf(f, "meshes=%zu vertices=%zu triangles=%zu suns=%d points=%d areas=%d "
                "world=%.6g,%.6g,%.6g\n",
             s->mesh_count, s->vertex_count, s->triangle_count, s->suns, s->points, s->areas,
@@ -1325,8 +1389,8 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
             s->normal_meshes);
     for (int i = 0; i < s->material_count; ++i)
         if (s->material_is_hair[i])
-            fprintf(f, "hair %d tables=%d %s\n", i, s->material_has_tables[i],
-                    s->material_parameters[i]);
+            fprintf(f, "hair %d tables=%d huang=%d %s\n", i, s->material_has_tables[i],
+                    s->material_is_huang[i], s->material_parameters[i]);
     fclose(f);
 }
 
@@ -1349,6 +1413,12 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
     if (!s->has_camera)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                     "scene has no camera: call hairis_scene_set_camera before hairis_render");
+    for (int i = 0; i < s->material_count; ++i)
+        if (s->material_is_huang[i] && !r.huang_sampling && (r.strategy == 1 || r.strategy == 3))
+            return fail(r.strategy == 3 ? HAIRIS_ERROR_INVALID_TABLE : HAIRIS_ERROR_INVALID_ARGUMENT,
+                        "material %d (hair): strategy=%s has no sampler for a huang2022 fiber in "
+                        "this version; render with strategy=uniform",
+                        i, strategies[r.strategy]);
     /* integrator=dual_scattering samples multiple scattering from every hair material's tables. */
     if (r.integrator == 1)
         for (int i = 0; i < s->material_count; ++i) {
@@ -1364,6 +1434,7 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
         }
     if (r.strategy == 3)
         for (int i = 0; i < s->material_count; ++i) {
+            if (s->material_is_huang[i]) continue; /* Cycles' own Huang sampler: no tables */
             if (s->material_is_hair[i] && !s->material_has_tables[i])
                 return fail(HAIRIS_ERROR_INVALID_TABLE,
                             "material %d (hair): strategy=table needs sampling tables, but the "

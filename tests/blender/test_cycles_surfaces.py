@@ -92,7 +92,7 @@ def make_scene():
     sphere("Head", 0.8, (0.0, 0.0, 1.0), skin, scale=(0.85, 0.95, 1.15))
 
     metal, _ = principled_material("Metal", **{"Base Color": (0.9, 0.7, 0.35, 1.0),
-                                                "Metallic": 1.0, "Roughness": 0.3})
+                                               "Metallic": 1.0, "Roughness": 0.3})
     sphere("Metal", 0.4, (1.25, -0.3, 0.4), metal)
 
     mixed = bpy.data.materials.new("Mixed")

@@ -28,6 +28,16 @@ HAIR_FIELDS = {
     "IOR": "ior", "Offset": "offset", "Random Color": "random_color",
     "Random Roughness": "random_roughness", "Random": "random",
 }
+# The Huang model's inputs (Blender 4.0+), by socket identifier: Chiang's without Radial
+# Roughness and Coat, plus Aspect Ratio and the lobe multipliers (shown as Reflection,
+# Transmission, Secondary Reflection).
+HUANG_FIELDS = {
+    "Color": "color", "Melanin": "melanin", "Melanin Redness": "melanin_redness",
+    "Tint": "tint", "Absorption Coefficient": "absorption_coefficient",
+    "Aspect Ratio": "aspect_ratio", "Roughness": "roughness", "IOR": "ior", "Offset": "offset",
+    "Random Color": "random_color", "Random Roughness": "random_roughness", "Random": "random",
+    "R lobe": "reflection", "TT lobe": "transmission", "TRT lobe": "secondary_reflection",
+}
 PARAMETRIZATION = {"ABSORPTION": 0, "MELANIN": 1, "COLOR": 2}
 
 
@@ -38,14 +48,14 @@ def particle_curves(data):
     return found[0]
 
 
-def check_hair_material(material_data, material, overrides=None):
+def check_hair_material(material_data, material, overrides=None, fields=HAIR_FIELDS):
     """The exported parameters equal the node's inputs, field for field (``overrides``: the
     fields whose value is not the socket's, e.g. Random when it varies per strand)."""
     node = material.node_tree.nodes["Principled Hair BSDF"]
     assert material_data.kind == "HAIR", material_data.kind
     params = material_data.hair
     assert params.parametrization == PARAMETRIZATION[node.parametrization]
-    for name, field in HAIR_FIELDS.items():
+    for name, field in fields.items():
         expected = helpers.socket(node, name).default_value
         if overrides and field in overrides:
             expected = overrides[field]
@@ -523,21 +533,23 @@ class StubSocket:
         self.enabled = True
 
 
-def stub_hair_node(model="CHIANG", leave_out=(), rename=None):
-    """A stand-in Principled Hair BSDF with the node's inputs, some left out or renamed."""
+def stub_hair_node(model="CHIANG", leave_out=(), rename=None, values=None):
+    """A stand-in Principled Hair BSDF with the model's inputs, some left out or renamed."""
     rename = rename or {}
-    values = {"Color": (0.2, 0.3, 0.4, 1.0), "Tint": (1.0, 1.0, 1.0, 1.0),
-              "Absorption Coefficient": (0.2, 0.5, 1.3)}
-    inputs = [StubSocket(rename.get(name, name), values.get(name, 0.5), rename.get(name))
-              for name in HAIR_FIELDS if name not in leave_out]
+    given = {"Color": (0.2, 0.3, 0.4, 1.0), "Tint": (1.0, 1.0, 1.0, 1.0),
+             "Absorption Coefficient": (0.2, 0.5, 1.3)}
+    given.update(values or {})
+    fields = HUANG_FIELDS if model == "HUANG" else HAIR_FIELDS
+    inputs = [StubSocket(rename.get(name, name), given.get(name, 0.5), rename.get(name))
+              for name in fields if name not in leave_out]
     return types.SimpleNamespace(model=model, parametrization="COLOR", inputs=inputs)
 
 
 def test_hair_node_models_and_missing_sockets():
-    """Huang is refused naming the material; a missing socket is named with the version; a
-    socket found by its identifier alone is read."""
-    params, _warnings, error = export.read_hair_node(stub_hair_node("HUANG"), "Future")
-    assert params is None and "'Future'" in error and "Huang support is coming" in error, error
+    """An unknown model is refused naming the material; a missing socket is named with the
+    version; a socket found by its identifier alone is read."""
+    params, _warnings, error = export.read_hair_node(stub_hair_node("FUTURE"), "Future")
+    assert params is None and "'Future'" in error and "'FUTURE' is not supported" in error, error
     params, _warnings, error = export.read_hair_node(stub_hair_node(leave_out=("Coat",)), "Old")
     assert params is None, params
     assert "'Old'" in error and "'Coat'" in error and bpy.app.version_string.split()[0] in error \
@@ -552,32 +564,122 @@ def test_hair_node_models_and_missing_sockets():
     node.inputs[7].name = "Coating"  # Coat: the identifier stays "Coat"
     params, _warnings, error = export.read_hair_node(node, "Identifier")
     assert error is None and params.coat == 0.5, (error, params)
+    # Huang reads the lobes by identifier; a Huang node without one is named.
+    params, _warnings, error = export.read_hair_node(
+        stub_hair_node("HUANG", leave_out=("TT lobe",)), "NoLobe")
+    assert params is None and "'TT lobe'" in error and "'NoLobe'" in error, error
 
 
-def test_huang_material_refused_at_render():
-    """Blender 4.0+: a new hair node is Chiang (RNA's default says Huang); a Huang material
-    fails F12 with a report naming it, a Chiang one exports."""
+def test_huang_rules_on_stub_nodes():
+    """Cycles' Huang rules: Aspect Ratio must be finite and > 0 (above 1 is passed on, the
+    library inverts it); a negative lobe is 0 with a warning; all three <= 0: no closure
+    (exported as black, opaque strands, with a warning)."""
+    def read(**values):
+        return export.read_hair_node(stub_hair_node("HUANG", values=values), "H")
+
+    params, warnings, error = read(**{"Aspect Ratio": 0.5, "R lobe": 1.0, "TT lobe": 0.5,
+                                      "TRT lobe": 0.2})
+    assert error is None, error
+    assert (params.model, params.aspect_ratio, params.reflection, params.transmission,
+            params.secondary_reflection) == ("HUANG", 0.5, 1.0, 0.5, 0.2), params
+    assert params.scatters and params.oriented
+    assert read(**{"Aspect Ratio": 1.0})[0].oriented is False
+    assert read(**{"Aspect Ratio": 2.0})[0].aspect_ratio == 2.0
+    for bad in (0.0, -0.3, float("nan"), float("inf")):
+        params, _warnings, error = read(**{"Aspect Ratio": bad})
+        assert params is None and "'H'" in error and "Aspect Ratio" in error, (bad, error)
+    params, warnings, error = read(**{"TT lobe": -0.25})
+    assert error is None and params.transmission == 0.0, (error, params)
+    assert any("Transmission is -0.25" in w and "Cycles uses 0" in w for w in warnings), warnings
+    params, warnings, error = read(**{"R lobe": 0.0, "TT lobe": -1.0, "TRT lobe": 0.0})
+    assert error is None and not params.scatters, (error, params)
+    assert any("Cycles makes no closure" in w for w in warnings), warnings
+    params, _warnings, error = read(**{"R lobe": float("nan")})
+    assert params is None and "Reflection" in error and "finite" in error, error
+
+
+def test_huang_materials_export():
+    """Blender 4.0+: a new hair node is Chiang (RNA's default says Huang); with model Huang it
+    exports every Huang input by identifier and none of Chiang's; all lobes 0 exports black
+    diffuse strands with Cycles' reason."""
     if helpers.VERSION < (4, 0, 0):
-        return  # Blender 3.4 has no model setting (read_hair_node's stub test covers it)
+        return  # Blender 3.4 has no model setting (the stub tests cover the reading)
     helpers.make_test_scene(with_curves=False)
-    node = bpy.data.materials["Hair"].node_tree.nodes["Principled Hair BSDF"]
+    material = bpy.data.materials["Hair"]
+    node = material.node_tree.nodes["Principled Hair BSDF"]
     assert node.model == "CHIANG", node.model
     assert node.bl_rna.properties["model"].default == "HUANG"
-    export.export_context()
     node.model = "HUANG"
-    try:
-        export.export_context()
-    except export.ExportError as error:
-        assert "'Hair'" in str(error) and "Huang support is coming" in str(error), error
-    else:
-        raise AssertionError("a Huang material must be refused")
-    try:
-        bpy.ops.render.render()
-    except RuntimeError as error:
-        assert "'Hair'" in str(error) and "Huang support is coming" in str(error), error
-        assert "Traceback" not in str(error), error
-    else:
-        raise AssertionError("F12 with a Huang material must fail with a report")
+    values = {"Aspect Ratio": 0.5, "R lobe": 1.0, "TT lobe": 0.5, "TRT lobe": 0.2,
+              "Roughness": 0.35, "IOR": 1.5, "Offset": math.radians(-3.0)}
+    for name, value in values.items():
+        helpers.socket(node, name).default_value = value
+    helpers.socket(node, "Radial Roughness").default_value = 0.9  # Chiang only: not read
+    data = export.export_context()
+    hair = data.materials[particle_curves(data).material]
+    check_hair_material(hair, material, fields=HUANG_FIELDS)
+    assert hair.hair.model == "HUANG" and hair.hair.radial_roughness == 0.3, hair.hair
+    native = helpers.module("native")
+    options = native.principled_options(hair.hair.as_dict())
+    assert options["model"] == "huang" and "radial_roughness" not in options \
+        and "coat" not in options and "cycles" not in options, options
+    assert options["aspect_ratio"] == 0.5, options
+    assert math.isclose(options["secondary_reflection"], 0.2, rel_tol=1e-6), options
+    # Particle hair has no normals (Cycles' fallback frame).
+    assert particle_curves(data).normals is None
+    for name in ("R lobe", "TT lobe", "TRT lobe"):
+        helpers.socket(node, name).default_value = 0.0
+    data = export.export_context()
+    dark = data.materials[particle_curves(data).material]
+    assert dark.kind == "DIFFUSE" and dark.albedo == (0.0, 0.0, 0.0), dark
+    assert any("'Hair'" in w and "no closure" in w for w in data.warnings), data.warnings
+
+
+def test_curves_normals_for_huang():
+    """A Curves object with an elliptical Huang material exports Blender's curve normals
+    (Curves.normals, which Cycles reads), in object space. Checked on planar curves, whose
+    minimum-twist normals keep one angle to the plane along each curve (parallel transport): unit
+    length and a constant |n_z| per curve, which a misread array would break. A Chiang
+    material or aspect 1 exports none; a rotated object warns and exports the same normals."""
+    if helpers.VERSION < (4, 0, 0):
+        return
+    scene = helpers.reset()
+    helpers.make_camera(scene)
+    material = helpers.make_hair_material("Oval", "COLOR")
+    node = material.node_tree.nodes["Principled Hair BSDF"]
+    node.model = "HUANG"
+    helpers.socket(node, "Aspect Ratio").default_value = 0.6
+    # New curves whose points are set before anything asks for their normals: Blender caches
+    # normals and does not drop the cache when positions are written through position_data.
+    curves = bpy.data.hair_curves.new("Planar")
+    count, points = 30, 8
+    curves.add_curves([points] * count)
+    planar = np.random.default_rng(5).uniform(-0.5, 0.5, (count * points, 3)).astype(np.float32)
+    planar[:, 2] = 0.01 * np.repeat(np.arange(count), points)  # each curve in a plane z = const
+    curves.position_data.foreach_set("vector", planar.reshape(-1))
+    curves.materials.append(material)
+    obj = bpy.data.objects.new("Curls", curves)
+    scene.collection.objects.link(obj)
+    bpy.context.view_layer.update()
+    data = export.export_context()
+    (exported,) = data.curves
+    assert exported.normals is not None and exported.normals.shape == (exported.point_count, 3)
+    np.testing.assert_allclose(np.linalg.norm(exported.normals, axis=1), 1.0, atol=1e-5)
+    first = exported.first.astype(np.int64)
+    spread = max(float(np.ptp(np.abs(exported.normals[first[c]:first[c + 1], 2])))
+                 for c in range(exported.curve_count))
+    assert spread < 5e-3, spread  # float rounding over the evaluated points; a misread is O(1)
+    assert not any("rotated" in w for w in data.warnings), data.warnings
+    obj.rotation_euler = (0.0, 0.0, 1.2)
+    bpy.context.view_layer.update()
+    data = export.export_context()
+    np.testing.assert_allclose(data.curves[0].normals, exported.normals, atol=1e-6)
+    assert any("'Curls' is rotated" in w and "object space" in w for w in data.warnings), \
+        data.warnings
+    helpers.socket(node, "Aspect Ratio").default_value = 1.0
+    assert export.export_context().curves[0].normals is None
+    node.model = "CHIANG"
+    assert export.export_context().curves[0].normals is None
 
 
 def test_disabled_modifier_and_strands():
@@ -890,7 +992,9 @@ helpers.run([
     test_surface_nodes,
     test_unsupported_things_warn,
     test_hair_node_models_and_missing_sockets,
-    test_huang_material_refused_at_render,
+    test_huang_rules_on_stub_nodes,
+    test_huang_materials_export,
+    test_curves_normals_for_huang,
     test_disabled_modifier_and_strands,
     test_no_camera,
     test_render_mode_export_through_engine,

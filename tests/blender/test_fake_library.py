@@ -331,9 +331,10 @@ def test_invalid_node_value_fails_cleanly():
     assert np.all(np.isfinite(pixels))
 
 
-def test_huang_material_refused_by_bake_and_render():
-    """Blender 4.0+: the bake operator and F12 refuse a Huang material with a report naming it
-    (the Chiang material beside it still bakes)."""
+def test_huang_material_by_bake_and_render():
+    """Blender 4.0+: the bake operator refuses a Huang material with a report naming it (the
+    Chiang material beside it still bakes); F12 with the Table strategy refuses it, with the
+    Uniform strategy or Cycles' own Huang sampling it renders (as a Huang material)."""
     if helpers.VERSION < (4, 0, 0):
         return  # no model setting before 4.0
     scene = helpers.make_test_scene()
@@ -343,12 +344,21 @@ def test_huang_material_refused_by_bake_and_render():
         try:
             bpy.ops.hairis.bake_tables(**kwargs)  # an ERROR report raises in bpy.ops
         except RuntimeError as error:
-            assert "'Curly'" in str(error) and "Huang support is coming" in str(error), error
+            assert "'Curly'" in str(error) and "huang2022" in str(error), error
         else:
             raise AssertionError("baking a Huang material must be refused")
     assert bpy.data.materials["Hair"].hairis.table_image is not None, "Hair must still bake"
     assert bpy.data.materials["Curly"].hairis.table_image is None
-    expect_render_error(scene, "'Curly'", "Huang support is coming")
+    expect_render_error(scene, "'Curly'", "huang2022")
+    scene.hairis.huang_sampling = "CYCLES"  # Cycles' sampler needs no tables
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "huang_sampling") == "1", summary
+    assert re.search(r"hair \d+ tables=0 huang=1 ", summary), summary
+    scene.hairis.huang_sampling = "STRATEGY"
+    scene.hairis.strategy = "UNIFORM"
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "huang_sampling") == "0", summary
+    assert "model=huang" in summary or "aspect_ratio=" in summary, summary
 
 
 class StubEngine:
@@ -422,7 +432,7 @@ helpers.run([
     test_bake_operator_saved_blend,
     test_bake_operator_unsaved_blend_packs,
     test_invalid_node_value_fails_cleanly,
-    test_huang_material_refused_by_bake_and_render,
+    test_huang_material_by_bake_and_render,
     test_cancel_returns_promptly,
     test_progress_reporter_rate_limit,
 ])

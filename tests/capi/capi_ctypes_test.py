@@ -43,9 +43,9 @@ ERROR_INVALID_TABLE = 3
 ERROR_CANCELLED = 4
 ERROR_INTERNAL = 5
 
-KINDS = ("chiang", "marschner", "bake", "sampler", "diffuse", "principled", "glossy", "emission",
-         "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
-         "curve_inputs")
+KINDS = ("chiang", "huang", "marschner", "bake", "sampler", "diffuse", "principled", "glossy",
+         "emission", "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
+         "curve_inputs", "curves")
 
 # ---- The prototypes, written here by hand ---------------------------------------------------
 
@@ -86,6 +86,8 @@ PROTOTYPES = {
     "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F]),
     "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
                                                     c_char_p, c_size_t, F]),
+    "hairis_scene_add_curves_with_normals": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
+                                                     F, c_char_p]),
     "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
     "hairis_scene_set_mesh_attribute": (c_int, [c_void_p, c_char_p, F, c_size_t]),
     "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
@@ -483,7 +485,8 @@ class TestOptions(unittest.TestCase):
         self.assertIn("camera", last_error())
 
     def test_fiber_defaults_round_trip(self):
-        for kind, bare in (("chiang", ""), ("marschner", "model=marschner")):
+        for kind, bare in (("chiang", ""), ("huang", "model=huang"),
+                           ("marschner", "model=marschner")):
             with self.subTest(kind=kind):
                 a, b = make_fiber(defaults(kind)), make_fiber(bare)
                 self.assertTrue(a and b, last_error())
@@ -804,6 +807,35 @@ class TestRender(unittest.TestCase):
                 self.assertEqual(int(stats["camera_rays"]), self.W * self.H * 4)
                 self.assertEqual(int(stats["threads"]), 2)
                 self.assertTrue(0 < float(stats["seconds"]) < 600)
+        lib().hairis_scene_destroy(scene)
+
+    def test_huang_hair_on_oriented_curves(self):
+        # A Huang material renders with the uniform strategy; curves may carry normals, which
+        # are checked (and their options refused by name) like every other array.
+        scene = self.make_scene(None, "model=huang;aspect_ratio=0.5")
+        first = np.array([0, 3], np.uint32)
+        positions = np.array([[-1, 0.2, 0.3], [0, 0.2, 0.3], [1, 0.2, 0.3]], np.float32)
+        radii = np.full(3, 0.1, np.float32)
+        normals = np.array([[0, 0, 1], [0, 1, 1], [0, 1, 0]], np.float32)
+        add = lib().hairis_scene_add_curves_with_normals
+        self.assertEqual(add(scene, 0, 1, ptr(first, c_uint32), 3, ptr(positions), ptr(radii),
+                             ptr(normals), b""), OK, last_error())
+        self.assertEqual(add(scene, 0, 1, ptr(first, c_uint32), 3, ptr(positions), ptr(radii),
+                             ptr(normals), b"frame=1"), ERROR_INVALID_ARGUMENT)
+        self.assertIn('"frame"', last_error())
+        normals[2, 0] = np.inf
+        self.assertEqual(add(scene, 0, 1, ptr(first, c_uint32), 3, ptr(positions), ptr(radii),
+                             ptr(normals), None), ERROR_INVALID_ARGUMENT)
+        self.assertIn("normals[6]", last_error())
+        rgba = np.full((self.H, self.W, 4), -1, np.float32)
+        status = lib().hairis_render(scene, self.settings("uniform"), ptr(rgba), PROGRESS_FN(),
+                                     None)
+        self.assertEqual(status, OK, last_error())
+        self.assertTrue(np.all(np.isfinite(rgba)) and np.all(rgba >= 0))
+        self.assertGreater(rgba[..., :3].sum(), 0)
+        self.assertEqual(lib().hairis_render(scene, self.settings("table"), ptr(rgba),
+                                             PROGRESS_FN(), None), ERROR_INVALID_TABLE)
+        self.assertIn("material 0", last_error())
         lib().hairis_scene_destroy(scene)
 
     def test_cancel_from_python(self):

@@ -261,10 +261,10 @@ static void expect_default(const char *kind, const char *name, const char *expec
           defaults ? defaults : "(null)");
 }
 
-static const char *const g_kinds[] = {"chiang", "marschner", "bake",   "sampler",
-                                      "diffuse", "principled", "glossy", "emission",
-                                      "sun",    "point",     "area",   "world",
-                                      "camera", "render", "curve_inputs"};
+static const char *const g_kinds[] = {"chiang",  "huang",      "marschner", "bake",   "sampler",
+                                      "diffuse",  "principled", "glossy",    "emission", "sun",
+                                      "point",    "area",       "world",     "camera", "render",
+                                      "curve_inputs", "curves"};
 enum { KIND_COUNT = sizeof g_kinds / sizeof g_kinds[0] };
 
 static void test_defaults(void)
@@ -281,6 +281,22 @@ static void test_defaults(void)
     expect_default("chiang", "coat", "0");
     expect_default("chiang", "random", "0");
     expect_default("chiang", "cycles", "3.4");
+    /* The node with the Huang model: Chiang's shared inputs, Aspect Ratio and the lobes. */
+    expect_default("huang", "model", "huang");
+    expect_default("huang", "aspect_ratio", "0.850000024");
+    expect_default("huang", "reflection", "1");
+    expect_default("huang", "transmission", "1");
+    expect_default("huang", "secondary_reflection", "1");
+    expect_default("huang", "roughness", "0.300000012");
+    expect_default("huang", "offset", "0.0349065848");
+    {
+        const char *huang = hairis_defaults("huang");
+        CHECK(huang && !strstr(huang, "radial_roughness") && !strstr(huang, "coat=") &&
+                  !strstr(huang, "cycles="),
+              "Huang lists no Chiang-only input: \"%s\"", huang ? huang : "(null)");
+    }
+    CHECK(hairis_defaults("curves") != NULL && strcmp(hairis_defaults("curves"), "") == 0,
+          "curves options: none yet");
     /* The seed's Marschner parameters (blonde). */
     expect_default("marschner", "model", "marschner");
     expect_default("marschner", "eta", "1.55");
@@ -301,6 +317,7 @@ static void test_defaults(void)
     expect_default("render", "max_bounces", "12");
     expect_default("render", "max_diffuse_bounces", "4");
     expect_default("render", "max_transmission_bounces", "12");
+    expect_default("render", "max_transparent_bounces", "8");
     expect_default("render", "tile_size", "16");
     expect_default("render", "film_transparent", "0");
     expect_default("render", "curve_backfaces", "ignore");
@@ -347,7 +364,7 @@ static int try_fiber(const char *kind, const char *options)
 static int try_options(const char *kind, const char *options)
 {
     char text[TEXT];
-    if (strcmp(kind, "chiang") == 0 || strcmp(kind, "marschner") == 0)
+    if (strcmp(kind, "chiang") == 0 || strcmp(kind, "huang") == 0 || strcmp(kind, "marschner") == 0)
         return try_fiber(kind, options);
     if (strcmp(kind, "bake") == 0) {
         /* Accepted options reach the first progress call, which cancels. */
@@ -449,6 +466,13 @@ static void test_option_strings(void)
     CHECK(!try_fiber("marschner", "roughness=0.3"), "roughness for Marschner");
     CHECK_ERROR_MENTIONS("\"roughness\"");
     CHECK_ERROR_MENTIONS("model=marschner");
+    CHECK(!try_fiber("huang", "radial_roughness=0.3"), "radial_roughness for Huang");
+    CHECK_ERROR_MENTIONS("\"radial_roughness\"");
+    CHECK_ERROR_MENTIONS("model=huang");
+    CHECK_ERROR_MENTIONS("aspect_ratio");
+    CHECK(!try_fiber("huang", "cycles=4.5"), "cycles for Huang (it is Cycles 4.5/5.0's)");
+    CHECK(!try_fiber("chiang", "aspect_ratio=0.5"), "aspect_ratio for Chiang");
+    CHECK_ERROR_MENTIONS("model=chiang");
     CHECK(!try_fiber("chiang", "preset=blonde"), "preset");
     CHECK_ERROR_MENTIONS("\"preset\"");
     CHECK(!try_fiber("chiang", "offset=0.1;offset_deg=3"), "offset and offset_deg");
@@ -1661,6 +1685,129 @@ static void test_render(void)
 
 /* ---- Render settings and camera options the first C API lacked ---------------------------- */
 
+/* ---- Huang fibers and oriented curves ------------------------------------------------------ */
+
+/* Curves along x with a normal per point (or none), added to `scene` as material `material`. */
+static int add_oriented_strands(hairis_scene *scene, int material, const float *normal,
+                                const char *options)
+{
+    enum { C = 5, P = 4 };
+    uint32_t first[C + 1];
+    float positions[3 * C * P], radii[C * P], normals[3 * C * P];
+    for (int c = 0; c <= C; ++c) first[c] = (uint32_t)(c * P);
+    for (int c = 0; c < C; ++c)
+        for (int p = 0; p < P; ++p) {
+            const int i = c * P + p;
+            positions[3 * i] = -1.5f + 1.0f * (float)p;
+            positions[3 * i + 1] = -0.8f + 0.4f * (float)c;
+            positions[3 * i + 2] = 0.0f;
+            radii[i] = 0.12f;
+            for (int k = 0; k < 3; ++k) normals[3 * i + k] = normal ? normal[k] : 0.0f;
+        }
+    return hairis_scene_add_curves_with_normals(scene, material, C, first, C * P, positions, radii,
+                                                normals, options);
+}
+
+static void test_huang(void)
+{
+    section("huang");
+    hairis_fiber *huang = hairis_fiber_create("model=huang;aspect_ratio=0.5;transmission=0.5");
+    CHECK(huang != NULL, "a Huang fiber: %s", hairis_last_error());
+    CHECK(huang && strcmp(hairis_fiber_model(huang), "huang2022") == 0, "model \"%s\"",
+          huang ? hairis_fiber_model(huang) : "");
+    CHECK(huang && strstr(hairis_fiber_parameters(huang), "aspect_ratio=0.5;") != NULL &&
+              strstr(hairis_fiber_parameters(huang), "transmission=0.5;") != NULL,
+          "its parameters: \"%s\"", huang ? hairis_fiber_parameters(huang) : "");
+    /* Aspect ratios above 1 are rendered as their inverse: the same scattering. */
+    hairis_fiber *inverted = hairis_fiber_create("model=huang;aspect_ratio=2;transmission=0.5");
+    CHECK(inverted != NULL, "aspect_ratio=2 accepted");
+
+    /* Refusals name the input and Cycles' rule. */
+    expect_fiber_refused("model=huang;aspect_ratio=0", "aspect_ratio");
+    expect_fiber_refused("model=huang;aspect_ratio=-1", "aspect_ratio");
+    expect_fiber_refused("model=huang;reflection=0;transmission=0;secondary_reflection=-1", "no closure");
+    expect_fiber_refused("model=huang;reflection=nan", "reflection");
+    expect_fiber_refused("model=huang;ior=0.8", "ior");
+
+    /* The far field: finite, non-negative, and the same for aspect 2 as for 1/2. */
+    enum { N = 64 };
+    float wi[3 * N], wo[3 * N], f[3 * N], g[3 * N];
+    for (int i = 0; i < N; ++i) {
+        random_direction(wi + 3 * i);
+        random_direction(wo + 3 * i);
+    }
+    CHECK(hairis_fiber_eval(huang, N, wi, wo, NULL, f) == HAIRIS_OK, "eval: %s", hairis_last_error());
+    CHECK(all_finite_non_negative(f, 3 * N), "Huang's f is finite and >= 0");
+    CHECK(hairis_fiber_eval(inverted, N, wi, wo, NULL, g) == HAIRIS_OK && memcmp(f, g, sizeof f) == 0,
+          "aspect 2 evaluates as 1/2");
+    double sum = 0;
+    for (int i = 0; i < 3 * N; ++i) sum += f[i];
+    CHECK(sum > 0.0, "and not all zero");
+    const float h[N] = {0};
+    CHECK(hairis_fiber_eval(huang, N, wi, wo, h, f) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "no near field by h for Huang");
+    CHECK_ERROR_MENTIONS("huang2022");
+    CHECK(hairis_tables_bake(huang, "", NULL, NULL) == NULL, "no tables for Huang yet");
+    CHECK_ERROR_MENTIONS("huang2022");
+
+    /* A scene of Huang hair: renders with uniform (and gaussian), refuses analytic and table
+     * naming the material. */
+    static float rgba[W * H * 4];
+    char s[TEXT];
+    hairis_scene *scene = hairis_scene_create();
+    const int hair = hairis_scene_add_hair_material(scene, huang, NULL);
+    CHECK(hair == 0, "Huang hair material: %s", hairis_last_error());
+    const float up[3] = {0, 0, 1};
+    CHECK(add_oriented_strands(scene, hair, up, "") == HAIRIS_OK, "curves with normals: %s",
+          hairis_last_error());
+    CHECK(add_oriented_strands(scene, hair, NULL, NULL) == HAIRIS_OK, "zero normals, NULL options");
+    CHECK(hairis_scene_add_light(scene, "type=sun;direction=0.3,0.2,1;strength=3") == HAIRIS_OK, "sun");
+    CHECK(hairis_scene_set_world(scene, SKY) == HAIRIS_OK && hairis_scene_set_camera(scene, CAMERA) == HAIRIS_OK,
+          "world and camera");
+    CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";max_transparent_bounces=3"), rgba, NULL, NULL) ==
+              HAIRIS_OK,
+          "uniform renders Huang: %s", hairis_last_error());
+    CHECK(pixels_ok(rgba) && pixel_sum(rgba, W * H) > 0.0, "a finite, non-black image");
+    CHECK(hairis_render(scene, tiny_settings(s, "gaussian", ""), rgba, NULL, NULL) == HAIRIS_OK,
+          "gaussian renders Huang");
+    CHECK(hairis_render(scene, tiny_settings(s, "analytic", ""), rgba, NULL, NULL) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "analytic refused for Huang");
+    CHECK_ERROR_MENTIONS("material 0");
+    CHECK_ERROR_MENTIONS("uniform");
+    CHECK(hairis_render(scene, tiny_settings(s, "table", ""), rgba, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+          "table refused for Huang");
+    CHECK_ERROR_MENTIONS("material 0");
+    CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";max_transparent_bounces=-1"), rgba, NULL, NULL) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "max_transparent_bounces -1 refused");
+    CHECK_ERROR_MENTIONS("max_transparent_bounces");
+
+    /* Curves with normals: the normals are checked like positions; options are refused by name. */
+    CHECK(add_oriented_strands(scene, hair, up, "twist=1") == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "unknown curve option");
+    CHECK_ERROR_MENTIONS("\"twist\"");
+    const float bad[3] = {0, NAN, 1};
+    CHECK(add_oriented_strands(scene, hair, bad, "") == HAIRIS_ERROR_INVALID_ARGUMENT, "NaN normal");
+    CHECK_ERROR_MENTIONS("normals[1]");
+    const uint32_t first[2] = {0, 2};
+    const float p[6] = {0, 0, 0, 1, 0, 0}, r[2] = {0.1f, 0.1f};
+    CHECK(hairis_scene_add_curves_with_normals(scene, hair, 1, first, 2, p, r, NULL, "") ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "NULL normals");
+    CHECK_ERROR_MENTIONS("normals");
+    CHECK(hairis_scene_add_curves_with_normals(scene, 5, 1, first, 2, p, r, p, "") ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "an unknown material");
+    CHECK_ERROR_MENTIONS("material");
+    CHECK(hairis_scene_add_curves_with_normals(NULL, 0, 1, first, 2, p, r, p, "") ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "NULL scene");
+    hairis_scene_destroy(scene);
+    hairis_fiber_destroy(huang);
+    hairis_fiber_destroy(inverted);
+}
+
 static void test_render_options(void)
 {
     section("render options");
@@ -1784,6 +1931,15 @@ static void test_defaults_round_trip(void)
           "hairis_fiber_create(hairis_defaults(\"chiang\")) is hairis_fiber_create(\"\")");
     hairis_fiber *c = hairis_fiber_create(with_option(text, d, "roughness", "0.4"));
     CHECK(c && strcmp(a_text, hairis_fiber_parameters(c)) != 0, "and roughness in it is read");
+    hairis_fiber_destroy(a);
+    hairis_fiber_destroy(b);
+    hairis_fiber_destroy(c);
+    a = hairis_fiber_create(keep(d, hairis_defaults("huang")));
+    b = hairis_fiber_create("model=huang");
+    CHECK(a && b && strcmp(keep(a_text, hairis_fiber_parameters(a)), hairis_fiber_parameters(b)) == 0,
+          "Huang's defaults are model=huang's");
+    c = hairis_fiber_create(with_option(text, d, "aspect_ratio", "0.5"));
+    CHECK(c && strcmp(a_text, hairis_fiber_parameters(c)) != 0, "and aspect_ratio in it is read");
     hairis_fiber_destroy(a);
     hairis_fiber_destroy(b);
     hairis_fiber_destroy(c);
@@ -2295,6 +2451,7 @@ int main(void)
     } else {
         CHECK(0, "no tables: the option, sampling and render tests cannot run");
     }
+    test_huang();
     test_render_options();
     test_defaults_round_trip();
     test_scene_refusals();

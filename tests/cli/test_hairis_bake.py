@@ -127,7 +127,7 @@ class HairisBakeTest(unittest.TestCase):
             ("offset_deg = inf\n", "line 1: offset_deg must be a finite number"),
             ("parametrization = melanin\nmelanin = -1\n", "melanin must be in [0, 1]"),
             ("model = marschner\neta = 0.9\n", "eta must be in (1, 4]"),
-            ("model = lambert\n", "line 1: model must be chiang or marschner"),
+            ("model = lambert\n", "line 1: model must be chiang, huang or marschner"),
             ("# fine\nno equals sign\n", "line 2: expected key = value"),
         ]
         for text, fragment in cases:

@@ -71,9 +71,10 @@ HAIRIS_API const char *hairis_version_string(void);
 HAIRIS_API const char *hairis_last_error(void);
 /**
  * Every option name of `kind` with its default, as an option string; NULL (and the last error
- * listing the kinds) for an unknown kind. Kinds: "chiang" and "marschner" (hairis_fiber_create),
- * "bake", "sampler", and hairis_render.h's "diffuse", "sun", "point", "spot", "area", "world",
- * "camera", "render", "curve_inputs".
+ * listing the kinds) for an unknown kind. Kinds: "chiang", "huang" and "marschner"
+ * (hairis_fiber_create), "bake", "sampler", and hairis_render.h's "diffuse", "principled",
+ * "glossy", "emission", "mix", "add", "texture", "sun", "point", "spot", "area", "world",
+ * "camera", "render", "curve_inputs", "curves".
  */
 HAIRIS_API const char *hairis_defaults(const char *kind);
 
@@ -86,17 +87,24 @@ HAIRIS_API const char *hairis_defaults(const char *kind);
  *    melanin_redness, tint, absorption, roughness, radial_roughness, coat, ior, offset
  *    (radians; offset_deg in degrees), random_color, random_roughness, random, and cycles (the
  *    Blender version whose Cycles evaluates it: 3.4 to 4.1 tilt θ_i, 4.2 and later θ_o).
+ *  - "model=huang": the node with the Huang model (Blender 4.0+), as Cycles 4.5 and 5.0
+ *    evaluate it: the same names without cycles, radial_roughness and coat (Huang inverts the
+ *    colour with roughness), plus aspect_ratio (> 0; above 1 rendered as its inverse, as
+ *    Cycles does) and the lobe multipliers reflection, transmission, secondary_reflection
+ *    (negative ones count as 0; all three <= 0 is refused: Cycles then makes no closure).
  *  - "model=marschner": Marschner 2003 (eta, sigma_a, alpha_r_deg, ..., eccentricity, ...).
  */
 HAIRIS_API hairis_fiber *hairis_fiber_create(const char *options);
 HAIRIS_API void hairis_fiber_destroy(hairis_fiber *fiber);
-/** "chiang2016" or "marschner2003". */
+/** "chiang2016", "huang2022" or "marschner2003". */
 HAIRIS_API const char *hairis_fiber_model(const hairis_fiber *fiber);
 /** The parameters that determine the fiber's scattering, "name=value;..." (what table metadata
  * records): for Chiang the mapped closure parameters, so nodes that scatter alike match. */
 HAIRIS_API const char *hairis_fiber_parameters(const hairis_fiber *fiber);
 /** f(ω_i, ω_o)·|cos θ_i| (RGB) for n direction pairs; `h` holds n offsets for the near field
- * (Chiang only), or is NULL for the far field (averaged over h). */
+ * (Chiang only), or is NULL for the far field (averaged over h). For a huang2022 fiber the
+ * frame's y axis is the ellipse's major axis (x the tangent, z = x × y), and f is the
+ * expectation of Cycles' stochastic eval. */
 HAIRIS_API int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi,
                                  const float *wo, const float *h, float *rgb_out);
 

@@ -22,8 +22,8 @@ HAIRIS_API hairis_scene *hairis_scene_create(void);
 HAIRIS_API void hairis_scene_destroy(hairis_scene *scene);
 
 /**
- * Adds a hair material of `fiber` (a Chiang fiber); `tables` (may be NULL) are what the TABLE
- * strategy samples and must have been baked for the fiber. Returns the material index, or -1.
+ * Adds a hair material of `fiber` (a chiang2016 or huang2022 fiber); `tables` (may be NULL)
+ * are what the TABLE strategy samples and must have been baked for the fiber. Returns the material index, or -1.
  * The scene keeps what it needs (the handles may be destroyed). Whether the tables fit is
  * checked by hairis_render for the TABLE strategy: HAIRIS_ERROR_INVALID_TABLE naming the
  * material otherwise.
@@ -72,7 +72,9 @@ HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *
 /**
  * Adds hair curves drawn as round Catmull-Rom curves (Cycles' "3D Curves"): curve c has points
  * first[c] .. first[c+1]-1 (first has curve_count+1 entries), positions xyz in world space,
- * one radius per point. `material` must already be in the scene.
+ * one radius per point. `material` must already be in the scene. The curves have no normals:
+ * elliptical Huang fibers on them take Cycles' fallback frame around the tangent, as
+ * Blender's particle hair does in Cycles.
  */
 HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t curve_count,
                                        const uint32_t *first, size_t point_count,
@@ -101,6 +103,20 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
                                                    const float *positions, const float *radii,
                                                    const char *inputs, size_t value_count,
                                                    const float *values);
+/**
+ * Adds hair curves as hairis_scene_add_curves does, with the curves' normal attribute:
+ * `normals` holds 3 finite floats per point (Blender's Curves.normals), interpolated linearly
+ * along each segment. A Huang fiber with an aspect ratio other than 1 puts its major axis
+ * along the normal made perpendicular to the tangent; where that is zero (a zero normal, or
+ * one along the tangent) it takes the fallback frame. The normals are used as given, as
+ * Cycles does (it does not rotate them with the object). `options`: none yet ("" or NULL;
+ * hairis_defaults("curves")).
+ */
+HAIRIS_API int hairis_scene_add_curves_with_normals(hairis_scene *scene, int material,
+                                                    size_t curve_count, const uint32_t *first,
+                                                    size_t point_count, const float *positions,
+                                                    const float *radii, const float *normals,
+                                                    const char *options);
 /** Adds a triangle mesh in world space; `materials` holds one material index per triangle. */
 HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                                      const float *positions, size_t triangle_count,
