@@ -237,7 +237,7 @@ TEST_F(EnvironmentEval, ScaleStretchesTheLookupVector) {
     const EnvironmentMap scaled = make_map(image(), a.value()), plain = make_map(image());
     const Vec3 dirs[] = {{0.6f, 0.8f, 0.0f}, {0.3f, -0.4f, 0.866f}, {-0.5f, 0.5f, -0.7071f}};
     for (Vec3 d : dirs) {
-        const Rgb want = plain.eval(safe_normalize({2 * d.x, d.y, d.z}));
+        const Rgb want = plain.eval(safe_normalize(Vec3{2 * d.x, d.y, d.z}));
         expect_rgb(scaled.eval(d), want, "scaled");
     }
 }
@@ -267,7 +267,7 @@ TEST(EnvironmentRadiance, StrengthAndColorMultiply) {
     desc.color = Rgb{1.0f, 0.5f, 0.25f};
     auto map = EnvironmentMap::create(std::move(desc));
     ASSERT_TRUE(map.ok());
-    const Rgb L = map.value().eval({0.3f, 0.4f, safe_normalize({0.3f, 0.4f, 0.5f}).z});
+    const Rgb L = map.value().eval({0.3f, 0.4f, safe_normalize(Vec3{0.3f, 0.4f, 0.5f}).z});
     EXPECT_FLOAT_EQ(L.r, 1.5f);
     EXPECT_FLOAT_EQ(L.g, 1.5f);
     EXPECT_FLOAT_EQ(L.b, 1.5f);

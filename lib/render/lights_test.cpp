@@ -201,7 +201,7 @@ TEST(LightSet, HitsAgreeWithSamples) {
     // sample's own: with bsdf_pdf = the light pdf the power heuristic gives exactly 1/2.
     // One light at a time, so that no other light overlaps the direction.
     SunLight sun;
-    sun.to_sun = safe_normalize({0.3f, 0.2f, 1.0f});
+    sun.to_sun = safe_normalize(Vec3{0.3f, 0.2f, 1.0f});
     sun.angle = 0.3f;
     AreaLight rect;
     rect.shape = AreaShape::Rectangle;
@@ -526,7 +526,7 @@ TEST(LightSet, NewLampsHitsAgreeWithSamples) {
     SpotLight sphere_spot = spot_at({0.3f, -0.2f, 2.0f}, 40.0f, 0.3f, 1.4f, 0.5f, CyclesVersion::V4_5);
     sphere_spot.soft_falloff = false;
     SunLight sun;
-    sun.to_sun = safe_normalize({0.3f, 0.2f, 1.0f});
+    sun.to_sun = safe_normalize(Vec3{0.3f, 0.2f, 1.0f});
     sun.angle = 0.3f;
     sun.cycles = CyclesVersion::V4_5;
     LightsDesc env;
@@ -566,7 +566,7 @@ TEST(LightSet, EnvironmentWorldIsALampAmongLamps) {
     EXPECT_EQ(set.lamp_count(), 2);
     EXPECT_TRUE(set.world_light_sampled());
     EXPECT_FLOAT_EQ(set.lamp_selection_probability(), 0.5f);
-    const Vec3 dir = safe_normalize({0.2f, -0.4f, 0.7f});
+    const Vec3 dir = safe_normalize(Vec3{0.2f, -0.4f, 0.7f});
     EXPECT_FLOAT_EQ(set.world_pdf(dir), 0.5f * d.world.environment->pdf(dir));
     // Escaped rays get the environment's radiance, weighted against that density.
     const Rgb L = d.world.environment->eval(dir);
@@ -686,7 +686,7 @@ TEST(LightSet, MisOfTheEnvironmentIsUnbiased) {
         return (x == 20 && y == 25) ? Rgb{300.0f, 200.0f, 100.0f} : Rgb{g, g, 1.5f * g};
     }, rotation);
     SunLight sun;
-    sun.to_sun = safe_normalize({0.5f, 0.1f, 0.8f});
+    sun.to_sun = safe_normalize(Vec3{0.5f, 0.1f, 0.8f});
     sun.angle = 0.2f;
     sun.strength = 2.0f;
     sun.cycles = CyclesVersion::V4_5;

@@ -576,7 +576,7 @@ TEST(Render, StrandInputsRenderAsTheFiberOfTheirValues) {
         d.curves = {c};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
         SunLight sun;
-        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
         sun.strength = 2.0f;
         d.suns = {sun};
         d.camera = ortho_down(0.3f, 0.3f, 6, 6);
@@ -620,7 +620,7 @@ TEST(Render, TableAndAnalyticAgreeOnStrandsAwayFromTheTables) {
         d.curves = {c};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
         SunLight sun;
-        sun.to_sun = safe_normalize({0.3f, 0.5f, 1.0f});
+        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
         sun.strength = 2.0f;
         sun.angle = 0.2f;
         d.suns = {sun};

@@ -131,7 +131,7 @@ TEST(Scene, RaysHitTheHairTubeWithCyclesShadingData) {
     EXPECT_EQ(top_sp.self.geometry, top->prim.geometry);
     EXPECT_EQ(top_sp.self.primitive, 0u);  // curve 0, although segment 1 was hit
     EXPECT_EQ(top->prim.primitive, 1u);
-    const Vec3 inward = safe_normalize({0.2f, 0.1f, -1});
+    const Vec3 inward = safe_normalize(Vec3{0.2f, 0.1f, -1});
     EXPECT_FALSE(scene.intersect(top_sp.position, inward, 0.0f, INFINITY, top_sp.self));
     const auto unskipped =
         scene.intersect(top_sp.position + Vec3{0, 0, 1e-4f}, inward, 0.0f, INFINITY);
@@ -141,7 +141,7 @@ TEST(Scene, RaysHitTheHairTubeWithCyclesShadingData) {
     const auto joint = scene.intersect({0.49f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
     ASSERT_TRUE(joint.has_value());
     const SurfacePoint joint_sp = scene.surface_point({0.49f, 0, 5}, {0, 0, -1}, *joint);
-    EXPECT_FALSE(scene.intersect(joint_sp.position, safe_normalize({1, 0, -0.2f}), 0.0f,
+    EXPECT_FALSE(scene.intersect(joint_sp.position, safe_normalize(Vec3{1, 0, -0.2f}), 0.0f,
                                  INFINITY, joint_sp.self));
     // Hair blocks shadow rays.
     EXPECT_TRUE(scene.occluded({0.3f, 0, 5}, {0, 0, -1}, 0.0f, 10.0f));

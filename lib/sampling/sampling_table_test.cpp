@@ -271,9 +271,9 @@ TEST(SamplingTables, PdfOfSampleMatchesSamplePdf) {
 
 TEST(SamplingTables, DirectionRoundTripsThroughTheFiberFrame) {
     // A caller with a frame and ω_o: ω_i from local_direction(φ_o), back to angles.
-    const FiberFrame frame = FiberFrame::from_tangent_and_view(safe_normalize({0.2f, 1.0f, 0.3f}),
-                                                               safe_normalize({-0.4f, 0.5f, 0.8f}));
-    const Vec3 wo = safe_normalize({-0.4f, 0.5f, 0.8f});
+    const FiberFrame frame = FiberFrame::from_tangent_and_view(safe_normalize(Vec3{0.2f, 1.0f, 0.3f}),
+                                                               safe_normalize(Vec3{-0.4f, 0.5f, 0.8f}));
+    const Vec3 wo = safe_normalize(Vec3{-0.4f, 0.5f, 0.8f});
     const FiberAngles o = angles_of(frame.to_local(wo));
     EXPECT_NEAR(o.phi, -float(kHalfPi), 1e-5f);  // Cycles' frame
     std::mt19937 rng(8);

@@ -235,7 +235,7 @@ Scene hair_scene(const std::shared_ptr<const Sampler> &sampler) {
     d.curves = {c};
     d.world = {Rgb(0.3f, 0.35f, 0.4f), 1.0f};
     SunLight sun;
-    sun.to_sun = safe_normalize({0.4f, -0.3f, 1.0f});
+    sun.to_sun = safe_normalize(Vec3{0.4f, -0.3f, 1.0f});
     sun.strength = 3.0f;
     sun.angle = float(radians(3.0));
     d.suns = {sun};
