@@ -170,13 +170,14 @@ def write_markdown(results, numbers, path):
         if name.startswith("blonde"):
             ok = all(abs(v) <= 0.05 for v in n["dual_error"])
             target = "≤ 5%%: %s" % ("met" if ok else "missed")
-        lines.append("| %s | %s | %s | %s |" % (name, percent(n["dual_error"], n["dual_error_se"]),
-                                               check, target))
+        lines.append("| %s | %s | %s | %s |"
+                     % (name, percent(n["dual_error"], n["dual_error_se"]), check, target))
     lines += ["", "## Equal time against Cycles at its 64-spp time", "",
               "RMSE over the hair pixels (noise-corrected) at the time Cycles needed for 64 spp, "
               "relative to the reference's mean; * marks an extrapolation (RMSE ∝ t^-1/2 from the "
               "nearest measured point).", "",
-              "| case | Cycles 64 spp time | Cycles | DUAL | DUAL / Cycles | PATH / Cycles | target |",
+              "| case | Cycles 64 spp time | Cycles | DUAL | DUAL / Cycles | PATH / Cycles "
+              "| target |",
               "| --- | --- | --- | --- | --- | --- | --- |"]
     for name, n in numbers.items():
         e = n.get("equal_time")
@@ -222,7 +223,8 @@ def tone(image):
 def write_images(results, images, numbers, out):
     names = list(results["cases"])
     columns = ["reference", "dual", "path", "cycles", "difference"]
-    fig, axes = plt.subplots(len(names), len(columns), figsize=(2.2 * len(columns), 2.3 * len(names)))
+    fig, axes = plt.subplots(len(names), len(columns),
+                             figsize=(2.2 * len(columns), 2.3 * len(names)))
     axes = np.atleast_2d(axes)
     for row, name in enumerate(names):
         ref = images["%s_reference" % name]

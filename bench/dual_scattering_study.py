@@ -67,7 +67,7 @@ REF_SEED = 1000
 SEEDS = (1, 2)
 COLOURS = {"blonde": 0.1, "brunette": 0.5, "black": 0.9}
 LIGHTINGS = ("sun", "area")
-ALL_CASES = ["%s_%s" % (c, l) for l in LIGHTINGS for c in COLOURS]
+ALL_CASES = ["%s_%s" % (c, light) for light in LIGHTINGS for c in COLOURS]
 CASES = os.environ.get("HAIRIS_DUAL_CASES", ",".join(ALL_CASES)).split(",")
 METHODS = ("DUAL", "PATH", "CYCLES")
 START = time.monotonic()
@@ -213,8 +213,8 @@ def study_case(name, keep):
     if PROBE:
         for method in METHODS:
             image, seconds = render(scene, method, 4, 1)
-            log("%s probe %s 4 spp: %.2f s, hair mean %s" % (name, method, seconds,
-                                                              np.round(image[mask].mean(axis=0), 4)))
+            log("%s probe %s 4 spp: %.2f s, hair mean %s"
+                % (name, method, seconds, np.round(image[mask].mean(axis=0), 4)))
             keep["%s_%s_probe" % (name, method.lower())] = image.astype(np.float32)
         keep["%s_mask" % name] = mask
         return {"warmup_seconds": warmup}

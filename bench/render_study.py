@@ -13,10 +13,10 @@ In one run, on the scene of tests/blender/test_cycles_compare.py (helpers.make_c
    the reference's own noise (MSE_ref = mean((hairis − cycles)²)/4), which is subtracted from
    every measured MSE ("noise-corrected" RMSE);
 2. every Hairis strategy (UNIFORM, ANALYTIC, GAUSSIAN at multiple_weight 0.25, TABLE at 0),
-   DUAL (TABLE with integrator=dual_scattering) and Cycles at each of SPPS samples per pixel, SEEDS seeds each (seeds other than the
-   reference's), timing ``bpy.ops.render.render()`` alone; a warm-up render of each
-   strategy and of Cycles comes first, so TABLE's auto-bake and first-render costs are not
-   timed;
+   DUAL (TABLE with integrator=dual_scattering) and Cycles at each of SPPS samples per pixel,
+   SEEDS seeds each (seeds other than the reference's), timing ``bpy.ops.render.render()``
+   alone; a warm-up render of each strategy and of Cycles comes first, so TABLE's auto-bake
+   and first-render costs are not timed;
 3. RMSE against the reference over all pixels and channels, relative RMSE (RMSE / mean of the
    reference) and, per channel, the bias mean(image) − mean(reference) with its standard error
    (from the scatter of the image around the reference: sqrt(MSE_channel / pixels), which holds

@@ -88,7 +88,6 @@ def summarize(results):
         }
     # Results of a run made before a method existed lack it.
     strategies = [m for m in STRATEGIES if m in summary]
-    methods = [m for m in METHODS if m in summary]
     cycles = summary["CYCLES"]["per_spp"]
     equal_time = {}
     for method in strategies:

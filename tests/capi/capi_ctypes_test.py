@@ -45,7 +45,7 @@ ERROR_INTERNAL = 5
 
 KINDS = ("chiang", "huang", "marschner", "bake", "sampler", "diffuse", "principled", "glossy",
          "emission", "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
-         "curve_inputs", "curves")
+         "curve_inputs")
 
 # ---- The prototypes, written here by hand ---------------------------------------------------
 

@@ -264,7 +264,7 @@ static void expect_default(const char *kind, const char *name, const char *expec
 static const char *const g_kinds[] = {"chiang",  "huang",      "marschner", "bake",   "sampler",
                                       "diffuse",  "principled", "glossy",    "emission", "sun",
                                       "point",    "area",       "world",     "camera", "render",
-                                      "curve_inputs", "curves"};
+                                      "curve_inputs"};
 enum { KIND_COUNT = sizeof g_kinds / sizeof g_kinds[0] };
 
 static void test_defaults(void)
