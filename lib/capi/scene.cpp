@@ -350,6 +350,22 @@ void add(hairis_scene &scene, HairCurves curves) {
     scene.geometry_bytes += bytes;
 }
 
+// The pixel arguments of an image given as an array (a texture's or the world's): an explicit
+// colour space, a size within the image limits, 1 to 4 channels; returns the float count.
+long long checked_pixels(const std::string &what, int color_space, const float *pixels, size_t width,
+                         size_t height, int channels) {
+    if (color_space == int(ImageColorSpace::Auto))
+        invalid(what + ": color_space must be linear or srgb with pixels (an array does not say what it holds)");
+    if (width < 1 || height < 1 || width > size_t(kMaxEnvironmentImageAxis) ||
+        height > size_t(kMaxEnvironmentImageAxis))
+        invalid("width and height must be in [1, " + std::to_string(kMaxEnvironmentImageAxis) + "] (got " +
+                std::to_string(width) + " x " + std::to_string(height) + ")");
+    if (channels < 1 || channels > 4) invalid("channels must be in [1, 4] (got " + std::to_string(channels) + ")");
+    const long long count = (long long)width * (long long)height * channels;
+    require_array(pixels, size_t(count), "pixels");
+    return count;
+}
+
 }  // namespace
 
 }  // namespace hairis::capi
@@ -407,17 +423,7 @@ HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *
     return guard_value<int>("hairis_scene_add_texture_pixels", -1, [&] {
         require(scene, "scene");
         const TextureOptions o = read_texture_options(options, true);
-        if (o.color_space == int(ImageColorSpace::Auto))
-            invalid("texture: color_space must be linear or srgb with pixels (an array does not "
-                    "say what it holds)");
-        if (width < 1 || height < 1 || width > size_t(kMaxEnvironmentImageAxis) ||
-            height > size_t(kMaxEnvironmentImageAxis))
-            invalid("width and height must be in [1, " + std::to_string(kMaxEnvironmentImageAxis) +
-                    "] (got " + std::to_string(width) + " x " + std::to_string(height) + ")");
-        if (channels < 1 || channels > 4)
-            invalid("channels must be in [1, 4] (got " + std::to_string(channels) + ")");
-        const long long count = (long long)width * (long long)height * channels;
-        require_array(pixels, size_t(count), "pixels");
+        const long long count = checked_pixels("texture", int(o.color_space), pixels, width, height, channels);
         Expected<EnvironmentImage> image = EnvironmentImage::from_pixels(
             pixels, count, int(width), int(height), channels, ImageColorSpace(o.color_space));
         if (!image) invalid("texture: pixels: " + image.error().message);
@@ -689,18 +695,7 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
         require(scene, "scene");
         WorldOptions o;
         const OptionReader reader = read_world_options(options, o, true);
-        if (o.color_space == int(ImageColorSpace::Auto))
-            invalid("world: color_space must be linear or srgb with pixels (an array does not "
-                    "say what it holds)");
-        if (width < 1 || height < 1 || width > size_t(kMaxEnvironmentImageAxis) ||
-            height > size_t(kMaxEnvironmentImageAxis))
-            invalid("width and height must be in [1, " +
-                    std::to_string(kMaxEnvironmentImageAxis) + "] (got " +
-                    std::to_string(width) + " x " + std::to_string(height) + ")");
-        if (channels < 1 || channels > 4)
-            invalid("channels must be in [1, 4] (got " + std::to_string(channels) + ")");
-        const long long count = (long long)width * (long long)height * channels;
-        require_array(pixels, size_t(count), "pixels");
+        const long long count = checked_pixels("world", int(o.color_space), pixels, width, height, channels);
         Expected<EnvironmentImage> image = EnvironmentImage::from_pixels(
             pixels, count, int(width), int(height), channels, ImageColorSpace(o.color_space));
         if (!image) invalid("world: pixels: " + image.error().message);

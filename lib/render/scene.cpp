@@ -593,14 +593,11 @@ bool traceable(Vec3 origin, Vec3 dir, float tmin, float tmax) {
 
 }  // namespace
 
-std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
-                                    PrimRef skip) const {
-    if (!traceable(origin, dir, tmin, tmax)) return std::nullopt;
-    TraceContext ctx;
-    rtcInitIntersectContext(&ctx.rtc);
-    ctx.skip_a = skip;
-    ctx.hit_curve_backfaces = impl_->curve_backfaces == CurveBackfaces::Hit;
-    RTCRayHit rh;
+namespace {
+
+// An Embree ray (origin, dir) over [tmin, tmax] with no hit yet.
+RTCRayHit ray_hit(Vec3 origin, Vec3 dir, float tmin, float tmax) {
+    RTCRayHit rh{};
     rh.ray.org_x = origin.x;
     rh.ray.org_y = origin.y;
     rh.ray.org_z = origin.z;
@@ -608,14 +605,24 @@ std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tma
     rh.ray.dir_x = dir.x;
     rh.ray.dir_y = dir.y;
     rh.ray.dir_z = dir.z;
-    rh.ray.time = 0.0f;
     rh.ray.tfar = tmax;
     rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
+}  // namespace
+
+std::optional<Hit> Scene::intersect(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                    PrimRef skip) const {
+    if (!traceable(origin, dir, tmin, tmax)) return std::nullopt;
+    TraceContext ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.skip_a = skip;
+    ctx.hit_curve_backfaces = impl_->curve_backfaces == CurveBackfaces::Hit;
+    RTCRayHit rh = ray_hit(origin, dir, tmin, tmax);
     rtcIntersect1(impl_->rtc_scene, &ctx.rtc, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     Hit hit;
@@ -634,19 +641,7 @@ bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip
     ctx.skip_a = skip_a;
     ctx.hit_curve_backfaces = impl_->curve_backfaces == CurveBackfaces::Hit;
     ctx.skip_b = skip_b;
-    RTCRay ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.tnear = tmin;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.time = 0.0f;
-    ray.tfar = tmax;
-    ray.mask = ~0u;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = ray_hit(origin, dir, tmin, tmax).ray;
     rtcOccluded1(impl_->rtc_scene, &ctx.rtc, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to −inf on a hit
 }
@@ -661,22 +656,7 @@ std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, 
     ctx.skip_a = skip_a;
     ctx.skip_b = skip_b;
     ctx.strands = &strands;
-    RTCRayHit rh;
-    rh.ray.org_x = origin.x;
-    rh.ray.org_y = origin.y;
-    rh.ray.org_z = origin.z;
-    rh.ray.tnear = tmin;
-    rh.ray.dir_x = dir.x;
-    rh.ray.dir_y = dir.y;
-    rh.ray.dir_z = dir.z;
-    rh.ray.time = 0.0f;
-    rh.ray.tfar = tmax;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = ray_hit(origin, dir, tmin, tmax);
     rtcIntersect1(impl_->rtc_scene, &ctx.rtc, &rh);
     std::optional<Hit> mesh;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
