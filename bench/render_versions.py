@@ -112,8 +112,23 @@ class OldHair:
 
     def as_dict(self):
         values = self.hair.as_dict()
-        del values["cycles"]
+        for name in NEW_HAIR_FIELDS:
+            values.pop(name, None)
         return values
+
+
+NEW_HAIR_FIELDS = ("cycles", "model", "aspect_ratio", "reflection", "transmission",
+                   "secondary_reflection")
+"""HairParameters fields the binding before ABI v2 does not know (Chiang 3.4 only)."""
+
+
+def old_surface(material):
+    """A surface material as the old binding's Lambertian one: its root node's colour and
+    emission (the comparison scenes' meshes are Diffuse, or Principled with a Base Color)."""
+    root = material.nodes[-1]
+    material.albedo = tuple(root.get("base_color", root.get("color", (0.8, 0.8, 0.8))))[:3]
+    material.emission = tuple(root.get("emission", (0.0, 0.0, 0.0)))[:3]
+    material.kind = "DIFFUSE"
 
 
 def for_old_binding(data):
@@ -123,6 +138,8 @@ def for_old_binding(data):
     for material in data.materials:
         if material.hair is not None:
             material.hair = OldHair(material.hair)
+        elif material.kind == "SURFACE":
+            old_surface(material)
     return data
 
 
