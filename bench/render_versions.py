@@ -170,6 +170,8 @@ class Version:
         settings.samples, settings.max_bounces, settings.strategy = samples, data.bounces, strategy
         settings.multiple_weight, settings.n_h, settings.seed = 0.0, 2, seed
         settings.threads = THREADS
+        settings.integrator, settings.huang_sampling = "PATH", "STRATEGY"
+        settings.max_transparent_bounces = 8
         if self.name == "old":
             args = (self.library, settings)
         else:
