@@ -377,31 +377,9 @@ def is_render_depsgraph(depsgraph):
 # ---- Node trees ------------------------------------------------------------------------------
 
 def _follow_link(socket):
-    """The (node, socket) feeding ``socket``, through reroutes; (None, None) if unlinked."""
-    seen = set()
-    while socket is not None and socket.is_linked:
-        links = [link for link in socket.links if getattr(link, "is_valid", True)
-                 and not getattr(link, "is_muted", False)]
-        if not links:
-            return None, None
-        link = links[0]
-        node = link.from_node
-        if node.as_pointer() in seen:
-            return None, None
-        seen.add(node.as_pointer())
-        if node.type == "REROUTE":
-            socket = node.inputs[0] if len(node.inputs) else None
-            continue
-        if getattr(node, "mute", False):
-            # A muted node passes its internal link through, or outputs nothing.
-            through = [internal.from_socket for internal in node.internal_links
-                       if internal.to_socket == link.from_socket]
-            if not through:
-                return None, None
-            socket = through[0]
-            continue
-        return node, link.from_socket
-    return None, None
+    """The (node, socket) feeding ``socket``, through reroutes and muted nodes; (None, None)
+    if unlinked (node_eval.source)."""
+    return node_eval.source(socket)
 
 
 def output_node(node_tree):

@@ -189,7 +189,7 @@ def _live_links(socket):
             if getattr(link, "is_valid", True) and not getattr(link, "is_muted", False)]
 
 
-def _source(socket):
+def source(socket):
     """The (node, output socket) feeding ``socket``, through reroutes and muted nodes; (None,
     None) when nothing does."""
     seen = set()
@@ -236,7 +236,7 @@ def _input(node, identifier):
 
 def compile_socket(socket, components, stack=()):
     """The field feeding an input ``socket``, converted to ``components``."""
-    node, output = _source(socket)
+    node, output = source(socket)
     if node is None:
         return convert(_default(socket), components)
     if node.as_pointer() in stack:
