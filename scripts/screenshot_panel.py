@@ -16,17 +16,20 @@ exits with code 1.
 import argparse
 import os
 import sys
-import traceback
 
 import bpy
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "blender"))
 import helpers  # noqa: E402  (scene-building helpers shared with the add-on's tests)
+from screenshot_ui import (Steps, largest_area, main_region, maximise,  # noqa: E402
+                           save_png, screenshot, window_and_screen)
 
 UI_SCALE = 1.0
-DELAY = 1.5  # seconds between steps, so Blender redraws in between
+STEPS = Steps("screenshot_panel")
+fail = STEPS.fail
 
 
 def parse_args():
@@ -44,30 +47,9 @@ def parse_args():
 ARGS = parse_args()
 
 
-def fail(message):
-    """Prints and quits with exit code 1."""
-    print("screenshot_panel: ERROR: " + message, flush=True)
-    os._exit(1)
-
-
-def window_and_screen():
-    """The (only) window and its screen."""
-    window = bpy.context.window_manager.windows[0]
-    return window, window.screen
-
-
-def main_region(area):
-    """The WINDOW region of an area."""
-    return next(r for r in area.regions if r.type == "WINDOW")
-
-
 def properties_area():
     """The Properties editor of the layout."""
-    _, screen = window_and_screen()
-    areas = [a for a in screen.areas if a.type == "PROPERTIES"]
-    if not areas:
-        fail("no Properties editor in the layout")
-    return max(areas, key=lambda a: a.width * a.height)
+    return largest_area("PROPERTIES")
 
 
 def build_scene():
@@ -105,20 +87,6 @@ def build_scene():
     return scene, sphere
 
 
-def maximise_properties():
-    """Maximises the Properties editor to the whole window (keeping its header and tabs).
-
-    The window's size (``blender -p``) sets the editor's width. (Dragging area edges with
-    screen.area_move needs the mouse outside every region, which Xvfb does not promise.)
-    """
-    window, screen = window_and_screen()
-    area = properties_area()
-    with bpy.context.temp_override(window=window, screen=screen, area=area):
-        result = bpy.ops.screen.screen_full_area(use_hide_panels=False)
-    if result != {"FINISHED"}:
-        fail("could not maximise the Properties editor: %s" % result)
-
-
 def show_tab(tab):
     """Shows ``tab`` ('RENDER', 'MATERIAL') in the Properties editor, scrolled to the top."""
     area = properties_area()
@@ -129,23 +97,6 @@ def show_tab(tab):
                                    region=main_region(area)):
         bpy.ops.view2d.scroll_up(deltay=100000)
     area.tag_redraw()
-
-
-def screenshot(path):
-    """Screenshots the Properties editor to ``path`` (full size); returns the RGBA pixels."""
-    window, screen = window_and_screen()
-    area = properties_area()
-    with bpy.context.temp_override(window=window, screen=screen, area=area,
-                                   region=main_region(area)):
-        result = bpy.ops.screen.screenshot_area(filepath=path, check_existing=False)
-    if result != {"FINISHED"} or not os.path.isfile(path):
-        fail("screenshot_area did not write %s (%s)" % (path, result))
-    image = bpy.data.images.load(path, check_existing=False)
-    width, height = image.size
-    pixels = np.empty(width * height * 4, dtype=np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    return pixels.reshape(height, width, 4)  # bottom row first
 
 
 def content_runs(pixels):
@@ -181,11 +132,7 @@ def last_open_panel_end(pixels):
 
 
 def save_crop(pixels, top, bottom, path):
-    """Writes rows ``top``..``bottom`` (top first, exclusive) of ``pixels`` as a PNG.
-
-    A byte image stores the screenshot's sRGB values as they are (``Image.save``, unlike
-    ``save_render``, applies no view transform).
-    """
+    """Writes rows ``top``..``bottom`` (top first, exclusive) of ``pixels`` as a PNG."""
     height, width = pixels.shape[:2]
     top, bottom = max(0, top), min(height, bottom)
     top_first = pixels[::-1]
@@ -193,29 +140,12 @@ def save_crop(pixels, top, bottom, path):
     # region background), not the next panel's header.
     margin = np.repeat(top_first[height - 8:height - 7], int(8 * UI_SCALE), axis=0)
     crop = np.concatenate((top_first[top:bottom], margin))[::-1]  # back to bottom row first
-    rows = crop.shape[0]
-    image = bpy.data.images.new(os.path.basename(path), width, rows, alpha=False)
-    image.pixels.foreach_set(np.ascontiguousarray(crop, dtype=np.float32).reshape(-1))
-    image.filepath_raw = path
-    image.file_format = "PNG"
-    image.save()
-    bpy.data.images.remove(image)
-    print("screenshot_panel: wrote %s (%dx%d, %d bytes)"
-          % (path, width, rows, os.path.getsize(path)), flush=True)
+    save_png(crop, path, "screenshot_panel")
 
 
 # ---- Steps (timers) -------------------------------------------------------------------------
 
-STEPS = []
-
-
-def step(function):
-    """Registers ``function`` as the next step."""
-    STEPS.append(function)
-    return function
-
-
-@step
+@STEPS.add
 def setup():
     """Builds the scene, bakes, maximises the Properties editor and shows the Render tab."""
     prefs = bpy.context.preferences
@@ -231,42 +161,33 @@ def setup():
         result = bpy.ops.hairis.bake_tables()  # exec: synchronous
         if result != {"FINISHED"}:
             fail("baking the sampling tables failed: %s" % result)
-    maximise_properties()
+    maximise(properties_area())
     show_tab("RENDER")
 
 
-@step
+@STEPS.add
 def render_tab():
     """Screenshots the Render tab: down to Hair Sampling Strategy and the library status."""
-    pixels = screenshot(os.path.join(ARGS.keep or ARGS.workdir, "render_full.png"))
+    pixels = screenshot(properties_area(),
+                        os.path.join(ARGS.keep or ARGS.workdir, "render_full.png"))
     save_crop(pixels, 0, last_open_panel_end(pixels),
               os.path.join(ARGS.output, "panel_render.png"))
     show_tab("MATERIAL")
 
 
-@step
+@STEPS.add
 def material_tab():
     """Screenshots the Material tab: slots, Surface node view, Hairis Sampling Tables."""
-    pixels = screenshot(os.path.join(ARGS.keep or ARGS.workdir, "material_full.png"))
+    pixels = screenshot(properties_area(),
+                        os.path.join(ARGS.keep or ARGS.workdir, "material_full.png"))
     save_crop(pixels, 0, last_open_panel_end(pixels),
               os.path.join(ARGS.output, "panel_material.png"))
 
 
-@step
+@STEPS.add
 def finish():
     """Quits."""
     bpy.ops.wm.quit_blender()
 
 
-def run_steps():
-    """Runs the next step; re-arms itself until all have run."""
-    try:
-        STEPS.pop(0)()
-    except Exception:  # noqa: BLE001 - any failure ends Blender with exit code 1
-        traceback.print_exc()
-        fail("a step failed")
-    return DELAY if STEPS else None
-
-
-bpy.context.preferences.view.show_splash = False
-bpy.app.timers.register(run_steps, first_interval=DELAY, persistent=True)
+STEPS.start()
