@@ -21,7 +21,10 @@ what the running Blender has, never from socket indices), so the other modules r
   (``use_soft_falloff``, default on) from 4.1: :func:`cycles_lights`, :func:`soft_falloff`;
 - whether rays hit a hair strand from inside its tube (``hairis_render``'s
   ``curve_backfaces``): Cycles with Embree 3 (Blender 3.4) culls those back faces, Blender's
-  builds from 3.6 use Embree 4, whose curve filter does not: :func:`curve_backfaces`.
+  builds from 3.6 use Embree 4, whose curve filter does not: :func:`curve_backfaces`;
+- how many transparent surfaces a path crosses under Max Bounces: Transparent
+  (``hairis_render``'s ``transparent_limit``): the setting + 1 up to 4.5, the setting (at
+  least 1) from 5.0, where Cycles stores the setting itself: :func:`transparent_limit`.
 """
 
 import bpy
@@ -177,3 +180,14 @@ def curve_backfaces(version=None):
     from inside; Cycles with Embree 3 lets it pass, with Embree 4 it is a hit.
     """
     return "hit" if tuple(version or running_version()) >= EMBREE_4_CURVES else "ignore"
+
+
+CYCLES_5_TRANSPARENT_LIMIT = (5, 0, 0)
+"""From 5.0 Cycles stores Max Bounces: Transparent as set, no longer the setting + 1."""
+
+
+def transparent_limit(version=None):
+    """``transparent_limit`` of the running Blender's Cycles: 'setting' from 5.0, else
+    'plus_one' (a path crosses at most max(setting, 1) or setting + 1 transparent surfaces)."""
+    version = tuple(version or running_version())
+    return "setting" if version >= CYCLES_5_TRANSPARENT_LIMIT else "plus_one"

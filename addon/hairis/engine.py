@@ -81,10 +81,12 @@ def light_options(light):
 
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``, and how the running Blender's
-    Cycles traces curves (:func:`compat.curve_backfaces`)."""
+    Cycles traces curves (:func:`compat.curve_backfaces`) and limits transparent crossings
+    (:func:`compat.transparent_limit`)."""
     return {"integrator": settings.integrator.lower(),
             "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
             "max_transparent_bounces": int(settings.max_transparent_bounces),
+            "transparent_limit": compat.transparent_limit(),
             "strategy": settings.strategy.lower(),
             "huang_sampling": settings.huang_sampling.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),

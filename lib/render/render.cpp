@@ -209,6 +209,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     float bsdf_pdf = 0.0f;
     bool use_mis = false;  // camera rays take emission at full weight
     int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0, transparent_bounces = 0;
+    const int crossings = transparent_crossings(TransparentLimit(settings.transparent_limit),
+                                                settings.max_transparent_bounces);
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     const bool dual = settings.integrator == int(Integrator::DualScattering);
     bool from_dual_hair = false;  // the ray left a hair vertex shaded by dual scattering
@@ -273,7 +275,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const Bsdf bsdf(material, sp, wo, context, inputs, scratch);
         if (bsdf.transparent()) {
             // The same ray goes on beyond this curve.
-            last_segment = ++transparent_bounces > settings.max_transparent_bounces;
+            last_segment = ++transparent_bounces >= crossings;
             tmin = hit->t;
             skip = sp.self;
             continue;
@@ -391,6 +393,10 @@ struct Tile {
 };
 
 }  // namespace
+
+int transparent_crossings(TransparentLimit limit, int setting) {
+    return limit == TransparentLimit::Setting ? std::max(setting, 1) : setting + 1;
+}
 
 float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo) {
     const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);

@@ -93,6 +93,19 @@ enum class HuangSampling {
     Cycles = 1,
 };
 
+/// How Max Bounces: Transparent limits a path's transparent crossings, as each Cycles stores
+/// the setting.
+enum class TransparentLimit {
+    /// Cycles up to 4.5 (kernel data transparent_max_bounce = setting + 1): setting + 1.
+    PlusOne = 0,
+    /// Cycles 5.0 (transparent_max_bounce = setting): the setting, and 1 for a setting of 0.
+    Setting = 1,
+};
+
+/// The transparent surfaces a path may cross under `limit` with Max Bounces: Transparent
+/// `setting` (>= 0); the surface after the last one ends the path.
+int transparent_crossings(TransparentLimit limit, int setting);
+
 /// How to render.
 struct RenderSettings {
     /// An Integrator: "path" or "dual_scattering".
@@ -116,9 +129,11 @@ struct RenderSettings {
     /// Same seed, same image.
     std::uint64_t seed = 0;
     /// Cycles' Max Bounces: Transparent, in [0, 1024] (Blender's default 8): a path crosses at
-    /// most this many + 1 transparent surfaces (Cycles stores the setting + 1); the surface
+    /// most transparent_crossings(transparent_limit, this) transparent surfaces; the surface
     /// after the last one ends it (emission only).
     int max_transparent_bounces = 8;
+    /// A TransparentLimit: "plus_one" (Cycles up to 4.5) or "setting" (Cycles 5.0).
+    int transparent_limit = int(TransparentLimit::PlusOne);
     /// Threads to use, in [0, 1024]; 0 = oneTBB's default concurrency (all cores).
     int threads = 0;
     /// Tile edge in pixels, in [1, 4096].
@@ -143,6 +158,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("max_glossy_bounces", s.max_glossy_bounces, 0, 1024);
     f.field("max_transmission_bounces", s.max_transmission_bounces, 0, 1024);
     f.field("max_transparent_bounces", s.max_transparent_bounces, 0, 1024);
+    f.choice("transparent_limit", s.transparent_limit, {"plus_one", "setting"});
     f.field("seed", s.seed);
     f.field("threads", s.threads, 0, 1024);
     f.field("tile_size", s.tile_size, 1, 4096);

@@ -803,7 +803,8 @@ TEST(Render, PixelCoverageIsHalfTheFootprintInRadii) {
 }
 
 // The hair's share of an orthographic image with a transparent film: the mean alpha.
-double hair_coverage(const std::vector<HairCurves> &curves, float aspect_ratio, int max_transparent) {
+double hair_coverage(const std::vector<HairCurves> &curves, float aspect_ratio, int max_transparent,
+                     TransparentLimit limit = TransparentLimit::PlusOne) {
     SceneDesc d;
     d.materials = {huang_hair(aspect_ratio)};
     d.curves = curves;
@@ -814,6 +815,7 @@ double hair_coverage(const std::vector<HairCurves> &curves, float aspect_ratio, 
     s.max_bounces = 0;
     s.film_transparent = true;
     s.max_transparent_bounces = max_transparent;
+    s.transparent_limit = int(limit);
     const auto img = render_ok(scene, s);
     double alpha = 0;
     for (std::size_t i = 3; i < img.size(); i += 4) alpha += img[i];
@@ -849,6 +851,34 @@ TEST(Render, TransparentCrossingsStopAfterTheLimit) {
     }
     EXPECT_NEAR(hair_coverage(stack, b, 2), r * b, 0.01 * r);
     EXPECT_NEAR(hair_coverage(stack, b, 1), r, 0.01 * r);
+}
+
+TEST(Render, Cycles50TransparentLimitIsTheSetting) {
+    // The same stack under transparent_limit=setting (Cycles 5.0 stores the setting itself):
+    // 3 allows the 3 crossings (alpha r·b), 2 ends on the third fiber (alpha r); 0 and 1 both
+    // allow one crossing (the second fiber ends the ray), as Cycles 5.0's path state does.
+    const float r = 0.2f, b = 0.5f;
+    std::vector<HairCurves> stack;
+    for (int k = 0; k < 3; ++k) {
+        HairCurves c = straight_hair(0.0f, -float(k), r, 3.0f);
+        c.normals.assign(c.points.size(), Vec3{0, 0, 1});
+        stack.push_back(c);
+    }
+    const TransparentLimit setting = TransparentLimit::Setting;
+    EXPECT_NEAR(hair_coverage(stack, b, 3, setting), r * b, 0.01 * r);
+    EXPECT_NEAR(hair_coverage(stack, b, 2, setting), r, 0.01 * r);
+    const std::vector<HairCurves> two(stack.begin(), stack.begin() + 2);
+    EXPECT_NEAR(hair_coverage(two, b, 1, setting), r, 0.01 * r);
+    EXPECT_NEAR(hair_coverage(two, b, 0, setting), r, 0.01 * r);
+    EXPECT_NEAR(hair_coverage(two, b, 2, setting), r * b, 0.01 * r);
+}
+
+TEST(Render, TransparentCrossingsFollowEachCyclesStorage) {
+    EXPECT_EQ(transparent_crossings(TransparentLimit::PlusOne, 0), 1);
+    EXPECT_EQ(transparent_crossings(TransparentLimit::PlusOne, 4), 5);
+    EXPECT_EQ(transparent_crossings(TransparentLimit::Setting, 0), 1);
+    EXPECT_EQ(transparent_crossings(TransparentLimit::Setting, 1), 1);
+    EXPECT_EQ(transparent_crossings(TransparentLimit::Setting, 4), 4);
 }
 
 // A thin clear Huang fiber (σ = 0, α = 0.3, aspect 1, offset 2°) across the view, narrower than

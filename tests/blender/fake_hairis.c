@@ -107,7 +107,7 @@ static const char *const kinds[][2] = {
                "frame=0.5,0.5,-1,0.5,-0.5,-1,-0.5,-0.5,-1,-0.5,0.5,-1;width=64;height=64;"
                "clip_start=0;clip_end=3.40282347e+38"},
     {"render", "integrator=path;samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
-               "max_transmission_bounces=12;max_transparent_bounces=8;"
+               "max_transmission_bounces=12;max_transparent_bounces=8;transparent_limit=plus_one;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "huang_sampling=strategy;strategy=table;multiple_weight=0;n_h=2;curve_backfaces=ignore"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -1318,7 +1318,7 @@ typedef struct render_settings {
     long long samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
         max_transmission_bounces, max_transparent_bounces, threads, tile_size, rr_start_bounce, n_h;
     unsigned long long seed;
-    int integrator, strategy, film_transparent, curve_backfaces, huang_sampling;
+    int integrator, strategy, film_transparent, curve_backfaces, huang_sampling, transparent_limit;
     double multiple_weight;
 } render_settings;
 
@@ -1329,6 +1329,7 @@ static int read_render_settings(const char *text, render_settings *r)
     const char *flags[4] = {"0", "1", "false", "true"};
     const char *backfaces[2] = {"ignore", "hit"};
     const char *integrators[2] = {"path", "dual_scattering"};
+    const char *transparent_limits[2] = {"plus_one", "setting"};
     if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
         word(&o, "integrator", integrators, 2, &r->integrator) != HAIRIS_OK ||
         integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
@@ -1337,6 +1338,7 @@ static int read_render_settings(const char *text, render_settings *r)
         integer_in(&o, "max_glossy_bounces", 0, 1024, &r->max_glossy_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_transmission_bounces", 0, 1024, &r->max_transmission_bounces) != HAIRIS_OK ||
         integer_in(&o, "max_transparent_bounces", 0, 1024, &r->max_transparent_bounces) != HAIRIS_OK ||
+        word(&o, "transparent_limit", transparent_limits, 2, &r->transparent_limit) != HAIRIS_OK ||
         integer_in(&o, "threads", 0, 1024, &r->threads) != HAIRIS_OK ||
         integer_in(&o, "tile_size", 1, 4096, &r->tile_size) != HAIRIS_OK ||
         integer_in(&o, "rr_start_bounce", 1, 1024, &r->rr_start_bounce) != HAIRIS_OK ||
@@ -1369,11 +1371,12 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
                "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
                "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
-               "integrator=%d huang_sampling=%d\n",
+               "integrator=%d huang_sampling=%d transparent_limit=%s\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
-            r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling);
+            r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling,
+            r->transparent_limit ? "setting" : "plus_one");
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

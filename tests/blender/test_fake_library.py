@@ -203,6 +203,9 @@ def test_engine_renders_scene():
     # Cycles with Embree 4 (Blender's builds from 3.6) hits strands from inside their tube.
     backfaces = "hit" if helpers.VERSION >= (3, 6, 0) else "ignore"
     assert summary_value(summary, "curve_backfaces") == backfaces, summary
+    # Cycles 5.0 stores Max Bounces: Transparent as set (4.5 and older: the setting + 1).
+    limit = "setting" if helpers.VERSION >= (5, 0, 0) else "plus_one"
+    assert summary_value(summary, "transparent_limit") == limit, summary
     data = export.export_scene(bpy.context.evaluated_depsgraph_get())
     assert int(summary_value(summary, "curve_sets")) == 2
     curves = {c.source: c for c in data.curves}

@@ -318,6 +318,7 @@ static void test_defaults(void)
     expect_default("render", "max_diffuse_bounces", "4");
     expect_default("render", "max_transmission_bounces", "12");
     expect_default("render", "max_transparent_bounces", "8");
+    expect_default("render", "transparent_limit", "plus_one");
     expect_default("render", "tile_size", "16");
     expect_default("render", "film_transparent", "0");
     expect_default("render", "curve_backfaces", "ignore");
