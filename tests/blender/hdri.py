@@ -47,6 +47,19 @@ def write_hdr(path, width, height, texel):
             f.write(row)
 
 
+def sky_world(width=64, height=32, sun=(44, 9), sun_value=(60.0, 55.0, 45.0)):
+    """texel(x, y) of a blue sky brightening towards the zenith, a brown ground and a 2 × 2
+    "sun" of ``sun_value`` whose top-left texel is ``sun`` (x, y from the top)."""
+    def texel(x, y):
+        if sun[0] <= x <= sun[0] + 1 and sun[1] <= y <= sun[1] + 1:
+            return sun_value
+        elevation = 0.5 - (y + 0.5) / height  # +0.5 at the zenith, -0.5 at the nadir
+        if elevation < 0.0:
+            return (0.08, 0.06, 0.04)
+        return (0.25 + 0.3 * elevation, 0.35 + 0.4 * elevation, 0.6 + 0.5 * elevation)
+    return texel
+
+
 def spot_world(width=64, height=32, spot=(40, 12), spot_value=50.0, background=0.05):
     """texel(x, y) of a dim grey world with one bright texel at `spot` (x, y from the top)."""
     def texel(x, y):

@@ -23,6 +23,9 @@ import addon_utils  # noqa: I100
 import numpy as np
 from mathutils import Euler, Vector
 
+import compare_stats  # siblings: whoever imports helpers has this folder on sys.path
+import hdri
+
 SKIP = 77
 RESULT_PREFIX = "hairis-test-result: "
 """run_test.py judges a test by the last line starting with this (not only by exit codes)."""
@@ -265,11 +268,21 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     sphere.scale = (scale, scale, scale)
     sphere.data.materials.append(skin_material)
     sphere.data.materials.append(hair_material)
-    modifier = sphere.modifiers.new("Hair", "PARTICLE_SYSTEM")
+    add_hair_particles(sphere, count, material_index=2, children=children)
+    return sphere
+
+
+def add_hair_particles(obj, count, material_index, hair_length=0.4, children=None,
+                       density_group=""):
+    """A hair particle system on mesh ``obj`` shaded with its material slot ``material_index``
+    (1-based); ``density_group``: a vertex group whose weights are the emission density.
+    Returns the particle settings."""
+    modifier = obj.modifiers.new("Hair", "PARTICLE_SYSTEM")
+    modifier.particle_system.vertex_group_density = density_group
     settings = modifier.particle_system.settings
     settings.type = "HAIR"
     settings.count = count
-    settings.hair_length = 0.4
+    settings.hair_length = hair_length
     settings.render_step = 3
     settings.display_step = 2
     settings.root_radius = 1.0
@@ -277,7 +290,7 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     settings.radius_scale = 0.02
     settings.shape = 0.3
     settings.use_close_tip = True
-    settings.material = 2
+    settings.material = material_index
     if children:
         settings.child_type = "INTERPOLATED"
         # Display amount of children per parent: child_nbr, child_percent from 4.0.
@@ -285,7 +298,7 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
         settings.rendered_child_count = children
     else:
         settings.child_type = "NONE"
-    return sphere
+    return settings
 
 
 def make_curves(scene, hair_material, location=(0.0, 0.0, 1.0), rotation=(0.0, 0.0, 1.2),
@@ -388,6 +401,17 @@ def match_cycles(scene, samples, bounces):
     scene.view_settings.look = "None"
 
 
+def match_engines(scene, samples, bounces):
+    """Cycles as Hairis needs it (``match_cycles``) and Hairis at the same samples and bounce
+    limit on every core."""
+    match_cycles(scene, samples, bounces)
+    settings = scene.hairis
+    settings.samples = samples
+    settings.max_bounces = bounces
+    settings.threads = 0
+    bpy.context.view_layer.update()
+
+
 def set_samples(scene, samples):
     """The same sample count for Cycles and Hairis."""
     scene.cycles.samples = samples
@@ -427,14 +451,9 @@ def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_o
                rotation=(math.radians(60), 0.0, math.radians(-40)))
     for extra in extras:
         extra(scene)
-    match_cycles(scene, samples, bounces)
-    settings = scene.hairis
-    settings.samples = samples
-    settings.max_bounces = bounces
-    settings.strategy = strategy
-    settings.auto_bake = True
-    settings.threads = 0
-    bpy.context.view_layer.update()
+    match_engines(scene, samples, bounces)
+    scene.hairis.strategy = strategy
+    scene.hairis.auto_bake = True
     return scene
 
 
@@ -461,6 +480,158 @@ def render_pixels(scene, engine, seed, workdir, name=None):
     bpy.data.images.remove(image)
     os.remove(path)
     return pixels.reshape(height, width, 4)[..., :3].astype(np.float64), seconds
+
+
+COMPARE_SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
+COMPARE_SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+"""Samples per image and images per engine of the comparisons (environment overrides)."""
+ENGINES = ("CYCLES", "HAIRIS")
+
+
+def setup_compare():
+    """:func:`setup` for a test that renders with libhairis (skipped while it is not built);
+    returns the arguments."""
+    args, package = setup()
+    if not os.path.isfile(bundled_library(package)):
+        skip("libhairis.so is not built yet (looked for %s)" % bundled_library(package))
+    return args
+
+
+def render_engines(scene, seeds, workdir, note=""):
+    """{engine: (seeds, height, width, 3) stack} of Cycles and Hairis at seeds 1..``seeds``.
+
+    Every pixel must be finite; HAIRIS_COMPARE_DUMP names an .npz file to keep the stacks in.
+    """
+    stacks, times = {}, {}
+    for engine in ENGINES:
+        images = []
+        times[engine] = 0.0
+        for seed in range(1, seeds + 1):
+            image, seconds = render_pixels(scene, engine, seed, workdir)
+            assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % engine
+            images.append(image)
+            times[engine] += seconds
+        stacks[engine] = np.stack(images)
+    print("render time for %d x %d samples: cycles %.1f s, hairis %.1f s%s"
+          % (seeds, scene.hairis.samples, times["CYCLES"], times["HAIRIS"], note))
+    dump = os.environ.get("HAIRIS_COMPARE_DUMP")
+    if dump:
+        np.savez(dump, cycles=stacks["CYCLES"], hairis=stacks["HAIRIS"])
+    return stacks
+
+
+def compare_with_cycles(scene, seeds, workdir, block, note=""):
+    """Renders both engines (``render_engines``) and asserts compare_stats.compare on the
+    stacks; returns its figures."""
+    stacks = render_engines(scene, seeds, workdir, note)
+    return compare_stats.compare(stacks["CYCLES"], stacks["HAIRIS"], block)
+
+
+def make_principled_material(name, **inputs):
+    """A Principled BSDF material with ``inputs`` set; returns (material, node)."""
+    material = bpy.data.materials.new(name)
+    use_nodes(material)
+    node = material.node_tree.nodes["Principled BSDF"]
+    for key, value in inputs.items():
+        socket(node, key).default_value = value
+    return material, node
+
+
+def make_sphere(name, radius, location, material, scale=(1.0, 1.0, 1.0)):
+    """A smooth-shaded 48×24 UV sphere (with its UV map) of ``material``."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=radius, location=location, segments=48,
+                                         ring_count=24)
+    obj = bpy.context.view_layer.objects.active
+    obj.name = name
+    obj.scale = scale
+    bpy.ops.object.shade_smooth()
+    obj.data.materials.append(material)
+    return obj
+
+
+def skin_pixels(width=64, height=32):
+    """RGBA floats (bottom row first): a skin tone, darker bands along u, spots."""
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    uu, vv = np.meshgrid(u, v)
+    base = np.array([0.85, 0.62, 0.5])
+    band = 0.75 + 0.25 * np.cos(2.0 * math.pi * 6.0 * uu)
+    spots = np.where((np.sin(17.0 * uu) * np.sin(11.0 * vv * math.pi)) > 0.8, 0.6, 1.0)
+    rgb = base[None, None, :] * (band * spots)[:, :, None]
+    rgb[..., 2] *= 0.8 + 0.2 * vv
+    rgba = np.concatenate([rgb, np.ones((height, width, 1))], axis=2)
+    return rgba.astype(np.float32)
+
+
+def make_textured_principled(name, path, pixels, **inputs):
+    """A Principled BSDF material whose Base Color is an Image Texture (on the UV map) of
+    ``pixels`` (``skin_pixels``' layout), saved as an 8-bit sRGB PNG at ``path``; returns
+    (material, node)."""
+    height, width = pixels.shape[:2]
+    image = bpy.data.images.new(name + "Paint", width, height, alpha=False)
+    image.pixels.foreach_set(pixels.reshape(-1))
+    image.filepath_raw = path
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+    material, node = make_principled_material(name, **inputs)
+    tree = material.node_tree
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.load(path)
+    tree.links.new(texture.outputs["Color"], socket(node, "Base Color"))
+    return material, node
+
+
+def vary_melanin(material, random_color=0.6, random_roughness=0.3):
+    """Makes a Melanin hair material's melanin vary per strand (Random Color, Random unlinked:
+    Cycles' per-strand number) and from root to tip (a ColorRamp on Hair Info Intercept)."""
+    tree = material.node_tree
+    node = tree.nodes["Principled Hair BSDF"]
+    socket(node, "Random Color").default_value = random_color
+    socket(node, "Random Roughness").default_value = random_roughness
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.75, 0.75, 0.75, 1.0)  # dark roots
+    ramp.color_ramp.elements[1].color = (0.15, 0.15, 0.15, 1.0)  # light tips
+    ramp.color_ramp.elements[1].position = 0.9
+    tree.links.new(info.outputs["Intercept"], socket(ramp, "Fac"))
+    tree.links.new(ramp.outputs["Color"], socket(node, "Melanin"))
+
+
+def make_floor(size, color=(0.5, 0.5, 0.5, 1.0)):
+    """A square diffuse floor of side ``size`` at z = 0, centred on the origin."""
+    material = make_diffuse_material("Floor", color)
+    bpy.ops.mesh.primitive_plane_add(size=size, location=(0.0, 0.0, 0.0))
+    floor = bpy.context.view_layer.objects.active
+    floor.data.materials.append(material)
+    return floor
+
+
+def make_key_spot(scene, location):
+    """The comparisons' spot light (radius 0.15, a 50° cone, blend 0.3, 400 W) at ``location``,
+    aimed down towards the origin from the front right."""
+    return make_light(scene, "SPOT", "Spot", location=location,
+                      rotation=(math.radians(40), 0.0, math.radians(48)), energy=400.0,
+                      spot_size=math.radians(50), spot_blend=0.3, shadow_soft_size=0.15)
+
+
+def make_hdri_world(scene, path, texel, rotation, strength, size=(64, 32)):
+    """A world whose Background Color is an Environment Texture of the Radiance HDR that
+    hdri.write_hdr makes of ``texel`` at ``size`` (width, height), looked up through a Mapping
+    rotation (radians, XYZ) of the Generated coordinates; World > Settings > Sampling Auto."""
+    hdri.write_hdr(path, size[0], size[1], texel)
+    world = make_world(scene, color=(0.0, 0.0, 0.0), strength=strength)
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    texture = nodes.new("ShaderNodeTexEnvironment")
+    texture.image = bpy.data.images.load(path)
+    mapping = nodes.new("ShaderNodeMapping")
+    socket(mapping, "Rotation").default_value = rotation
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    links.new(coordinates.outputs["Generated"], socket(mapping, "Vector"))
+    links.new(mapping.outputs["Vector"], socket(texture, "Vector"))
+    links.new(texture.outputs["Color"], socket(nodes["Background"], "Color"))
+    world.cycles.sampling_method = "AUTOMATIC"
+    return world
 
 
 # ---- UI stubs --------------------------------------------------------------------------------

@@ -18,18 +18,12 @@ import os
 import sys
 
 import bpy
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import compare_stats  # noqa: E402
 import helpers  # noqa: E402
 
-ARGS, PACKAGE = helpers.setup()
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
-SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
-SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+ARGS = helpers.setup_compare()
+SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
 BOUNCES = 4
 BLOCK = 4
 STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
@@ -43,32 +37,12 @@ def make_scene():
                                       curves_offset=math.radians(-4.0), extras=EXTRA_HAIR)
 
 
-def render(scene, engine, seed):
-    """Renders with ``engine``; returns (linear RGB array, seconds)."""
-    return helpers.render_pixels(scene, engine, seed, ARGS.workdir)
-
-
 def test_hairis_matches_cycles():
     """Cycles and Hairis render the same scene to the same image within the noise."""
     scene = make_scene()
     blend = os.path.join(ARGS.workdir, "compare.blend")
     bpy.ops.wm.save_as_mainfile(filepath=blend)
-    stacks, times = {}, {}
-    for engine in ("CYCLES", "HAIRIS"):
-        images = []
-        times[engine] = 0.0
-        for seed in range(1, SEEDS + 1):
-            image, seconds = render(scene, engine, seed)
-            assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % engine
-            images.append(image)
-            times[engine] += seconds
-        stacks[engine] = np.stack(images)
-    print("render time for %d x %d samples: cycles %.1f s, hairis %.1f s (%s)"
-          % (SEEDS, SAMPLES, times["CYCLES"], times["HAIRIS"], STRATEGY))
-    dump = os.environ.get("HAIRIS_COMPARE_DUMP")
-    if dump:
-        np.savez(dump, cycles=stacks["CYCLES"], hairis=stacks["HAIRIS"])
-    compare_stats.compare(stacks["CYCLES"], stacks["HAIRIS"], BLOCK)
+    helpers.compare_with_cycles(scene, SEEDS, ARGS.workdir, BLOCK, " (%s)" % STRATEGY)
 
 
 helpers.run([test_hairis_matches_cycles])

@@ -20,15 +20,10 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import compare_stats  # noqa: E402
 import helpers  # noqa: E402
 
-ARGS, PACKAGE = helpers.setup()
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
-SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
-SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+ARGS = helpers.setup_compare()
+SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
 BOUNCES = 4
 BLOCK = 4
 STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
@@ -47,18 +42,7 @@ def make_scene():
     strands.hair_length = 0.5
     curls.location = (0.75, 0.0, 0.1)
     curls.scale = (0.75, 0.75, 0.75)
-    hair = bpy.data.materials["Hair"]
-    tree = hair.node_tree
-    node = tree.nodes["Principled Hair BSDF"]
-    helpers.socket(node, "Random Color").default_value = 0.6
-    helpers.socket(node, "Random Roughness").default_value = 0.3
-    info = tree.nodes.new("ShaderNodeHairInfo")
-    ramp = tree.nodes.new("ShaderNodeValToRGB")
-    ramp.color_ramp.elements[0].color = (0.75, 0.75, 0.75, 1.0)  # dark roots
-    ramp.color_ramp.elements[1].color = (0.15, 0.15, 0.15, 1.0)  # light tips
-    ramp.color_ramp.elements[1].position = 0.9
-    tree.links.new(info.outputs["Intercept"], helpers.socket(ramp, "Fac"))
-    tree.links.new(ramp.outputs["Color"], helpers.socket(node, "Melanin"))
+    helpers.vary_melanin(bpy.data.materials["Hair"], random_color=0.6, random_roughness=0.3)
 
     dyed = bpy.data.materials["Dyed"]
     tree = dyed.node_tree
@@ -131,22 +115,7 @@ def test_strands_match_cycles():
     assert inputs["PARTICLES"]["melanin"][0] == "point"
     assert set(inputs["CURVES"]) == {"roughness"}, inputs["CURVES"].keys()
     assert not any("Principled Hair" in w for w in data.warnings), data.warnings
-    stacks, times = {}, {}
-    for engine in ("CYCLES", "HAIRIS"):
-        images = []
-        times[engine] = 0.0
-        for seed in range(1, SEEDS + 1):
-            image, seconds = helpers.render_pixels(scene, engine, seed, ARGS.workdir)
-            assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % engine
-            images.append(image)
-            times[engine] += seconds
-        stacks[engine] = np.stack(images)
-    print("render time for %d x %d samples: cycles %.1f s, hairis %.1f s (%s)"
-          % (SEEDS, SAMPLES, times["CYCLES"], times["HAIRIS"], STRATEGY))
-    dump = os.environ.get("HAIRIS_COMPARE_DUMP")
-    if dump:
-        np.savez(dump, cycles=stacks["CYCLES"], hairis=stacks["HAIRIS"])
-    compare_stats.compare(stacks["CYCLES"], stacks["HAIRIS"], BLOCK)
+    helpers.compare_with_cycles(scene, SEEDS, ARGS.workdir, BLOCK, " (%s)" % STRATEGY)
 
 
 helpers.run([test_strand_random_is_cycles, test_strands_match_cycles])
