@@ -357,6 +357,17 @@ def _uniform_scale(matrix):
     return float(abs(np.linalg.det(matrix[:3, :3])) ** (1.0 / 3.0))
 
 
+def _warn_non_uniform_scale(obj, matrix, warn):
+    """Cycles intersects the hair of a non-uniformly scaled object in object space (its tubes
+    squashed by the scale); hairis renders round tubes in world space: a warning says so."""
+    stretch = np.linalg.svd(matrix[:3, :3], compute_uv=False)
+    if stretch[0] > 0.0 and stretch[-1] < stretch[0] * (1.0 - 1e-4):
+        warn("object %r has a non-uniform scale (%s): Cycles renders its hair with strands "
+             "squashed by that scale, hairis with round strands of the mean radius; apply the "
+             "scale (Object > Apply > Scale) for the same image"
+             % (obj.name, ", ".join("%.3g" % v for v in stretch)))
+
+
 def _rgb(value):
     return tuple(float(v) for v in tuple(value)[:3])
 
@@ -1108,6 +1119,7 @@ class _Exporter:
             radius.data.foreach_get("value", radii)
         positions = positions.reshape(-1, 3).astype(np.float64)
         radii = radii.astype(np.float64) * _uniform_scale(matrix)
+        _warn_non_uniform_scale(obj, matrix, self.data.warn)
         kept = np.nonzero(np.diff(offsets.astype(np.int64)) >= 2)[0]  # Cycles' curve indices
         first, local, radii, dropped = _drop_short_curves(offsets, positions, radii)
         if dropped:
@@ -1223,6 +1235,8 @@ def export_particle_hair(exporter, obj):
         data.warn("object %r has a singular matrix; its particle hair is skipped" % obj.name)
         return
     scale = _uniform_scale(matrix)
+    if any(p.settings.type == "HAIR" for p in obj.particle_systems):
+        _warn_non_uniform_scale(obj, matrix, data.warn)
     exported = 0  # strands of this object so far: Cycles numbers them across its systems
     for psys in obj.particle_systems:
         settings = psys.settings

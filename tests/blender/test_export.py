@@ -522,6 +522,24 @@ def test_unsupported_things_warn():
     assert "Glass BSDF is not supported" in text, text
 
 
+def test_non_uniform_scale_on_hair_warns():
+    """Cycles squashes the strands of a non-uniformly scaled object; the export says so for
+    particle hair and Curves, and is silent for a uniform scale."""
+    helpers.make_test_scene()
+    head, curls = bpy.data.objects["Head"], bpy.data.objects["Curls"]
+    head.scale = (1.3, 1.3, 1.3)
+    curls.scale = (0.7, 0.7, 0.7)
+    bpy.context.view_layer.update()
+    text = "\n".join(export.export_context().warnings)
+    assert "non-uniform scale" not in text, text
+    head.scale = (0.85, 0.95, 1.15)
+    curls.scale = (1.0, 2.0, 1.0)
+    bpy.context.view_layer.update()
+    text = "\n".join(export.export_context().warnings)
+    for name in ("Head", "Curls"):
+        assert "object %r has a non-uniform scale" % name in text, text
+
+
 class StubSocket:
     """A node input with a name, an identifier and a value (for nodes no Blender makes)."""
 
@@ -991,6 +1009,7 @@ helpers.run([
     test_mesh_normals_and_uvs,
     test_surface_nodes,
     test_unsupported_things_warn,
+    test_non_uniform_scale_on_hair_warns,
     test_hair_node_models_and_missing_sockets,
     test_huang_rules_on_stub_nodes,
     test_huang_materials_export,
