@@ -350,7 +350,8 @@ def test_huang_material_by_bake_and_render():
         assert bpy.data.materials[name].hairis.table_image is not None, name
         assert tables.quick_state(lib, bpy.data.materials[name]) == "OK", name
     assert curly.hairis.baked_model == "huang2022", curly.hairis.baked_model
-    with lib.fiber_principled(tables.principled_struct(lib, tables.material_parameters(curly))) as fiber:
+    curly_node = tables.principled_struct(lib, tables.material_parameters(curly))
+    with lib.fiber_principled(curly_node) as fiber:
         status = tables.check_material(lib, curly, fiber)
     assert status.ok, status.message
     assert status.tables.info.get("huang_theta_o") == "24", status.tables.info
