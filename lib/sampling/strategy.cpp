@@ -89,7 +89,7 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
     if (!multiple) return table_error("multiple table: " + multiple.error().message);
     return SamplingTables{std::make_shared<const DirectTable>(std::move(direct).value()),
                           std::make_shared<const MultipleTable>(std::move(multiple).value()), t.model,
-                          canonical_parameters(t.parameters), t.near_field};
+                          canonical_parameters(t.parameters), t.near_field, nullptr};
 }
 
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &input) {

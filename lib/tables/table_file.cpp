@@ -498,11 +498,11 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     const std::string n_h_text = spec.get_string_attribute("hairis:n_h_values");
     if (!n_h_text.empty()) {
         std::stringstream in_text(n_h_text);
-        std::string item;
-        while (std::getline(in_text, item, ',')) {
+        std::string entry;
+        while (std::getline(in_text, entry, ',')) {
             char *end = nullptr;
-            const long v = std::strtol(item.c_str(), &end, 10);
-            if (item.empty() || *end != '\0' || v < 1 || v > 1024)
+            const long v = std::strtol(entry.c_str(), &end, 10);
+            if (entry.empty() || *end != '\0' || v < 1 || v > 1024)
                 return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + n_h_text + "\")");
             t.n_h_values.push_back(int(v));
         }
