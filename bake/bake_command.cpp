@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "fiber_options.h"
 #include "tables/bake.h"
+#include "sampling/huang_table.h"
 #include "tables/table_file.h"
 
 namespace hairis::cli {
@@ -48,11 +49,6 @@ int run_bake(const BakeFlags &flags) {
         std::cerr << "hairis-bake bake: " << spec.error().message << "\n";
         return kExitFailure;
     }
-    if (spec.value().kind == FiberKind::Huang) {
-        std::cerr << "hairis-bake bake: model = huang: this version bakes no tables for Huang fibers (the "
-                     "renderer samples them with strategy=uniform)\n";
-        return kExitFailure;
-    }
     Expected<std::unique_ptr<FiberModel>> model = spec.value().create_model();
     auto parameters = spec.value().parameters();
     if (!model || !parameters) {
@@ -86,10 +82,16 @@ int run_bake(const BakeFlags &flags) {
         return kExitFailure;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!flags.quiet)
-        std::cerr << "hairis-bake bake: wrote " << flags.output << " (" << tables.value().model << ", "
-                  << tables.value().theta_r_count() << " x " << tables.value().theta_i_count << " x "
-                  << tables.value().phi_count << ", " << seconds << " s)\n";
+    if (!flags.quiet) {
+        const TableSet &t = tables.value();
+        std::cerr << "hairis-bake bake: wrote " << flags.output << " (" << t.model << ", ";
+        if (t.huang)
+            std::cerr << t.huang->theta_o_count() << " theta_o x " << t.huang->phi_o_count() << " phi_o nodes, "
+                      << t.huang->theta_i_count << " x " << t.huang->phi_count << " cells";
+        else
+            std::cerr << t.theta_r_count() << " x " << t.theta_i_count << " x " << t.phi_count;
+        std::cerr << ", " << seconds << " s)\n";
+    }
     return 0;
 }
 
@@ -112,6 +114,14 @@ void add_bake_command(CLI::App &app, int &exit_code) {
         ->check(CLI::Range(1, 1024))->delimiter(',')->capture_default_str();
     cmd->add_option("--source", b.source, "exact (the model's distributions) or gaussian (the seed's PDFs)")
         ->check(CLI::IsMember({"exact", "gaussian"}))->capture_default_str();
+    cmd->add_option("--huang-theta-o", b.huang.theta_o, "Huang fibers: theta_o view nodes over [-90, 90] degrees")
+        ->check(CLI::Range(1, kMaxThetaRNodes))->capture_default_str();
+    cmd->add_option("--huang-phi-o", b.huang.phi_o, "Huang fibers: phi_o view nodes over [0, 90] degrees (1 if circular)")
+        ->check(CLI::Range(1, kMaxPhiONodes))->capture_default_str();
+    cmd->add_option("--huang-theta-i", b.huang.theta_i, "Huang fibers: theta_i cells over [-90, 90] degrees")
+        ->check(CLI::Range(1, kMaxTableAxisCells))->capture_default_str();
+    cmd->add_option("--huang-phi", b.huang.phi, "Huang fibers: phi_i - phi_o cells over [-180, 180] degrees")
+        ->check(CLI::Range(1, kMaxTableAxisCells))->capture_default_str();
     cmd->add_option("--threads", b.threads, "worker threads, 0 for all cores (the output does not depend on it)")
         ->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--output,-o", flags->output, "the EXR file to write (atomically)")->required();

@@ -8,15 +8,17 @@ namespace hairis::cli {
 void FiberOptions::add_to(CLI::App &cmd, const std::string &default_preset) {
     preset = default_preset;
     cmd.add_option("--preset", preset,
-                   "fiber preset: blonde, brunette (Marschner 2003, the seed's) or cycles-default "
-                   "(Chiang 2016 with the Principled Hair BSDF node's defaults)")
+                   "fiber preset: blonde, brunette (Marschner 2003, the seed's), cycles-default "
+                   "(Chiang 2016 with the Principled Hair BSDF node's defaults) or cycles-default-huang "
+                   "(Huang 2022 with the node's defaults)")
         ->check(CLI::IsMember(fiber_preset_names()))
         ->capture_default_str();
     cmd.add_option("--param-file", param_file,
                    "a parameter file of key = value lines applied over the preset "
                    "(keys: model, parametrization, color, melanin, melanin_redness, tint, absorption, "
                    "roughness, radial_roughness, coat, ior, offset_deg, random_color, random_roughness, "
-                   "random; Marschner: eta, sigma_a, alpha_r_deg, alpha_tt_deg, alpha_trt_deg, beta_r_deg, "
+                   "random; Huang also: aspect_ratio, reflection, transmission, secondary_reflection; "
+                   "Marschner: eta, sigma_a, alpha_r_deg, alpha_tt_deg, alpha_trt_deg, beta_r_deg, "
                    "beta_tt_deg, beta_trt_deg, eccentricity, glint_scale, caustic_width_deg, caustic_fade, "
                    "caustic_limit)")
         ->check(CLI::ExistingFile);

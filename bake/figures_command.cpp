@@ -8,6 +8,7 @@
 #include "fiber/distributions.h"
 #include "fiber/dual_scattering.h"
 #include "npy.h"
+#include "sampling/huang_table.h"
 #include "seed_fits.h"
 #include "seed_tables.h"
 #include "tables/table_file.h"
@@ -59,10 +60,30 @@ int plot(const char *script_env_name, const std::string &default_script, const s
 // The parts of a table file as arrays: far direct [θ_r][θ_i][φ], multiple [θ_r][n_h][θ_i],
 // theta_r nodes; near (Chiang) cell densities [θ_o][lobe][θ_i] (mass / cell width, each row
 // normalised to integrate to 1) and the cone flags [θ_o][lobe].
+// A Huang part (huang2022 files, which hold nothing else): its values [φ_o][θ_o][θ_i][φ] and
+// the view nodes.
+int run_huang_table_figures(const FiguresFlags &flags, const std::filesystem::path &dir, const TableSet &s) {
+    const HuangTableSet &h = *s.huang;
+    const std::vector<std::pair<std::string, Status>> writes = {
+        {"table_huang.npy", write_npy((dir / "table_huang.npy").string(), h.values,
+                                      {h.phi_o_nodes.size(), h.theta_o_nodes.size(), size_t(h.theta_i_count),
+                                       size_t(h.phi_count)})},
+        {"table_huang_theta_o.npy",
+         write_npy((dir / "table_huang_theta_o.npy").string(), h.theta_o_nodes, {h.theta_o_nodes.size()})},
+        {"table_huang_phi_o.npy",
+         write_npy((dir / "table_huang_phi_o.npy").string(), h.phi_o_nodes, {h.phi_o_nodes.size()})}};
+    for (const auto &[name, status] : writes)
+        if (status) return fail(status->message);
+    if (flags.data_only) return 0;
+    return plot("HAIRIS_TABLE_FIGURES_SCRIPT", HAIRIS_TABLE_FIGURES_SCRIPT, flags.output,
+                s.model + " table " + std::filesystem::path(flags.table).filename().string(), "the table's part PNGs");
+}
+
 int run_table_figures(const FiguresFlags &flags, const std::filesystem::path &dir) {
     Expected<TableSet> t = read_table_file(flags.table);
     if (!t) return fail(t.error().message);
     const TableSet &s = t.value();
+    if (s.huang) return run_huang_table_figures(flags, dir, s);
     const size_t nr = size_t(s.theta_r_count()), ni = size_t(s.theta_i_count), np = size_t(s.phi_count);
     std::vector<float> nodes(s.theta_r_nodes.begin(), s.theta_r_nodes.end());
     std::vector<float> n_h(s.n_h_values.begin(), s.n_h_values.end());

@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "core/math.h"
+#include "sampling/huang_table.h"
 #include "tables/table_file.h"
 
 namespace hairis::cli {
@@ -25,6 +26,29 @@ int run_inspect(const std::string &path) {
     std::printf("source:          %s\n", s.source.c_str());
     std::printf("parameters:\n");
     for (const auto &[name, value] : s.parameters) std::printf("  %-18s %.9g\n", name.c_str(), value);
+    std::error_code size_error;
+    const auto bytes = std::filesystem::file_size(path, size_error);
+    if (const HuangTableSet *h = s.huang.get()) {
+        const int rows = h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
+        std::printf("theta_o nodes:   %d (%.2f .. %.2f deg)\n", h->theta_o_count(), degrees(h->theta_o_nodes.front()),
+                    degrees(h->theta_o_nodes.back()));
+        std::printf("phi_o nodes:     %d (%.2f .. %.2f deg)\n", h->phi_o_count(), degrees(h->phi_o_nodes.front()),
+                    degrees(h->phi_o_nodes.back()));
+        std::printf("theta_i cells:   %d\n", h->theta_i_count);
+        std::printf("phi cells:       %d (of phi_i - phi_o)\n", h->phi_count);
+        std::printf("parts:\n");
+        std::printf("  huang  rows 0-%d: %d phi_o nodes x %d theta_o nodes x %d theta_i cells, %d phi cells "
+                    "(R cell value of luminance(f cos theta_i))\n",
+                    rows - 1, h->phi_o_count(), h->theta_o_count(), h->theta_i_count, h->phi_count);
+        std::printf("cells:           %zu\n", h->values.size());
+        std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", h->phi_count, rows,
+                    double(h->phi_count) * rows * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
+        std::printf("sampling table:  %.1f MB\n",
+                    double(HuangTable::bytes_needed(h->theta_o_count(), h->phi_o_count(), h->theta_i_count,
+                                                    h->phi_count)) / 1e6);
+        std::printf("valid:           yes (metadata, sizes, values and pixel hash checked)\n");
+        return 0;
+    }
     std::printf("theta_r nodes:   %d (%.2f .. %.2f deg)\n", s.theta_r_count(), degrees(s.theta_r_nodes.front()),
                 degrees(s.theta_r_nodes.back()));
     std::printf("theta_i cells:   %d\n", s.theta_i_count);
@@ -51,8 +75,6 @@ int run_inspect(const std::string &path) {
         rows += n.rows();
         width = std::max(width, n.theta_i_cells + 1);
     }
-    std::error_code size_error;
-    const auto bytes = std::filesystem::file_size(path, size_error);
     std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", width, rows,
                 double(width) * rows * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
     std::printf("valid:           yes (metadata, sizes, values and pixel hash checked)\n");

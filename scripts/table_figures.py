@@ -3,7 +3,9 @@
 table_far.png: the direct-scattering distribution over (θ_i, φ) at five θ_r nodes (log scale);
 table_multiple.png: the multiple-scattering distribution over θ_i per n_h (rows) and θ_r (x);
 table_near.png (Chiang): per lobe, the near field's θ_i density per θ_o node (the rows TABLE
-samples single scattering from), with the nodes that draw from the fiber's cone marked.
+samples single scattering from), with the nodes that draw from the fiber's cone marked;
+table_huang.png (Huang, whose files hold only this part): the Huang table's density over
+(θ_i, φ_i − φ_o) per φ_o node (rows) at five θ_o nodes (columns), log scale.
 """
 
 import argparse
@@ -90,11 +92,42 @@ def draw_near(d, label):
     plt.close(fig)
 
 
+def draw_huang(d, label):
+    values = np.load(os.path.join(d, "table_huang.npy"))
+    theta_o = np.degrees(np.load(os.path.join(d, "table_huang_theta_o.npy")))
+    phi_o = np.degrees(np.load(os.path.join(d, "table_huang_phi_o.npy")))
+    picks = np.unique(np.linspace(0, len(theta_o) - 1, 5).round().astype(int))
+    # Each slice as a density per steradian: values over the slice's sum × a cell's solid angle.
+    n_i, n_p = values.shape[2], values.shape[3]
+    edges = np.sin(np.linspace(-np.pi / 2, np.pi / 2, n_i + 1))
+    solid = (edges[1:] - edges[:-1])[:, None] * (2 * np.pi / n_p)
+    total = (values * solid).sum(axis=(2, 3), keepdims=True)
+    density = np.where(total > 0, values / np.where(total > 0, total, 1.0), 0.0)
+    fig, axes = plt.subplots(len(phi_o), len(picks), figsize=(3.2 * len(picks), 2.8 * len(phi_o)),
+                             squeeze=False, constrained_layout=True)
+    norm = positive_norm(density[:, picks])
+    for q in range(len(phi_o)):
+        for ax, r in zip(axes[q], picks):
+            image = ax.imshow(np.maximum(density[q, r], norm.vmin), origin="lower",
+                              aspect="auto", extent=[-180, 180, -90, 90], norm=norm,
+                              cmap="magma")
+            ax.set_title("φ_o %.0f°, θ_o %.1f°" % (phi_o[q], theta_o[r]), fontsize=9)
+            ax.set_xlabel("φ_i − φ_o (deg)")
+            ax.set_ylabel("θ_i (deg)")
+    fig.colorbar(image, ax=axes, shrink=0.8, label="density per sr")
+    fig.suptitle("huang part: the density TABLE samples per view node — " + label, fontsize=10)
+    fig.savefig(os.path.join(d, "table_huang.png"), dpi=110)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("dir")
     parser.add_argument("--model", default="")
     args = parser.parse_args()
+    if os.path.exists(os.path.join(args.dir, "table_huang.npy")):
+        draw_huang(args.dir, args.model)
+        return 0
     draw_far(args.dir, args.model)
     draw_multiple(args.dir, args.model)
     if os.path.exists(os.path.join(args.dir, "table_near.npy")):

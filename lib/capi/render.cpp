@@ -16,19 +16,24 @@ namespace {
 
 thread_local std::string t_last_stats;
 
-// The shading of a Huang material: the samplers that need no tables (UNIFORM, GAUSSIAN); with
-// Cycles' own sampling (huang_sampling=cycles) the renderer samples the fiber itself and the
-// strategy is not used.
+// The shading of a Huang material: TABLE samples the material's Huang table (baked for its
+// parameters), UNIFORM and GAUSSIAN need none; with Cycles' own sampling (huang_sampling=cycles)
+// the renderer samples the fiber itself and the strategy is not used.
 HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name, StrategyKind kind,
                           const SamplerOptions &o, bool cycles_sampling) {
     if (cycles_sampling) kind = StrategyKind::Uniform;
     if (kind == StrategyKind::Analytic)
         invalid(name + "strategy=analytic has no sampler with a known density for a huang2022 fiber (Cycles' "
-                       "own Huang sampler has none); render with strategy=uniform");
-    if (kind == StrategyKind::Table)
-        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "strategy=table has no tables for huang2022 fibers in this "
-                                                  "version; render with strategy=uniform");
+                       "own Huang sampler has none); render with strategy=table or uniform");
     StrategyInputs inputs;
+    if (kind == StrategyKind::Table) {
+        if (!hair.tables)
+            refuse(HAIRIS_ERROR_INVALID_TABLE, name + "strategy=table needs sampling tables, but the material was "
+                                                      "added without tables; bake or load tables for it, or render "
+                                                      "with another strategy");
+        inputs.huang = hair.huang;
+        inputs.tables = &*hair.tables;
+    }
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
     Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
@@ -91,13 +96,16 @@ std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fibe
 // averages, with the parameters the multiple tables were baked with, and those tables.
 void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, size_t index) {
     const std::string name = "material " + std::to_string(index) + " (hair): ";
+    if (!hair.fiber)
+        invalid(name + "integrator=dual_scattering is for chiang2016 materials (this one is huang2022); render it "
+                       "with integrator=path");
     if (!hair.tables)
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "integrator=dual_scattering samples multiple scattering from the "
                                                   "material's baked multiple-scattering tables, but it was added "
                                                   "without tables; bake or load tables for it, or render with "
                                                   "integrator=path");
     if (hair.tables->parameters != canonical_parameters(chiang_parameters(hair.fiber->params())) ||
-        hair.tables->model != hair.fiber->name())
+        hair.tables->model != hair.fiber->name() || !hair.tables->multiple)
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "the tables were baked for " + hair.tables->model + " \"" +
                                                hair.tables->parameters + "\", not for this fiber; bake tables for it");
     material.dual = dual_scattering_of(*hair.fiber, name);

@@ -45,6 +45,9 @@ HAIRIS_API hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, cons
             if (!fiber->chiang)
                 invalid("fiber must be a chiang2016 fiber for strategy=analytic (got " + fiber->model_name + ")");
         }
+        if (kind == StrategyKind::Table && fiber && fiber->huang)
+            invalid("fiber: strategy=table for a huang2022 fiber samples its Huang table in the renderer "
+                    "(hairis_scene_add_hair_material); a sampler for it takes strategy=uniform or gaussian");
         if (kind == StrategyKind::Table && !tables)
             refuse(HAIRIS_ERROR_INVALID_TABLE, "tables must not be NULL for strategy=table");
         if (kind == StrategyKind::Analytic || kind == StrategyKind::Table) inputs.chiang = fiber ? fiber->chiang : nullptr;

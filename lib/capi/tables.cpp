@@ -18,6 +18,16 @@ hairis_tables *make_tables(TableSet set) {
     if (!sampling) refuse(HAIRIS_ERROR_INVALID_TABLE, "hairis table: " + sampling.error().message);
     auto tables = std::make_unique<hairis_tables>();
     tables->parameters = canonical_parameters(set.parameters);
+    if (const HuangTableSet *h = set.huang.get()) {
+        tables->info = format_options({{"source", set.source},
+                                       {"huang_theta_o", std::to_string(h->theta_o_count())},
+                                       {"huang_phi_o", std::to_string(h->phi_o_count())},
+                                       {"huang_theta_i", std::to_string(h->theta_i_count)},
+                                       {"huang_phi", std::to_string(h->phi_count)}});
+        tables->sampling = std::move(sampling).value();
+        tables->set = std::move(set);
+        return tables.release();
+    }
     std::string n_h;
     for (int v : set.n_h_values) n_h += (n_h.empty() ? "" : ",") + std::to_string(v);
     tables->info = format_options({{"source", set.source},
@@ -64,9 +74,6 @@ HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const ch
                                              hairis_progress_fn progress, void *user) {
     return guard_handle<hairis_tables>("hairis_tables_bake", [&] {
         require(fiber, "fiber");
-        if (fiber->huang)
-            invalid("fiber: tables for huang2022 fibers cannot be baked by this version (render Huang materials "
-                    "with strategy=uniform)");
         BakeOptions o;
         read_options(options, "bake options", o);
         ok_or_invalid(o.validate(), "bake options: ");

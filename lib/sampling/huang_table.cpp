@@ -73,8 +73,8 @@ std::size_t HuangTable::memory_bytes() const {
                                     phi_count()));
 }
 
-Expected<HuangTable> HuangTable::create(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes,
-                                        int theta_i_count, int phi_count, const std::vector<float> &values) {
+Status HuangTable::check(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes, int theta_i_count,
+                         int phi_count, const std::vector<float> &values) {
     const double half_pi = double(float(kHalfPi));  // π/2 rounded up to float is allowed
     if (Status s = first_error(check_nodes("theta_o_nodes", theta_o_nodes, kMaxThetaRNodes, -half_pi, half_pi),
                                check_nodes("phi_o_nodes", phi_o_nodes, kMaxPhiONodes, 0.0, half_pi),
@@ -103,7 +103,14 @@ Expected<HuangTable> HuangTable::create(const std::vector<float> &theta_o_nodes,
                                  ", theta_i cell " + std::to_string(i) + ", phi cell " + std::to_string(j) + "]";
         return prefixed(*check::non_negative(name.c_str(), double(values[n])));
     }
+    return std::nullopt;
+}
 
+Expected<HuangTable> HuangTable::create(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes,
+                                        int theta_i_count, int phi_count, const std::vector<float> &values) {
+    if (Status s = check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values)) return *s;
+    const long long n_r = (long long)theta_o_nodes.size(), n_q = (long long)phi_o_nodes.size();
+    const long long slice = (long long)theta_i_count * phi_count;
     HuangTable t;
     t.theta_o_nodes_ = theta_o_nodes;
     t.phi_o_nodes_ = phi_o_nodes;
@@ -208,6 +215,14 @@ std::vector<std::pair<std::string, double>> huang_parameters(const HuangParams &
             {"reflection", p.reflection},
             {"transmission", p.transmission},
             {"secondary_reflection", p.secondary_reflection}};
+}
+
+Status HuangTableSet::validate() const {
+    if (model != "huang2022") return Error{"a Huang table must have model \"huang2022\" (got \"" + model + "\")"};
+    for (const auto &[name, value] : parameters)
+        if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
+            return Error{"Huang table parameter \"" + name + "\" must have a plain name and a finite value"};
+    return HuangTable::check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values);
 }
 
 Expected<HuangSamplingTable> HuangSamplingTable::from(const HuangTableSet &set) {

@@ -92,6 +92,9 @@ class HuangTable {
     /// argument, the entry and the allowed range.
     static Expected<HuangTable> create(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes,
                                        int theta_i_count, int phi_count, const std::vector<float> &values);
+    /// What create() refuses, without building anything.
+    static Status check(const std::vector<float> &theta_o_nodes, const std::vector<float> &phi_o_nodes,
+                        int theta_i_count, int phi_count, const std::vector<float> &values);
 
     /// Where ω_o (Huang's frame, unit) falls: its fold, neighbouring nodes and warps. One asin
     /// and one atan2.
@@ -140,6 +143,11 @@ struct HuangTableSet {
     std::vector<float> theta_o_nodes, phi_o_nodes;
     int theta_i_count = 0, phi_count = 0;
     std::vector<float> values;  ///< HuangTable::create's layout
+
+    int theta_o_count() const { return int(theta_o_nodes.size()); }
+    int phi_o_count() const { return int(phi_o_nodes.size()); }
+    /// The model, plain parameter names with finite values, and what HuangTable::check checks.
+    Status validate() const;
 };
 
 /// A Huang table ready to sample, and the fiber parameters it was baked for.

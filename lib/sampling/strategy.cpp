@@ -43,13 +43,20 @@ Expected<std::shared_ptr<const Sampler>> huang_table_sampler(const StrategyInput
     if (in.multiple_weight > 0.0f)
         return Error{"multiple_weight must be 0 for a Huang fiber (got " + std::to_string(in.multiple_weight) +
                      "): the multiple-scattering table is not part of the single-fiber f a path tracer samples"};
-    if (!in.huang_table || !in.huang_table->table)
-        return table_error("the table strategy for a Huang fiber needs a baked Huang table (none was given)");
     const std::string parameters = canonical_parameters(huang_parameters(in.huang->params()));
-    if (in.huang_table->parameters != parameters)
-        return table_error("the Huang table was baked for \"" + in.huang_table->parameters + "\", not for " +
+    const HuangSamplingTable *table = in.huang_table;
+    if (!table && in.tables) {
+        if (!in.tables->huang)
+            return table_error("the tables were baked for " + in.tables->model + " \"" + in.tables->parameters +
+                               "\", not for " + in.huang->name() + " \"" + parameters + "\"; bake tables for this fiber");
+        table = in.tables->huang.get();
+    }
+    if (!table || !table->table)
+        return table_error("the table strategy for a Huang fiber needs a baked Huang table (none was given)");
+    if (table->parameters != parameters)
+        return table_error("the Huang table was baked for \"" + table->parameters + "\", not for " +
                            in.huang->name() + " \"" + parameters + "\"; bake a table for this fiber");
-    return mixture(shared(HuangTableSampler::create(in.huang, in.huang_table->table)),
+    return mixture(shared(HuangTableSampler::create(in.huang, table->table)),
                    std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>()), in.huang_uniform_weight);
 }
 
@@ -67,13 +74,22 @@ const char *strategy_name(StrategyKind kind) {
 
 Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
     if (Status s = t.validate()) return Error{s->message, ErrorKind::InvalidTable};
+    if (t.huang) {
+        Expected<HuangSamplingTable> huang = HuangSamplingTable::from(*t.huang);
+        if (!huang) return table_error("Huang table: " + huang.error().message);
+        SamplingTables out;
+        out.model = t.model;
+        out.parameters = canonical_parameters(t.parameters);
+        out.huang = std::make_shared<const HuangSamplingTable>(std::move(huang).value());
+        return out;
+    }
     Expected<DirectTable> direct = DirectTable::create(t.theta_r_nodes, t.theta_i_count, t.phi_count, t.direct);
     if (!direct) return table_error("direct table: " + direct.error().message);
     Expected<MultipleTable> multiple = MultipleTable::create(t.theta_r_nodes, t.n_h_values, t.theta_i_count, t.multiple);
     if (!multiple) return table_error("multiple table: " + multiple.error().message);
     return SamplingTables{std::make_shared<const DirectTable>(std::move(direct).value()),
                           std::make_shared<const MultipleTable>(std::move(multiple).value()), t.model,
-                          canonical_parameters(t.parameters), t.near_field};
+                          canonical_parameters(t.parameters), t.near_field, nullptr};
 }
 
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &input) {
@@ -98,6 +114,10 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
                            in.multiple_weight);
         case StrategyKind::Table: {
             if (in.huang) return huang_table_sampler(in);
+            if (in.tables && in.tables->huang)
+                return table_error("the tables are huang2022 tables (\"" + in.tables->parameters +
+                                   "\"), which only a Huang fiber samples" +
+                                   (in.chiang ? "; bake tables for this " + in.chiang->name() + " fiber" : std::string()));
             if (!in.tables || !in.tables->direct || !in.tables->multiple)
                 return table_error("the table strategy needs baked tables (none were given)");
             const SamplingTables &t = *in.tables;

@@ -32,6 +32,8 @@ struct SamplingTables {
     std::string parameters;  ///< canonical_parameters(TableSet::parameters)
     /// The near-field part (Chiang), or null.
     std::shared_ptr<const NearFieldData> near_field;
+    /// The Huang table (huang2022 tables, which have no direct or multiple table), or null.
+    std::shared_ptr<const HuangSamplingTable> huang;
 
     /// Builds the samplers' tables from a table set (validated here).
     static Expected<SamplingTables> from(const TableSet &tables);
@@ -83,6 +85,7 @@ struct StrategyInputs {
     /// work as for any fiber, ANALYTIC is refused.
     std::shared_ptr<const HuangFiber> huang;
     /// The Huang table (TABLE with `huang`): it must have been baked for `huang`'s parameters.
+    /// Null: the Huang part of `tables`, if they have one.
     const HuangSamplingTable *huang_table = nullptr;
     /// TABLE with `huang`: the uniform sphere's weight in the mixture, in [0, 1).
     float huang_uniform_weight = kHuangUniformWeight;

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/math.h"
+#include "sampling/huang_table.h"
 
 namespace hairis {
 
@@ -26,8 +27,13 @@ std::string canonical_parameters(const std::vector<std::pair<std::string, double
 }
 
 Status TableSet::validate() const {
+    for (const auto &[name, value] : parameters)
+        if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
+            return file_error("parameter \"" + name + "\" must have a plain name and a finite value");
+    if (model == "huang2022") return validate_huang();
+    if (huang) return file_error("a Huang part is only for huang2022 tables (got " + model + ")");
     if (model != "chiang2016" && model != "marschner2003")
-        return file_error("model must be \"chiang2016\" or \"marschner2003\" (got \"" + model + "\")");
+        return file_error("model must be \"chiang2016\", \"marschner2003\" or \"huang2022\" (got \"" + model + "\")");
     if (source != "exact" && source != "gaussian")
         return file_error("source must be \"exact\" or \"gaussian\" (got \"" + source + "\")");
     if (Status s = first_error(resolution().validate(),
@@ -64,9 +70,25 @@ Status TableSet::validate() const {
         if (model != "chiang2016") return file_error("a near-field part is only for chiang2016 tables (got " + model + ")");
         if (Status s = near_field->validate()) return file_error(s->message);
     }
-    for (const auto &[name, value] : parameters)
-        if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
-            return file_error("parameter \"" + name + "\" must have a plain name and a finite value");
+    return std::nullopt;
+}
+
+Status TableSet::validate_huang() const {
+    if (!huang) return file_error("huang2022 tables need their Huang part (there is none)");
+    if (source != "exact") return file_error("huang2022 tables have source \"exact\" (got \"" + source + "\")");
+    if (!theta_r_nodes.empty() || theta_i_count != 0 || phi_count != 0 || !n_h_values.empty() || !direct.empty() ||
+        !multiple.empty() || near_field)
+        return file_error("huang2022 tables hold only the Huang part (no far-field or near-field part)");
+    if (Status s = huang->validate()) return file_error(s->message);
+    // Every parameter of a Huang fiber, by name and in order (the staleness check compares them).
+    std::string names, expected;
+    for (const auto &entry : parameters) names += (names.empty() ? "" : ",") + entry.first;
+    for (const auto &entry : huang_parameters(HuangParams{})) expected += (expected.empty() ? "" : ",") + entry.first;
+    if (names != expected)
+        return file_error("huang2022 tables record the parameters " + expected + " (got \"" + names + "\")");
+    if (canonical_parameters(huang->parameters) != canonical_parameters(parameters))
+        return file_error("the Huang part was baked for \"" + canonical_parameters(huang->parameters) +
+                          "\", but the tables record \"" + canonical_parameters(parameters) + "\"");
     return std::nullopt;
 }
 

@@ -15,9 +15,12 @@
 
 namespace hairis {
 
-/// Everything a table file holds, as plain data.
+struct HuangTableSet;  // sampling/huang_table.h
+
+/// Everything a table file holds, as plain data. A huang2022 set holds only its Huang table
+/// (`huang`): no far-field part (every far-field member empty or 0) and no near-field part.
 struct TableSet {
-    std::string model;   ///< "chiang2016" or "marschner2003"
+    std::string model;   ///< "chiang2016", "marschner2003" or "huang2022"
     std::string source;  ///< "exact" (our distributions) or "gaussian" (the seed's PDFs)
     std::vector<std::pair<std::string, double>> parameters;  ///< every model parameter
     std::vector<float> theta_r_nodes;  ///< radians, strictly increasing, in [−π/2, π/2]
@@ -29,8 +32,12 @@ struct TableSet {
     /// Chiang's near-field tables (what TABLE samples single scattering from for a fiber); null
     /// for other models.
     std::shared_ptr<const NearFieldData> near_field;
+    /// The Huang table (huang2022 sets only; its parameters are `parameters`), else null.
+    std::shared_ptr<const HuangTableSet> huang;
 
     int theta_r_count() const { return int(theta_r_nodes.size()); }
+    /// True when the set has the far-field part (every model but huang2022).
+    bool has_far_field() const { return !theta_r_nodes.empty(); }
     TableResolution resolution() const { return {theta_r_count(), theta_i_count, phi_count}; }
     float direct_at(int r, int i, int j) const {
         return direct[(size_t(r) * theta_i_count + i) * phi_count + j];
@@ -41,6 +48,9 @@ struct TableSet {
 
     /// Checks sizes, ordering, ranges and values; names the first problem found.
     Status validate() const;
+
+  private:
+    Status validate_huang() const;
 };
 
 /// "name=value;..." with values printed to 9 significant digits, in the order given.

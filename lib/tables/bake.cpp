@@ -10,6 +10,7 @@
 #include "fiber/chiang.h"
 #include "fiber/dual_scattering.h"
 #include "sampling/near_field_table.h"
+#include "tables/huang_bake.h"
 
 namespace hairis {
 
@@ -150,6 +151,11 @@ Expected<TableSet> bake_tables(const FiberModel &model,
                                const std::vector<std::pair<std::string, double>> &parameters,
                                const BakeOptions &options, const ProgressFn &progress) {
     if (Status s = options.validate()) return *s;
+    if (const auto *huang = dynamic_cast<const HuangFiber *>(&model)) {
+        if (canonical_parameters(parameters) != canonical_parameters(huang_parameters(huang->params())))
+            return Error{"the parameters \"" + canonical_parameters(parameters) + "\" are not the huang2022 fiber's"};
+        return bake_huang_tables(*huang, options, progress);
+    }
     // The file's image must hold the far part and, for Chiang, the near part: refused before
     // the bake rather than by the writer after it.
     const long long far_rows = (long long)options.theta_r_count * options.theta_i_count;

@@ -10,9 +10,19 @@
 #include "core/expected.h"
 #include "fiber/fiber.h"
 #include "fiber/seed_pdfs.h"
+#include "sampling/huang_table.h"
 #include "sampling/table_set.h"
 
 namespace hairis {
+
+/// The resolution of a Huang table (sampling/huang_table.h): θ_o nodes, φ_o nodes, θ_i cells
+/// and cells of φ_i − φ_o (HuangBakeOptions takes its defaults from here).
+struct HuangResolution {
+    int theta_o = 24;
+    int phi_o = 4;
+    int theta_i = 48;
+    int phi = 64;
+};
 
 /// What to bake and at which resolution.
 struct BakeOptions {
@@ -24,6 +34,8 @@ struct BakeOptions {
     std::string source = "exact";  ///< "exact" (the model's distributions) or "gaussian"
     SeedPdfParams seed;            ///< the seed's PDFs, for source "gaussian"
     int threads = 0;               ///< 0: all cores
+    /// What a huang2022 fiber bakes instead of everything above but `threads`.
+    HuangResolution huang;
 
     /// Names the first option out of range.
     Status validate() const;
@@ -39,6 +51,10 @@ void describe(Fields &f, BakeOptions &o) {
     f.field("source", o.source);
     f.field("quadrature_points", o.quadrature_points, 1, 16);
     f.field("threads", o.threads, 0, 1024);
+    f.field("huang_theta_o", o.huang.theta_o, 1, kMaxThetaRNodes);
+    f.field("huang_phi_o", o.huang.phi_o, 1, kMaxPhiONodes);
+    f.field("huang_theta_i", o.huang.theta_i, 1, kMaxTableAxisCells);
+    f.field("huang_phi", o.huang.phi, 1, kMaxTableAxisCells);
 }
 
 /// The θ_r nodes of a bake: centres of `count` equal cells of [−π/2, π/2]. The ends ±π/2
@@ -50,7 +66,8 @@ std::vector<float> theta_r_nodes(int count);
 using ProgressFn = std::function<bool(float)>;
 
 /// Bakes direct and multiple tables for `model` whose parameters are `parameters` (recorded
-/// in the metadata). Deterministic: the same inputs give the same numbers for any thread
+/// in the metadata); for a huang2022 fiber its Huang table alone, at options.huang's resolution
+/// (bake_huang_tables). Deterministic: the same inputs give the same numbers for any thread
 /// count. Returns an error naming the problem, or "cancelled".
 Expected<TableSet> bake_tables(const FiberModel &model,
                                const std::vector<std::pair<std::string, double>> &parameters,

@@ -138,4 +138,32 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
     return result;
 }
 
+Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions &options, const ProgressFn &progress) {
+    if (options.source != "exact")
+        return Error{"source must be \"exact\" for a huang2022 fiber (got \"" + options.source +
+                     "\"): its tables are the Huang table, baked from the fiber"};
+    HuangBakeOptions o;
+    o.theta_o_count = options.huang.theta_o;
+    o.phi_o_count = options.huang.phi_o;
+    o.theta_i_count = options.huang.theta_i;
+    o.phi_count = options.huang.phi;
+    o.threads = options.threads;
+    if (Status s = o.validate()) return Error{"the Huang resolution (huang_theta_o, huang_phi_o, huang_theta_i, huang_phi): " + s->message};
+    // The file's image: one row per (φ_o node, θ_o node, θ_i cell), refused before the bake.
+    const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count * o.theta_i_count;
+    if (Status s = TableImageSize{o.phi_count, rows}.validate()) return *s;
+    if (HuangTable::bytes_needed(o.theta_o_count, o.phi_o_count, o.theta_i_count, o.phi_count) > kMaxSamplingTableBytes)
+        return Error{"the Huang table (huang_theta_o x huang_phi_o x huang_theta_i x huang_phi) would need more than " +
+                     std::to_string(kMaxSamplingTableBytes) + " bytes; bake fewer cells"};
+    Expected<HuangTableSet> baked = bake_huang_table(fiber, o, progress);
+    if (!baked) return baked.error();
+    TableSet t;
+    t.model = fiber.name();
+    t.source = "exact";
+    t.parameters = baked.value().parameters;
+    t.huang = std::make_shared<const HuangTableSet>(std::move(baked).value());
+    if (Status s = t.validate()) return Error{"the baked Huang table is invalid (a bug): " + s->message};
+    return t;
+}
+
 }  // namespace hairis

@@ -17,11 +17,11 @@ namespace hairis {
 
 /// How a Huang table is baked.
 struct HuangBakeOptions {
-    int theta_o_count = 24;  ///< θ_o nodes at the centres of equal cells of [−π/2, π/2]
+    int theta_o_count = HuangResolution{}.theta_o;  ///< θ_o nodes at the centres of equal cells of [−π/2, π/2]
     /// φ_o nodes over [0, π/2], ends included (1: the node π/2). Circular fibers get one node.
-    int phi_o_count = 4;
-    int theta_i_count = 48;  ///< θ_i cells over [−π/2, π/2]
-    int phi_count = 64;      ///< cells of φ_i − φ_o over [−π, π]
+    int phi_o_count = HuangResolution{}.phi_o;
+    int theta_i_count = HuangResolution{}.theta_i;  ///< θ_i cells over [−π/2, π/2]
+    int phi_count = HuangResolution{}.phi;          ///< cells of φ_i − φ_o over [−π, π]
     int points = 1;          ///< evaluation points per cell and axis (midpoints in sin θ_i and φ)
     /// "expectation" (HuangExpectation with the orders below) or "estimate" (Cycles' eval).
     std::string evaluator = "expectation";
@@ -40,5 +40,11 @@ std::vector<float> huang_phi_o_nodes(int count);
 /// (false cancels: Error "cancelled", ErrorKind::Cancelled).
 Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBakeOptions &options = {},
                                          const ProgressFn &progress = {});
+
+/// The table set of a huang2022 fiber (table_set.h): its Huang table baked at options.huang's
+/// resolution with options.threads, the default evaluator, and the fiber's parameters. Refuses
+/// source "gaussian" (the seed's far-field PDFs, which a Huang table set does not hold).
+Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions &options,
+                                     const ProgressFn &progress = {});
 
 }  // namespace hairis

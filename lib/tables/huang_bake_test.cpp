@@ -214,5 +214,58 @@ TEST(HuangBake, RefusesOptionsByName) {
     EXPECT_NE(message(o).find("cells; at most"), std::string::npos);
 }
 
+// bake_tables on a Huang fiber: its Huang table set at BakeOptions::huang's resolution, the
+// same bytes as bake_huang_table with those options, for any thread count, and cancellable.
+TEST(HuangBake, BakeTablesOfAHuangFiberIsItsHuangTableSet) {
+    const HuangFiber fiber = make_fiber(0.6f);
+    BakeOptions o;
+    o.huang = {4, 3, 8, 12};
+    o.threads = 1;
+    const Expected<TableSet> one = bake_tables(fiber, huang_parameters(fiber.params()), o);
+    ASSERT_TRUE(one.ok()) << one.error().message;
+    o.threads = 2;
+    const TableSet two = bake_tables(fiber, huang_parameters(fiber.params()), o).value();
+    const TableSet &t = one.value();
+    EXPECT_EQ(t.model, "huang2022");
+    EXPECT_FALSE(t.has_far_field());
+    EXPECT_FALSE(t.near_field);
+    ASSERT_TRUE(t.huang && two.huang);
+    EXPECT_EQ(t.huang->theta_o_nodes.size(), 4u);
+    EXPECT_EQ(t.huang->phi_o_nodes.size(), 3u);
+    EXPECT_EQ(t.huang->theta_i_count, 8);
+    EXPECT_EQ(t.huang->phi_count, 12);
+    const HuangTableSet direct = bake_huang_table(fiber, tiny()).value();
+    ASSERT_EQ(direct.values.size(), t.huang->values.size());
+    EXPECT_EQ(std::memcmp(direct.values.data(), t.huang->values.data(), direct.values.size() * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(two.huang->values.data(), t.huang->values.data(), direct.values.size() * sizeof(float)), 0);
+    EXPECT_EQ(canonical_parameters(t.parameters), canonical_parameters(huang_parameters(fiber.params())));
+    int calls = 0;
+    const Expected<TableSet> cancelled =
+        bake_tables(fiber, huang_parameters(fiber.params()), o, [&](float) { return ++calls < 2; });
+    ASSERT_FALSE(cancelled.ok());
+    EXPECT_EQ(cancelled.error().kind, ErrorKind::Cancelled);
+}
+
+TEST(HuangBake, BakeTablesRefusesWhatAHuangTableSetCannotHold) {
+    const HuangFiber fiber = make_fiber(0.6f);
+    auto message = [&](const BakeOptions &o, std::vector<std::pair<std::string, double>> parameters = {}) {
+        if (parameters.empty()) parameters = huang_parameters(fiber.params());
+        const Expected<TableSet> t = bake_tables(fiber, parameters, o);
+        return t.ok() ? std::string("(accepted)") : t.error().message;
+    };
+    BakeOptions o;
+    o.source = "gaussian";
+    EXPECT_NE(message(o).find("source must be \"exact\" for a huang2022 fiber"), std::string::npos) << message(o);
+    o = {};
+    o.huang = {1024, 256, 4096, 4096};
+    EXPECT_NE(message(o).find("huang_theta_o, huang_phi_o"), std::string::npos) << message(o);
+    o = {};
+    o.huang.phi = 5000;
+    EXPECT_NE(message(o).find("huang_phi"), std::string::npos) << message(o);
+    auto other = huang_parameters(fiber.params());
+    other[3].second = 0.9;  // roughness
+    EXPECT_NE(message(BakeOptions{}, other).find("are not the huang2022 fiber's"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hairis

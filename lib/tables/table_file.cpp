@@ -15,6 +15,7 @@
 
 #include "core/math.h"
 #include "core/options.h"
+#include "sampling/huang_table.h"
 
 namespace hairis {
 
@@ -73,6 +74,11 @@ struct Layout {
     long long width = 0, height = 0;
     static Layout of(const TableSet &t) {
         Layout l;
+        if (const HuangTableSet *h = t.huang.get()) {
+            l.width = h->phi_count;
+            l.height = (long long)h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
+            return l;
+        }
         l.far_rows = t.theta_r_count() * t.theta_i_count;
         if (t.near_field) {
             l.near_rows = t.near_field->rows();
@@ -84,7 +90,19 @@ struct Layout {
     }
 };
 
+// The Huang part: row (q·theta_o_count + r)·theta_i_count + i, column j holds R = the value of
+// φ_o node q, θ_o node r, cell (i, j); G = B = 0, A = 1. The values' order is exactly this.
+std::vector<float> huang_pixels_of(const HuangTableSet &h) {
+    std::vector<float> px(h.values.size() * kChannels, 0.0f);
+    for (size_t n = 0; n < h.values.size(); ++n) {
+        px[n * kChannels] = h.values[n];
+        px[n * kChannels + 3] = 1.0f;
+    }
+    return px;
+}
+
 std::vector<float> pixels_of(const TableSet &t) {
+    if (t.huang) return huang_pixels_of(*t.huang);
     const Layout l = Layout::of(t);
     const size_t width = size_t(l.width);
     const int bands = int(t.n_h_values.size());
@@ -226,6 +244,113 @@ Status check_exr_header(const unsigned char *data, size_t size) {
     return std::nullopt;
 }
 
+Expected<std::vector<unsigned char>> write_exr(const OIIO::ImageSpec &spec, const std::vector<float> &px) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("openexr");
+    if (!out) return file_error("OpenImageIO has no OpenEXR writer: " + OIIO::geterror());
+    if (!out->set_ioproxy(&proxy) || !out->open("tables.exr", spec) ||
+        !out->write_image(TypeDesc::FLOAT, px.data()) || !out->close())
+        return file_error("encoding the EXR failed: " + out->geterror());
+    return bytes;
+}
+
+// Reads every scanline in bands of rows, so memory grows with the data the file really holds
+// (a small file whose header claims a large table fails at its first missing scanline instead
+// of after allocating the whole table), and checks the pixels against hairis:pixel_sha1 and
+// that every value is finite.
+Expected<std::vector<float>> read_pixels(OIIO::ImageInput &in) {
+    const OIIO::ImageSpec &spec = in.spec();
+    const size_t width = size_t(spec.width), height = size_t(spec.height);
+    constexpr size_t kBandRows = 64;
+    std::vector<float> px, band;
+    OIIO::SHA1 hash;
+    for (size_t y = 0; y < height; y += kBandRows) {
+        const size_t rows = std::min(kBandRows, height - y);
+        band.resize(rows * width * kChannels);
+        if (!in.read_scanlines(0, 0, int(y), int(y + rows), 0, 0, kChannels, TypeDesc::FLOAT, band.data()))
+            return file_error("the pixel data cannot be read (truncated or corrupt): " + in.geterror());
+        hash.append(band.data(), band.size() * sizeof(float));
+        px.insert(px.end(), band.begin(), band.end());
+    }
+    if (spec.get_string_attribute("hairis:pixel_sha1") != hash.digest())
+        return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
+    for (size_t n = 0; n < px.size(); ++n)
+        if (!std::isfinite(px[n]))
+            return file_error(pixel_name((long long)(n / kChannels % width), (long long)(n / kChannels / width)) +
+                              " holds NaN or infinity");
+    return px;
+}
+
+// A float array attribute of exactly `count` values, else an error naming it.
+Expected<std::vector<float>> float_array(const OIIO::ImageSpec &spec, const char *name, int count) {
+    const OIIO::ParamValue *a = spec.find_attribute(name);
+    if (!a || a->type().basetype != TypeDesc::FLOAT || a->type().basevalues() * size_t(a->nvalues()) != size_t(count))
+        return file_error(std::string(name) + " must hold " + std::to_string(count) + " floats");
+    const float *values = static_cast<const float *>(a->data());
+    return std::vector<float>(values, values + count);
+}
+
+// The Huang part (parts "huang"): the layout of huang_pixels_of, sizes checked before the
+// pixels are read.
+Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t) {
+    const OIIO::ImageSpec &spec = in.spec();
+    for (const char *far : {"hairis:theta_r_count", "hairis:theta_i_count", "hairis:phi_count", "hairis:theta_r_nodes",
+                            "hairis:n_h_values", "hairis:near"})
+        if (spec.find_attribute(far))
+            return file_error(std::string("hairis:parts is \"huang\", which has no far-field or near-field part, "
+                                          "but the file has ") + far);
+    const OIIO::ParamValue *attribute = spec.find_attribute("hairis:huang");
+    if (!attribute || attribute->type() != TypeDesc::STRING)
+        return file_error("hairis:parts is \"huang\" but there is no string attribute hairis:huang "
+                          "(\"row=0;theta_o=...;phi_o=...;theta_i=...;phi=...\")");
+    Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:huang"), "hairis:huang");
+    if (!reader) return file_error(reader.error().message);
+    auto h = std::make_shared<HuangTableSet>();
+    int row = -1, theta_o = 0, phi_o = 0;
+    reader.value().field("row", row, 0, 0);
+    reader.value().field("theta_o", theta_o, 1, kMaxThetaRNodes);
+    reader.value().field("phi_o", phi_o, 1, kMaxPhiONodes);
+    reader.value().field("theta_i", h->theta_i_count, 1, kMaxTableAxisCells);
+    reader.value().field("phi", h->phi_count, 1, kMaxTableAxisCells);
+    if (Status e = reader.value().finish()) return file_error(e->message);
+    if (row != 0 || theta_o == 0 || phi_o == 0 || h->theta_i_count == 0 || h->phi_count == 0)
+        return file_error("hairis:huang must give row=0, theta_o, phi_o, theta_i and phi");
+    const long long rows = (long long)phi_o * theta_o * h->theta_i_count;
+    if (rows * h->phi_count > kMaxTableCells ||
+        HuangTable::bytes_needed(theta_o, phi_o, h->theta_i_count, h->phi_count) > kMaxSamplingTableBytes)
+        return file_error("hairis:huang claims " + std::to_string(rows * h->phi_count) +
+                          " cells; a Huang table has at most " + std::to_string(kMaxTableCells) + " cells and " +
+                          std::to_string(kMaxSamplingTableBytes) + " bytes");
+    if (Status s = TableImageSize{h->phi_count, rows}.validate()) return file_error(s->message);
+    if (spec.width != h->phi_count || spec.height != rows || spec.depth != 1 || spec.x != 0 || spec.y != 0)
+        return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                          " but hairis:huang needs " + std::to_string(h->phi_count) + "x" + std::to_string(rows));
+    Expected<std::vector<float>> theta_o_nodes = float_array(spec, "hairis:huang_theta_o_nodes", theta_o);
+    if (!theta_o_nodes) return theta_o_nodes.error();
+    Expected<std::vector<float>> phi_o_nodes = float_array(spec, "hairis:huang_phi_o_nodes", phi_o);
+    if (!phi_o_nodes) return phi_o_nodes.error();
+    h->theta_o_nodes = std::move(theta_o_nodes).value();
+    h->phi_o_nodes = std::move(phi_o_nodes).value();
+
+    Expected<std::vector<float>> px = read_pixels(in);
+    in.close();
+    if (!px) return px.error();
+    const size_t width = size_t(spec.width);
+    h->values.resize(px.value().size() / kChannels);
+    for (size_t n = 0; n < h->values.size(); ++n) {
+        const float *p = &px.value()[n * kChannels];
+        if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
+            return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
+                              pixel_name((long long)(n % width), (long long)(n / width)));
+        h->values[n] = p[0];
+    }
+    h->parameters = t.parameters;
+    t.huang = std::move(h);
+    if (Status s = t.validate()) return *s;
+    return t;
+}
+
 }  // namespace
 
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
@@ -247,6 +372,19 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.attribute("hairis:model", t.model);
     spec.attribute("hairis:source", t.source);
     spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
+    if (const HuangTableSet *h = t.huang.get()) {
+        spec.attribute("hairis:parts", "huang");
+        spec.attribute("hairis:huang", format_options({{"row", "0"},
+                                                       {"theta_o", std::to_string(h->theta_o_count())},
+                                                       {"phi_o", std::to_string(h->phi_o_count())},
+                                                       {"theta_i", std::to_string(h->theta_i_count)},
+                                                       {"phi", std::to_string(h->phi_count)}}));
+        spec.attribute("hairis:huang_theta_o_nodes", TypeDesc(TypeDesc::FLOAT, h->theta_o_count()),
+                       h->theta_o_nodes.data());
+        spec.attribute("hairis:huang_phi_o_nodes", TypeDesc(TypeDesc::FLOAT, h->phi_o_count()), h->phi_o_nodes.data());
+        spec.attribute("hairis:pixel_sha1", sha1_of(px));
+        return write_exr(spec, px);
+    }
     spec.attribute("hairis:theta_r_count", t.theta_r_count());
     spec.attribute("hairis:theta_i_count", t.theta_i_count);
     spec.attribute("hairis:phi_count", t.phi_count);
@@ -262,15 +400,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     }
     spec.attribute("hairis:parts", parts);
     spec.attribute("hairis:pixel_sha1", sha1_of(px));
-
-    std::vector<unsigned char> bytes;
-    OIIO::Filesystem::IOVecOutput proxy(bytes);
-    auto out = OIIO::ImageOutput::create("openexr");
-    if (!out) return file_error("OpenImageIO has no OpenEXR writer: " + OIIO::geterror());
-    if (!out->set_ioproxy(&proxy) || !out->open("tables.exr", spec) ||
-        !out->write_image(TypeDesc::FLOAT, px.data()) || !out->close())
-        return file_error("encoding the EXR failed: " + out->geterror());
-    return bytes;
+    return write_exr(spec, px);
 }
 
 Expected<TableSet> decode_table_exr(const void *data, size_t size) {
@@ -305,15 +435,33 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     TableSet t;
     t.model = spec.get_string_attribute("hairis:model");
     t.source = spec.get_string_attribute("hairis:source");
+    const std::string parameters = spec.get_string_attribute("hairis:parameters");
+    std::stringstream param_text(parameters);
+    std::string item;
+    while (std::getline(param_text, item, ';')) {
+        const size_t eq = item.find('=');
+        char *end = nullptr;
+        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
+        t.parameters.emplace_back(item.substr(0, eq), v);
+    }
+    const std::string parts = spec.get_string_attribute("hairis:parts");
+    if (parts == "huang") {
+        if (t.model != "huang2022")
+            return file_error("hairis:parts \"huang\" is for model huang2022 (got \"" + t.model + "\")");
+        return decode_huang(*in, std::move(t));
+    }
+    if (t.model == "huang2022")
+        return file_error("huang2022 tables have hairis:parts \"huang\" (got \"" + parts + "\")");
     const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
     t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
     t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
     // Checked before anything is allocated: the header alone can claim any size.
     if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
         return file_error(s->message);
-    const std::string parts = spec.get_string_attribute("hairis:parts");
     if (parts != "far" && parts != "far,near")
-        return file_error("hairis:parts must be \"far\" or \"far,near\" (got \"" + parts + "\")");
+        return file_error("hairis:parts must be \"far\", \"far,near\" or \"huang\" (got \"" + parts + "\")");
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;
     if (parts == "far,near") {
@@ -350,58 +498,25 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     const std::string n_h_text = spec.get_string_attribute("hairis:n_h_values");
     if (!n_h_text.empty()) {
         std::stringstream in_text(n_h_text);
-        std::string item;
-        while (std::getline(in_text, item, ',')) {
+        std::string entry;
+        while (std::getline(in_text, entry, ',')) {
             char *end = nullptr;
-            const long v = std::strtol(item.c_str(), &end, 10);
-            if (item.empty() || *end != '\0' || v < 1 || v > 1024)
+            const long v = std::strtol(entry.c_str(), &end, 10);
+            if (entry.empty() || *end != '\0' || v < 1 || v > 1024)
                 return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + n_h_text + "\")");
             t.n_h_values.push_back(int(v));
         }
     }
 
-    const std::string parameters = spec.get_string_attribute("hairis:parameters");
-    std::stringstream param_text(parameters);
-    std::string item;
-    while (std::getline(param_text, item, ';')) {
-        const size_t eq = item.find('=');
-        char *end = nullptr;
-        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
-        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
-            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
-        t.parameters.emplace_back(item.substr(0, eq), v);
-    }
-
-    // Read in bands of rows, so memory grows with the data the file really holds: a small file
-    // whose header claims a large table fails at its first missing scanline instead of after
-    // allocating the whole table.
-    const size_t width = size_t(spec.width), height = size_t(spec.height);
-    constexpr size_t kBandRows = 64;
-    std::vector<float> px, band;
-    OIIO::SHA1 hash;
-    for (size_t y = 0; y < height; y += kBandRows) {
-        const size_t rows = std::min(kBandRows, height - y);
-        band.resize(rows * width * kChannels);
-        if (!in->read_scanlines(0, 0, int(y), int(y + rows), 0, 0, kChannels, TypeDesc::FLOAT, band.data()))
-            return file_error("the pixel data cannot be read (truncated or corrupt): " + in->geterror());
-        hash.append(band.data(), band.size() * sizeof(float));
-        px.insert(px.end(), band.begin(), band.end());
-    }
+    Expected<std::vector<float>> read = read_pixels(*in);
     in->close();
-
-    const std::string sha = spec.get_string_attribute("hairis:pixel_sha1");
-    if (sha != hash.digest())
-        return file_error("pixel data does not match its hash hairis:pixel_sha1 (file modified or corrupt)");
+    if (!read) return read.error();
+    const std::vector<float> &px = read.value();
+    const size_t width = size_t(spec.width);
 
     const int bands = int(t.n_h_values.size());
     if (bands > t.phi_count) return file_error("more n_h values than phi columns");
     auto pixel = [&](size_t row, size_t j) { return &px[(row * width + j) * kChannels]; };
-    for (size_t row = 0; row < height; ++row)
-        for (size_t j = 0; j < width; ++j) {
-            const float *p = pixel(row, j);
-            if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3]))
-                return file_error(pixel_name((long long)j, (long long)row) + " holds NaN or infinity");
-        }
     // The far part: R direct, G the n_h bands, B = 0, A = 1; zero padding beyond phi_count.
     t.direct.resize(size_t(theta_r_count) * t.theta_i_count * t.phi_count);
     t.multiple.assign(size_t(theta_r_count) * bands * t.theta_i_count, 0.0f);

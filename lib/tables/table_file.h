@@ -17,11 +17,19 @@
 //        B  the lobe's integral ∫ M_p cos θ_i dθ_i, along the whole row;
 //        A  1 when the lobe draws θ_i from the fiber's cone instead of the row, along the row.
 //        This is what the TABLE strategy samples single scattering from (near_field_table.h).
+//  huang (huang2022 files, the only part they hold) rows y = (q·theta_o + r)·theta_i + i for
+//        φ_o node q, θ_o node r and θ_i cell i, columns j < phi for cell j of φ_i − φ_o
+//        (HuangTable::create's values in their order, sampling/huang_table.h):
+//        R  the cell's value (∝ luminance(f·cos θ_i) there);  G, B  0;  A  1.
+//        This is what the TABLE strategy samples a Huang fiber from.
 // Metadata (EXR header attributes): hairis:format_version (2), hairis:model (string),
 // hairis:source ("exact" or "gaussian"), hairis:parameters ("name=value;..."),
 // hairis:theta_r_count, hairis:theta_i_count, hairis:phi_count (the far part), hairis:theta_r_nodes
-// (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far" or "far,near"),
-// hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:pixel_sha1 (hex SHA-1 of the float
+// (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far", "far,near" or
+// "huang"), hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:huang
+// ("row=0;theta_o=...;phi_o=...;theta_i=...;phi=..."), hairis:huang_theta_o_nodes and
+// hairis:huang_phi_o_nodes (float arrays, radians; a huang file has none of the far part's
+// attributes), hairis:pixel_sha1 (hex SHA-1 of the float
 // pixels in scanline order, RGBA interleaved, little-endian). Every pixel outside the parts is 0.
 // The image has at most kMaxTableAxisCells + 1 columns and kMaxTableCells pixels.
 // Version 1 files (no near part) are refused with a message asking for a re-bake.

@@ -539,10 +539,13 @@ TEST(TableFileNearPart, RefusesAbsurdCountsBeforeAllocating) {
 }
 
 TEST(TableFileNearPart, RefusesUnknownParts) {
-    for (const char *parts : {"", "near", "near,far", "far,near,far", "far,mid", "far, near", "FAR,NEAR"}) {
+    for (const char *parts : {"", "near", "near,far", "far,near,far", "far,mid", "far, near", "FAR,NEAR", "far,huang"}) {
         SCOPED_TRACE(parts);
-        expect_refused(with_attribute(small_tables(), "hairis:parts", parts), "hairis:parts must be \"far\" or \"far,near\"");
+        expect_refused(with_attribute(small_tables(), "hairis:parts", parts),
+                       "hairis:parts must be \"far\", \"far,near\" or \"huang\"");
     }
+    // A Huang part claimed on a Chiang file.
+    expect_refused(with_attribute(small_tables(), "hairis:parts", "huang"), "is for model huang2022");
     // "far" alone leaves the near rows unaccounted for.
     expect_refused(with_attribute(small_tables(), "hairis:parts", "far"), "image is 13x26 but the metadata needs 10x18");
     // A near part claimed on a file that has none.

@@ -76,7 +76,7 @@ static const char *const kinds[][2] = {
                   "beta_tt_deg=3.725;beta_trt_deg=15;eccentricity=0.9;glint_scale=0.4;"
                   "caustic_width_deg=1.5;caustic_fade=0.3;caustic_limit=0.5"},
     {"bake", "theta_r=31;theta_i=64;phi=64;n_h=1,2,4,8,16;source=exact;quadrature_points=2;"
-             "threads=0"},
+             "threads=0;huang_theta_o=24;huang_phi_o=4;huang_theta_i=48;huang_phi=64"},
     {"sampler", "strategy=table;multiple_weight=0;n_h=2"},
     {"diffuse", "type=diffuse;color=0.800000012,0.800000012,0.800000012;emission=0,0,0;"
                 "roughness=0;color_texture=-1;cycles=3.4"},
@@ -552,16 +552,14 @@ hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *text,
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
         return NULL;
     }
-    if (fiber->huang) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-             "fiber: tables for huang2022 fibers cannot be baked by this version (render Huang "
-             "materials with strategy=uniform)");
-        return NULL;
-    }
     options o;
     if (read_options(text, "bake", "bake options", NULL, &o) != HAIRIS_OK) return NULL;
-    long long theta_r, theta_i, phi, threads, points;
-    if (integer_in(&o, "theta_r", 1, 1024, &theta_r) != HAIRIS_OK ||
+    long long theta_r, theta_i, phi, threads, points, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi;
+    if (integer_in(&o, "huang_theta_o", 1, 1024, &huang_theta_o) != HAIRIS_OK ||
+        integer_in(&o, "huang_phi_o", 1, 256, &huang_phi_o) != HAIRIS_OK ||
+        integer_in(&o, "huang_theta_i", 1, 4096, &huang_theta_i) != HAIRIS_OK ||
+        integer_in(&o, "huang_phi", 1, 4096, &huang_phi) != HAIRIS_OK ||
+        integer_in(&o, "theta_r", 1, 1024, &theta_r) != HAIRIS_OK ||
         integer_in(&o, "theta_i", 2, 4096, &theta_i) != HAIRIS_OK ||
         integer_in(&o, "phi", 1, 4096, &phi) != HAIRIS_OK ||
         integer_in(&o, "threads", 0, 1024, &threads) != HAIRIS_OK ||
@@ -570,6 +568,11 @@ hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *text,
     const char *sources[2] = {"exact", "gaussian"};
     int source = 0;
     if (word(&o, "source", sources, 2, &source) != HAIRIS_OK) return NULL;
+    if (fiber->huang && source != 0) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "source must be \"exact\" for a huang2022 fiber (got \"%s\")",
+             sources[source]);
+        return NULL;
+    }
     /* n_h: 1 to 16 increasing integers. */
     int n_h_count = 0, previous = 0;
     const char *p = value_of(&o, "n_h");
@@ -604,8 +607,12 @@ hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *text,
     }
     memcpy(t->model, fiber->model, sizeof t->model);
     memcpy(t->parameters, fiber->parameters, sizeof t->parameters);
-    snprintf(t->info, sizeof t->info, "source=%s;theta_r=%lld;theta_i=%lld;phi=%lld;n_h=%s",
-             sources[source], theta_r, theta_i, phi, value_of(&o, "n_h"));
+    if (fiber->huang)
+        snprintf(t->info, sizeof t->info, "source=exact;huang_theta_o=%lld;huang_phi_o=%lld;huang_theta_i=%lld;"
+                 "huang_phi=%lld", huang_theta_o, huang_phi_o, huang_theta_i, huang_phi);
+    else
+        snprintf(t->info, sizeof t->info, "source=%s;theta_r=%lld;theta_i=%lld;phi=%lld;n_h=%s",
+                 sources[source], theta_r, theta_i, phi, value_of(&o, "n_h"));
     clear_error();
     return t;
 }
@@ -742,6 +749,11 @@ hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, const hairis_ta
         return NULL;
     if (strategy == 1 && !(fiber && fiber->chiang)) {
         fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must be a chiang2016 fiber for strategy=analytic");
+        return NULL;
+    }
+    if (strategy == 3 && fiber && fiber->huang) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber: strategy=table for a huang2022 fiber samples its Huang "
+             "table in the renderer; a sampler for it takes strategy=uniform or gaussian");
         return NULL;
     }
     if (strategy == 3 && !tables) {
@@ -1417,11 +1429,18 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                     "scene has no camera: call hairis_scene_set_camera before hairis_render");
     for (int i = 0; i < s->material_count; ++i)
-        if (s->material_is_huang[i] && !r.huang_sampling && (r.strategy == 1 || r.strategy == 3))
-            return fail(r.strategy == 3 ? HAIRIS_ERROR_INVALID_TABLE : HAIRIS_ERROR_INVALID_ARGUMENT,
-                        "material %d (hair): strategy=%s has no sampler for a huang2022 fiber in "
-                        "this version; render with strategy=uniform",
-                        i, strategies[r.strategy]);
+        if (s->material_is_huang[i] && !r.huang_sampling && r.strategy == 1)
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                        "material %d (hair): strategy=analytic has no sampler with a known density "
+                        "for a huang2022 fiber; render with strategy=table or uniform",
+                        i);
+    if (r.integrator == 1)
+        for (int i = 0; i < s->material_count; ++i)
+            if (s->material_is_huang[i])
+                return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                            "material %d (hair): integrator=dual_scattering is for chiang2016 "
+                            "materials (this one is huang2022); render it with integrator=path",
+                            i);
     /* integrator=dual_scattering samples multiple scattering from every hair material's tables. */
     if (r.integrator == 1)
         for (int i = 0; i < s->material_count; ++i) {
@@ -1437,7 +1456,7 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
         }
     if (r.strategy == 3)
         for (int i = 0; i < s->material_count; ++i) {
-            if (s->material_is_huang[i]) continue; /* Cycles' own Huang sampler: no tables */
+            if (s->material_is_huang[i] && r.huang_sampling) continue; /* Cycles' own Huang sampler */
             if (s->material_is_hair[i] && !s->material_has_tables[i])
                 return fail(HAIRIS_ERROR_INVALID_TABLE,
                             "material %d (hair): strategy=table needs sampling tables, but the "

@@ -335,24 +335,44 @@ def test_invalid_node_value_fails_cleanly():
 
 
 def test_huang_material_by_bake_and_render():
-    """Blender 4.0+: the bake operator refuses a Huang material with a report naming it (the
-    Chiang material beside it still bakes); F12 with the Table strategy refuses it, with the
-    Uniform strategy or Cycles' own Huang sampling it renders (as a Huang material)."""
+    """Blender 4.0+: the bake operator bakes a Huang material's tables (its Huang table) beside
+    the Chiang material's; F12 with the Table strategy renders it with them, refuses them once
+    a Huang-only input (Aspect Ratio, a lobe multiplier) changed, and auto-bakes them again;
+    Cycles' own Huang sampling needs no tables."""
     if helpers.VERSION < (4, 0, 0):
         return  # no model setting before 4.0
     scene = helpers.make_test_scene()
+    scene.hairis.auto_bake = False
+    scene.hairis.strategy = "TABLE"
+    curly = bpy.data.materials["Curly"]
+    node = curly.node_tree.nodes["Principled Hair BSDF"]
+    node.model = "HUANG"
+    lib = library()
+    assert bpy.ops.hairis.bake_tables() == {"FINISHED"}
+    for name in ("Hair", "Curly"):
+        assert bpy.data.materials[name].hairis.table_image is not None, name
+        assert tables.quick_state(lib, bpy.data.materials[name]) == "OK", name
+    assert curly.hairis.baked_model == "huang2022", curly.hairis.baked_model
+    curly_node = tables.principled_struct(lib, tables.material_parameters(curly))
+    with lib.fiber_principled(curly_node) as fiber:
+        status = tables.check_material(lib, curly, fiber)
+    assert status.ok, status.message
+    assert status.tables.info.get("huang_theta_o") == "24", status.tables.info
+    status.tables.close()
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "huang_sampling") == "0", summary
+    assert re.search(r"hair \d+ tables=1 huang=1 ", summary), summary
+    assert summary.count("tables=1") == 2, summary
+    for socket_name, value in (("Aspect Ratio", 0.5), ("TT lobe", 0.3)):
+        helpers.socket(node, socket_name).default_value = value
+        assert tables.quick_state(lib, curly) == "STALE", socket_name
+        expect_render_error(scene, "'Curly'", "baked for other hair parameters")
+        assert bpy.ops.hairis.bake_tables(material="Curly") == {"FINISHED"}
+        assert tables.quick_state(lib, curly) == "OK", socket_name
+    helpers.socket(node, "Aspect Ratio").default_value = 0.7
     scene.hairis.auto_bake = True
-    bpy.data.materials["Curly"].node_tree.nodes["Principled Hair BSDF"].model = "HUANG"
-    for kwargs in ({}, {"material": "Curly"}):
-        try:
-            bpy.ops.hairis.bake_tables(**kwargs)  # an ERROR report raises in bpy.ops
-        except RuntimeError as error:
-            assert "'Curly'" in str(error) and "huang2022" in str(error), error
-        else:
-            raise AssertionError("baking a Huang material must be refused")
-    assert bpy.data.materials["Hair"].hairis.table_image is not None, "Hair must still bake"
-    assert bpy.data.materials["Curly"].hairis.table_image is None
-    expect_render_error(scene, "'Curly'", "huang2022")
+    _pixels, summary = render(scene)
+    assert re.search(r"hair \d+ tables=1 huang=1 ", summary), summary
     scene.hairis.huang_sampling = "CYCLES"  # Cycles' sampler needs no tables
     _pixels, summary = render(scene)
     assert summary_value(summary, "huang_sampling") == "1", summary

@@ -838,6 +838,44 @@ class TestRender(unittest.TestCase):
         self.assertIn("material 0", last_error())
         lib().hairis_scene_destroy(scene)
 
+    def test_huang_hair_with_its_huang_table(self):
+        # Huang tables bake, survive a round trip through EXR bytes in a file, and TABLE
+        # renders with them; tables of another aspect ratio are refused naming the material.
+        fiber = make_fiber("model=huang;aspect_ratio=0.5")
+        options = b"huang_theta_o=6;huang_phi_o=3;huang_theta_i=12;huang_phi=16"
+        tables = lib().hairis_tables_bake(fiber, options, PROGRESS_FN(), None)
+        self.assertTrue(tables, last_error())
+        self.assertEqual(lib().hairis_tables_model(tables), b"huang2022")
+        self.assertEqual(items(lib().hairis_tables_info(tables).decode()),
+                         {"source": "exact", "huang_theta_o": "6", "huang_phi_o": "3",
+                          "huang_theta_i": "12", "huang_phi": "16"})
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "huang.exr")
+            self.assertEqual(lib().hairis_tables_write(tables, path.encode()), OK, last_error())
+            with open(path, "rb") as handle:
+                loaded = load_memory(handle.read())
+        lib().hairis_tables_destroy(tables)
+        self.assertTrue(loaded, last_error())
+        self.assertEqual(lib().hairis_tables_match_fiber(loaded, fiber), 1)
+        lib().hairis_fiber_destroy(fiber)
+        rgba = np.full((self.H, self.W, 4), -1, np.float32)
+        for fiber_options, expected in (("model=huang;aspect_ratio=0.5", OK),
+                                        ("model=huang;aspect_ratio=0.6", ERROR_INVALID_TABLE),
+                                        ("", ERROR_INVALID_TABLE)):
+            with self.subTest(fiber=fiber_options):
+                scene = self.make_scene(loaded, fiber_options)
+                status = lib().hairis_render(scene, self.settings("table"), ptr(rgba),
+                                             PROGRESS_FN(), None)
+                self.assertEqual(status, expected, last_error())
+                if expected == OK:
+                    self.assertTrue(np.all(np.isfinite(rgba)) and np.all(rgba >= 0))
+                    self.assertGreater(rgba[..., :3].sum(), 0)
+                else:
+                    self.assertIn("material 0", last_error())
+                    self.assertIn("huang2022", last_error())
+                lib().hairis_scene_destroy(scene)
+        lib().hairis_tables_destroy(loaded)
+
     def test_cancel_from_python(self):
         scene = self.make_scene(None)
         rgba = np.zeros((self.H, self.W, 4), np.float32)

@@ -1748,8 +1748,30 @@ static void test_huang(void)
     CHECK(hairis_fiber_eval(huang, N, wi, wo, h, f) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "no near field by h for Huang");
     CHECK_ERROR_MENTIONS("huang2022");
-    CHECK(hairis_tables_bake(huang, "", NULL, NULL) == NULL, "no tables for Huang yet");
+    /* Its tables are its Huang table: baked, described, matched, written and loaded. */
+    const char *small = "huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;threads=2";
+    hairis_tables *huang_tables = hairis_tables_bake(huang, small, NULL, NULL);
+    CHECK(huang_tables != NULL, "Huang tables bake: %s", hairis_last_error());
+    CHECK(huang_tables && strcmp(hairis_tables_model(huang_tables), "huang2022") == 0, "model huang2022");
+    CHECK(huang_tables && strcmp(hairis_tables_info(huang_tables),
+                                 "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24") == 0,
+          "info \"%s\"", huang_tables ? hairis_tables_info(huang_tables) : "");
+    CHECK(hairis_tables_match_fiber(huang_tables, huang) == 1, "they match their fiber");
+    hairis_fiber *rounder = hairis_fiber_create("model=huang;aspect_ratio=0.6;transmission=0.5");
+    hairis_fiber *dimmer = hairis_fiber_create("model=huang;aspect_ratio=0.5;transmission=0.4");
+    CHECK(hairis_tables_match_fiber(huang_tables, rounder) == 0 && hairis_tables_match_fiber(huang_tables, dimmer) == 0,
+          "not another aspect ratio or lobe multiplier");
+    CHECK(hairis_tables_bake(huang, "huang_phi=0", NULL, NULL) == NULL, "huang_phi=0 refused");
+    CHECK_ERROR_MENTIONS("huang_phi");
+    CHECK(hairis_tables_bake(huang, "source=gaussian", NULL, NULL) == NULL, "gaussian refused for Huang");
     CHECK_ERROR_MENTIONS("huang2022");
+    CHECK(hairis_tables_bake(huang, small, cancel_at_once, NULL) == NULL &&
+              strcmp(hairis_last_error(), "cancelled") == 0,
+          "a Huang bake cancels");
+    hairis_sampler *huang_sampler = hairis_sampler_create(huang, huang_tables, "strategy=table");
+    CHECK(huang_sampler == NULL, "the sampler API takes no Huang table");
+    CHECK_ERROR_MENTIONS("huang2022");
+    hairis_sampler_destroy(huang_sampler);
 
     /* A scene of Huang hair: renders with uniform (and gaussian), refuses analytic and table
      * naming the material. */
@@ -1777,8 +1799,71 @@ static void test_huang(void)
     CHECK_ERROR_MENTIONS("material 0");
     CHECK_ERROR_MENTIONS("uniform");
     CHECK(hairis_render(scene, tiny_settings(s, "table", ""), rgba, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
-          "table refused for Huang");
+          "table refused for Huang without tables");
     CHECK_ERROR_MENTIONS("material 0");
+    CHECK_ERROR_MENTIONS("without tables");
+    CHECK(hairis_render(scene, tiny_settings(s, "table", ";huang_sampling=cycles"), rgba, NULL, NULL) == HAIRIS_OK,
+          "Cycles' own Huang sampling needs no tables");
+
+    /* With its Huang table, TABLE renders Huang hair, converging to what UNIFORM converges to:
+     * the image means over independent seeds agree within 4 standard errors. */
+    hairis_scene *tabled = hairis_scene_create();
+    CHECK(hairis_scene_add_hair_material(tabled, huang, huang_tables) == 0, "Huang material with tables");
+    CHECK(add_oriented_strands(tabled, 0, up, "") == HAIRIS_OK, "its curves");
+    CHECK(hairis_scene_add_light(tabled, "type=sun;direction=0.3,0.2,1;strength=3") == HAIRIS_OK &&
+              hairis_scene_set_world(tabled, SKY) == HAIRIS_OK && hairis_scene_set_camera(tabled, CAMERA) == HAIRIS_OK,
+          "sun, world and camera");
+    enum { SEEDS = 8 };
+    double mean[2] = {0, 0}, square[2] = {0, 0};
+    const char *const compared[2] = {"table", "uniform"};
+    for (int k = 0; k < 2; ++k)
+        for (int seed = 1; seed <= SEEDS; ++seed) {
+            snprintf(s, TEXT, "samples=16;max_bounces=3;max_transparent_bounces=3;threads=2;seed=%d;strategy=%s", seed,
+                     compared[k]);
+            CHECK(hairis_render(tabled, s, rgba, NULL, NULL) == HAIRIS_OK, "%s renders Huang with its table: %s",
+                  compared[k], hairis_last_error());
+            CHECK(pixels_ok(rgba), "%s: a finite image", compared[k]);
+            const double m = pixel_sum(rgba, W * H) / (3.0 * W * H);
+            mean[k] += m / SEEDS;
+            square[k] += m * m / SEEDS;
+        }
+    double error2 = 0;
+    for (int k = 0; k < 2; ++k) error2 += (square[k] - mean[k] * mean[k]) / (SEEDS - 1);
+    printf("   Huang TABLE vs UNIFORM image means over %d seeds: %g vs %g (standard error of the difference %g)\n",
+           SEEDS, mean[0], mean[1], sqrt(error2));
+    CHECK(mean[0] > 0.0 && fabs(mean[0] - mean[1]) <= 4.0 * sqrt(error2),
+          "TABLE and UNIFORM agree in the mean: %g and %g (standard error of the difference %g)", mean[0], mean[1],
+          sqrt(error2));
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering"), rgba, NULL, NULL) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT,
+          "dual scattering refused for Huang");
+    CHECK_ERROR_MENTIONS("material 0");
+    CHECK_ERROR_MENTIONS("chiang2016");
+    hairis_scene_destroy(tabled);
+
+    /* Tables of other parameters, or of another model, are refused naming the material. */
+    hairis_fiber *chiang = hairis_fiber_create("");
+    hairis_tables *chiang_tables = hairis_tables_bake(chiang, "theta_r=2;theta_i=4;phi=4;n_h=2", NULL, NULL);
+    CHECK(chiang_tables != NULL, "Chiang tables: %s", hairis_last_error());
+    struct {
+        const hairis_fiber *fiber;
+        const hairis_tables *tables;
+        const char *what;
+    } stale[3] = {{rounder, huang_tables, "aspect_ratio=0.6"}, {dimmer, huang_tables, "transmission=0.4"},
+                  {huang, chiang_tables, "chiang2016"}};
+    for (int k = 0; k < 3; ++k) {
+        hairis_scene *other = hairis_scene_create();
+        hairis_scene_add_hair_material(other, stale[k].fiber, stale[k].tables);
+        add_oriented_strands(other, 0, up, "");
+        hairis_scene_set_camera(other, CAMERA);
+        CHECK(hairis_render(other, tiny_settings(s, "table", ""), rgba, NULL, NULL) == HAIRIS_ERROR_INVALID_TABLE,
+              "stale tables refused (%s)", stale[k].what);
+        CHECK_ERROR_MENTIONS("material 0");
+        CHECK_ERROR_MENTIONS(stale[k].what);
+        hairis_scene_destroy(other);
+    }
+    hairis_tables_destroy(chiang_tables);
+    hairis_fiber_destroy(chiang);
     CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";max_transparent_bounces=-1"), rgba, NULL, NULL) ==
               HAIRIS_ERROR_INVALID_ARGUMENT,
           "max_transparent_bounces -1 refused");
@@ -1805,8 +1890,11 @@ static void test_huang(void)
               HAIRIS_ERROR_INVALID_ARGUMENT,
           "NULL scene");
     hairis_scene_destroy(scene);
+    hairis_tables_destroy(huang_tables);
     hairis_fiber_destroy(huang);
     hairis_fiber_destroy(inverted);
+    hairis_fiber_destroy(rounder);
+    hairis_fiber_destroy(dimmer);
 }
 
 static void test_render_options(void)

@@ -56,6 +56,38 @@ class HairisBakeTest(unittest.TestCase):
                      "near   rows 80-", "x 4 lobes", "valid:           yes"]:
             self.assertIn(text, r.stdout)
 
+    def test_huang_bake_then_inspect(self):
+        out, again = self.path("h.exr"), self.path("h2.exr")
+        small = ["--huang-theta-o", "6", "--huang-phi-o", "3", "--huang-theta-i", "12",
+                 "--huang-phi", "16"]
+        r = run("bake", "--preset", "cycles-default-huang", *small, "--threads", "1", "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("huang2022, 6 theta_o x 3 phi_o nodes, 12 x 16 cells", r.stderr)
+        r = run("bake", "--set", "model=huang", *small, "--threads", "2", "-q", "-o", again)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(out, "rb") as fa, open(again, "rb") as fb:
+            self.assertEqual(fa.read(), fb.read(), "the Huang bake depends on the thread count")
+        r = run("inspect", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for text in ["huang2022", "aspect_ratio", "secondary_reflection",
+                     "theta_o nodes:   6", "phi_o nodes:     3 (0.00 .. 90.00 deg)",
+                     "huang  rows 0-215: 3 phi_o nodes x 6 theta_o nodes x 12 theta_i cells",
+                     "cells:           3456", "image:           16 x 216", "valid:           yes"]:
+            self.assertIn(text, r.stdout)
+        self.assertNotIn("far    rows", r.stdout)
+        r = run("bake", "--set", "model=huang", "--source", "gaussian", "-q", "-o", again)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("huang2022", r.stderr)
+        out = self.path("huang_figures")
+        r = run("figures", "--table", self.path("h.exr"), "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(out, "table_huang.png"), "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        import numpy as np
+        values = np.load(os.path.join(out, "table_huang.npy"))
+        self.assertEqual(values.shape, (3, 6, 12, 16))
+        self.assertTrue((values >= 0).all() and (values > 0).any())
+
     def test_bake_is_deterministic_whatever_the_thread_count(self):
         a, b = self.path("a.exr"), self.path("b.exr")
         self.assertEqual(run("bake", *SMALL, "--threads", "1", "-q", "-o", a).returncode, 0)

@@ -113,8 +113,11 @@ HAIRIS_API int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const floa
 /**
  * Bakes tables for a fiber; NULL on error or cancel (then the last error is exactly
  * "cancelled"). Options: theta_r, theta_i, phi (resolution), n_h (strand counts, increasing),
- * source (exact | gaussian), quadrature_points, threads (0: all cores). `progress` (may be
- * NULL) is called on the calling thread; non-zero cancels within one θ_r slice.
+ * source (exact | gaussian), quadrature_points, threads (0: all cores); a huang2022 fiber's
+ * tables are its Huang table alone, of huang_theta_o × huang_phi_o view nodes and
+ * huang_theta_i × huang_phi cells (the options above but source = exact and threads do not
+ * apply to it). `progress` (may be NULL) is called on the calling thread; non-zero cancels
+ * within one θ_r (Huang: θ_o) slice.
  */
 HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *options,
                                              hairis_progress_fn progress, void *user);
@@ -129,7 +132,8 @@ HAIRIS_API void hairis_tables_destroy(hairis_tables *tables);
 HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables);
 /** The fiber parameters the tables were baked for, "name=value;...". */
 HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables);
-/** What the tables hold, as options: source, theta_r, theta_i, phi, n_h. */
+/** What the tables hold, as options: source, theta_r, theta_i, phi, n_h; for huang2022 tables
+ * source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi. */
 HAIRIS_API const char *hairis_tables_info(const hairis_tables *tables);
 /** 1 when the tables were baked for exactly this fiber's parameters, else 0 (also for NULL
  * arguments, with the last error set). */
@@ -144,7 +148,8 @@ HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hair
  * one the tables hold for TABLE, 1, 2, 4, 8 or 16 for GAUSSIAN). `fiber` is needed for
  * ANALYTIC; `tables` for TABLE, where a Chiang `fiber` (optional) makes the single-scattering
  * part follow its near field at h, and the tables must then have been baked for it
- * (HAIRIS_ERROR_INVALID_TABLE otherwise). The sampler keeps what it samples from.
+ * (HAIRIS_ERROR_INVALID_TABLE otherwise). huang2022 tables are sampled by the renderer only
+ * (TABLE here refuses them and huang2022 fibers). The sampler keeps what it samples from.
  */
 HAIRIS_API hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, const hairis_tables *tables,
                                                  const char *options);

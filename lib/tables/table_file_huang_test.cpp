@@ -1,0 +1,415 @@
+// Table files of huang2022 fibers (table_file.h, the "huang" part): the Huang table round-trips
+// bit for bit and lies in the image where the format says, the TABLE strategy sampled from a
+// loaded file is exact, and damaged or inconsistent files are refused naming the problem.
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/hash.h>
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+
+#include "chi2.h"
+#include "core/frame.h"
+#include "fiber/principled_hair.h"
+#include "sampling/huang_table_sampler.h"
+#include "sampling/strategy.h"
+#include "tables/bake.h"
+#include "tables/huang_bake.h"
+#include "tables/table_file.h"
+
+namespace hairis {
+namespace {
+
+using testing::Chi2Options;
+using testing::Sample3;
+
+std::shared_ptr<const HuangFiber> huang_fiber(float aspect_ratio = 0.85f) {
+    HuangParams p;  // Blender's default node: its default colour mapped with Huang's roughness
+    p.sigma_a = principled_hair::sigma_from_reflectance({0.017513f, 0.005763f, 0.002059f}, p.roughness);
+    p.aspect_ratio = aspect_ratio;
+    return std::make_shared<const HuangFiber>(HuangFiber::create(p).value());
+}
+
+BakeOptions small_bake() {
+    BakeOptions o;
+    o.huang = {8, 3, 16, 24};
+    return o;
+}
+
+// A baked table set of the default fiber at small_bake()'s resolution (baked once).
+const TableSet &baked() {
+    static const TableSet t = [] {
+        const auto fiber = huang_fiber();
+        return bake_tables(*fiber, huang_parameters(fiber->params()), small_bake()).value();
+    }();
+    return t;
+}
+
+// A Huang set whose values are all distinct (a value read from another pixel cannot
+// round-trip), with a zero and a subnormal value.
+TableSet distinct_tables(int theta_o = 3, int phi_o = 2, int theta_i = 4, int phi = 5) {
+    auto h = std::make_shared<HuangTableSet>();
+    h->parameters = huang_parameters(HuangParams{});
+    for (int r = 0; r < theta_o; ++r) h->theta_o_nodes.push_back(float(-1.2 + 2.4 * r / std::max(theta_o - 1, 1)));
+    h->phi_o_nodes = huang_phi_o_nodes(phi_o);
+    h->theta_i_count = theta_i;
+    h->phi_count = phi;
+    const int cells = phi_o * theta_o * theta_i * phi;
+    for (int n = 0; n < cells; ++n) h->values.push_back(n == 1 ? 0.0f : n == 2 ? 1e-40f : 0.5f + 0.001f * float(n));
+    TableSet t;
+    t.model = "huang2022";
+    t.source = "exact";
+    t.parameters = h->parameters;
+    t.huang = std::move(h);
+    return t;
+}
+
+std::vector<unsigned char> encode(const TableSet &t) {
+    auto bytes = encode_table_exr(t);
+    EXPECT_TRUE(bytes.ok()) << (bytes.ok() ? "" : bytes.error().message);
+    return bytes.ok() ? bytes.value() : std::vector<unsigned char>{};
+}
+
+struct Image {
+    OIIO::ImageSpec spec;
+    std::vector<float> px;
+    float &at(int x, int y, int c) { return px[(size_t(y) * size_t(spec.width) + size_t(x)) * 4 + size_t(c)]; }
+};
+
+Image read_image(const std::vector<unsigned char> &bytes) {
+    OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+    auto in = OIIO::ImageInput::create("openexr");
+    Image image;
+    OIIO::ImageSpec config;
+    void *proxy_pointer = &reader;
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+    EXPECT_TRUE(in && in->open("t.exr", image.spec, config));
+    image.px.resize(size_t(image.spec.width) * image.spec.height * image.spec.nchannels);
+    EXPECT_TRUE(in->read_image(0, 0, 0, image.spec.nchannels, OIIO::TypeDesc::FLOAT, image.px.data()));
+    in->close();
+    return image;
+}
+
+std::vector<unsigned char> write_image(const Image &image) {
+    std::vector<unsigned char> out_bytes;
+    OIIO::Filesystem::IOVecOutput writer(out_bytes);
+    auto out = OIIO::ImageOutput::create("openexr");
+    EXPECT_TRUE(out->set_ioproxy(&writer));
+    EXPECT_TRUE(out->open("t.exr", image.spec));
+    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, image.px.data()));
+    EXPECT_TRUE(out->close());
+    return out_bytes;
+}
+
+void rehash(Image &image) {
+    OIIO::SHA1 sha(image.px.data(), image.px.size() * sizeof(float));
+    image.spec.attribute("hairis:pixel_sha1", sha.digest());
+}
+
+// Valid bytes of `t` re-encoded after `edit` changed the header or the pixels; the hash is
+// made to match the edited pixels unless `fix_hash` is false.
+std::vector<unsigned char> tamper(const TableSet &t, const std::function<void(Image &)> &edit, bool fix_hash = true) {
+    Image image = read_image(encode(t));
+    edit(image);
+    if (fix_hash) rehash(image);
+    return write_image(image);
+}
+
+void expect_refused(const std::vector<unsigned char> &bytes, const std::string &fragment) {
+    const Expected<TableSet> t = decode_table_exr(bytes.data(), bytes.size());
+    ASSERT_FALSE(t.ok()) << "expected a refusal mentioning \"" << fragment << "\"";
+    EXPECT_NE(t.error().message.find(fragment), std::string::npos) << t.error().message;
+    EXPECT_EQ(t.error().kind, ErrorKind::InvalidTable) << t.error().message;
+}
+
+void expect_same_huang_part(const TableSet &b, const TableSet &t) {
+    EXPECT_EQ(b.model, t.model);
+    EXPECT_EQ(b.source, t.source);
+    // Parameters are recorded to 9 significant digits (canonical_parameters), values bit for bit.
+    EXPECT_EQ(canonical_parameters(b.parameters), canonical_parameters(t.parameters));
+    ASSERT_TRUE(b.huang && t.huang);
+    EXPECT_FALSE(b.has_far_field());
+    EXPECT_FALSE(b.near_field);
+    EXPECT_EQ(canonical_parameters(b.huang->parameters), canonical_parameters(t.huang->parameters));
+    EXPECT_EQ(b.huang->theta_o_nodes, t.huang->theta_o_nodes);
+    EXPECT_EQ(b.huang->phi_o_nodes, t.huang->phi_o_nodes);
+    EXPECT_EQ(b.huang->theta_i_count, t.huang->theta_i_count);
+    EXPECT_EQ(b.huang->phi_count, t.huang->phi_count);
+    ASSERT_EQ(b.huang->values.size(), t.huang->values.size());
+    EXPECT_EQ(0, std::memcmp(b.huang->values.data(), t.huang->values.data(), t.huang->values.size() * sizeof(float)));
+}
+
+TEST(HuangTableFile, RoundTripIsBitExact) {
+    for (const TableSet &t : {distinct_tables(), distinct_tables(1, 1, 2, 1), distinct_tables(5, 4, 7, 3), baked()}) {
+        const std::vector<unsigned char> bytes = encode(t);
+        const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
+        ASSERT_TRUE(back.ok()) << back.error().message;
+        expect_same_huang_part(back.value(), t);
+    }
+}
+
+TEST(HuangTableFile, TheImageHoldsThePartWhereTheFormatSays) {
+    const TableSet t = distinct_tables(3, 2, 4, 5);
+    Image image = read_image(encode(t));
+    const HuangTableSet &h = *t.huang;
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:parts"), "huang");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:model"), "huang2022");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:huang"), "row=0;theta_o=3;phi_o=2;theta_i=4;phi=5");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:parameters"), canonical_parameters(h.parameters));
+    EXPECT_EQ(image.spec.find_attribute("hairis:theta_r_count"), nullptr);
+    ASSERT_EQ(image.spec.width, 5);
+    ASSERT_EQ(image.spec.height, 2 * 3 * 4);
+    for (int q = 0; q < 2; ++q)
+        for (int r = 0; r < 3; ++r)
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 5; ++j) {
+                    const int y = (q * 3 + r) * 4 + i;
+                    // values[((q·theta_o + r)·theta_i + i)·phi + j], the order HuangTable::create reads.
+                    EXPECT_EQ(image.at(j, y, 0), h.values[size_t(((q * 3 + r) * 4 + i) * 5 + j)]) << q << r << i << j;
+                    EXPECT_EQ(image.at(j, y, 1), 0.0f);
+                    EXPECT_EQ(image.at(j, y, 2), 0.0f);
+                    EXPECT_EQ(image.at(j, y, 3), 1.0f);
+                }
+}
+
+TEST(HuangTableFile, EncodingIsDeterministic) { EXPECT_EQ(encode(baked()), encode(baked())); }
+
+// ---- The TABLE strategy from a loaded file -------------------------------------------------
+
+// A renderer hit at θ_o (degrees) whose curve normal puts the major axis at ψ from y.
+FiberHit huang_hit(double theta_o_deg, double psi) {
+    const double t = radians(theta_o_deg);
+    FiberHit hit;
+    hit.wo = {float(std::sin(t)), 0.0f, float(-std::cos(t))};
+    hit.normal = {0.2f, float(std::cos(psi)), float(std::sin(psi))};
+    return hit;
+}
+
+std::shared_ptr<const Sampler> table_sampler(const SamplingTables &tables) {
+    StrategyInputs in;
+    in.huang = huang_fiber();
+    in.tables = &tables;
+    auto made = make_sampler(StrategyKind::Table, in);
+    EXPECT_TRUE(made.ok()) << made.error().message;
+    return made.ok() ? made.value() : nullptr;
+}
+
+// χ² of the TABLE strategy built from `tables` at views on and between the nodes.
+void expect_table_strategy_exact(const SamplingTables &tables, const char *what) {
+    const auto s = table_sampler(tables);
+    ASSERT_TRUE(s);
+    const HuangTable &table = *tables.huang->table;
+    const std::pair<double, double> views[] = {{-33.75, 0.0}, {20.0, 0.7}, {-70.0, 2.2}};
+    for (const auto &[theta_o, psi] : views) {
+        const FiberHit hit = huang_hit(theta_o, psi);
+        ScratchBuffer scratch;
+        const HuangPoint &point = static_cast<const HuangPoint &>(s->model()->prepare(hit, scratch));
+        const SamplerPoint &at = s->at(hit, &point, scratch);
+        const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
+        Chi2Options options;
+        options.test_count = 2 * int(std::size(views));
+        for (const ThetaWarp &w : q.warp)
+            for (int k = 0; k <= table.theta_i_count(); ++k)
+                options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
+        options.theta_breaks.push_back(q.warp[0].anchor);
+        for (int k = 0; k <= table.phi_count(); ++k) {
+            const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
+            options.phi_breaks.push_back(
+                angles_of(point.from_huang({0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))})).phi);
+        }
+        const auto r = testing::chi2_direction_test(
+            [&](Sample3 u) -> std::optional<Vec3> {
+                auto d = at.sample(u.u0, u.u1, u.u2);
+                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
+            },
+            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        std::printf("[chi2] Huang table %s at theta_o %.2f, psi %.1f: %s\n", what, theta_o, psi, r.message.c_str());
+        EXPECT_TRUE(r.passed) << what << " " << theta_o << ": " << r.message;
+        EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what << " " << theta_o;
+        EXPECT_EQ(r.failed_samples, 0) << what << " " << theta_o;
+    }
+}
+
+TEST(HuangTableFile, TheTableStrategyFromBytesIsExact) {
+    const std::vector<unsigned char> bytes = encode(baked());
+    const Expected<TableSet> loaded = decode_table_exr(bytes.data(), bytes.size());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    const Expected<SamplingTables> tables = SamplingTables::from(loaded.value());
+    ASSERT_TRUE(tables.ok()) << tables.error().message;
+    EXPECT_FALSE(tables.value().direct);
+    EXPECT_EQ(tables.value().model, "huang2022");
+    expect_table_strategy_exact(tables.value(), "from bytes");
+}
+
+TEST(HuangTableFile, TheTableStrategyFromAFileIsExactAndSamplesTheBakedTable) {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("hairis_huang_" + std::to_string(::getpid()) + ".exr")).string();
+    ASSERT_FALSE(write_table_file(baked(), path));
+    const Expected<TableSet> loaded = read_table_file(path);
+    std::remove(path.c_str());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    const SamplingTables from_file = SamplingTables::from(loaded.value()).value();
+    expect_table_strategy_exact(from_file, "from a file");
+    // The loaded sampler is the baked table's: the same density at every direction tried.
+    const SamplingTables from_bake = SamplingTables::from(baked()).value();
+    const auto a = table_sampler(from_file), b = table_sampler(from_bake);
+    const FiberHit hit = huang_hit(12.0, 0.3);
+    ScratchBuffer scratch;
+    const FiberPoint &point = a->model()->prepare(hit, scratch);
+    const SamplerPoint &pa = a->at(hit, &point, scratch), &pb = b->at(hit, &point, scratch);
+    float largest = 0.0f, smallest = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < 500; ++k) {
+        const Vec3 wi = direction_of(float(-1.5 + 3.0 * ((k * 37) % 500) / 500.0), float(-kPi + kTwoPi * k / 500.0));
+        EXPECT_EQ(pa.pdf(wi), pb.pdf(wi)) << k;
+        largest = std::max(largest, pa.pdf(wi));
+        smallest = std::min(smallest, pa.pdf(wi));
+    }
+    EXPECT_GT(largest, 4.0f * smallest);  // not the uniform sphere
+}
+
+TEST(HuangTableFile, TablesOfAnotherFiberAreRefusedByTheStrategy) {
+    const auto other = huang_fiber(0.5f);
+    const TableSet t = bake_tables(*other, huang_parameters(other->params()), small_bake()).value();
+    const std::vector<unsigned char> bytes = encode(t);
+    const SamplingTables tables = SamplingTables::from(decode_table_exr(bytes.data(), bytes.size()).value()).value();
+    StrategyInputs in;
+    in.huang = huang_fiber();
+    in.tables = &tables;
+    const auto made = make_sampler(StrategyKind::Table, in);
+    ASSERT_FALSE(made.ok());
+    EXPECT_EQ(made.error().kind, ErrorKind::InvalidTable);
+    EXPECT_NE(made.error().message.find("aspect_ratio=0.5"), std::string::npos) << made.error().message;
+    // Huang tables are not far-field tables: a Chiang fiber or no fiber is refused by name.
+    StrategyInputs none;
+    none.tables = &tables;
+    const auto far = make_sampler(StrategyKind::Table, none);
+    ASSERT_FALSE(far.ok());
+    EXPECT_NE(far.error().message.find("huang2022"), std::string::npos) << far.error().message;
+}
+
+// ---- Refusals --------------------------------------------------------------------------------
+
+TEST(HuangTableFile, RefusesATruncatedFile) {
+    const std::vector<unsigned char> bytes = encode(baked());
+    for (size_t keep : {bytes.size() / 2, bytes.size() - 10}) {
+        const std::vector<unsigned char> cut(bytes.begin(), bytes.begin() + std::ptrdiff_t(keep));
+        const Expected<TableSet> t = decode_table_exr(cut.data(), cut.size());
+        ASSERT_FALSE(t.ok()) << keep;
+        EXPECT_EQ(t.error().kind, ErrorKind::InvalidTable) << t.error().message;
+    }
+}
+
+TEST(HuangTableFile, RefusesAnAlteredValueWithAStaleHash) {
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(2, 3, 0) *= 1.5f; }, false), "hairis:pixel_sha1");
+}
+
+TEST(HuangTableFile, RefusesNaNInfinityAndNegativeValues) {
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(1, 2, 0) = std::nanf(""); }), "NaN");
+    expect_refused(tamper(distinct_tables(), [](Image &im) {
+                       im.at(4, 7, 0) = std::numeric_limits<float>::infinity();
+                   }),
+                   "NaN or infinity");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(3, 5, 0) = -0.25f; }), "theta_o node 1");
+}
+
+TEST(HuangTableFile, RefusesNonZeroGOrBAndAOtherThanOne) {
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(0, 1, 1) = 0.5f; }), "G and B must be 0");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(2, 0, 2) = 1.0f; }), "pixel (2, 0)");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.at(4, 9, 3) = 0.0f; }), "A must be 1");
+}
+
+TEST(HuangTableFile, RefusesWrongCounts) {
+    auto with_huang = [](const std::string &value) {
+        return tamper(distinct_tables(), [&](Image &im) { im.spec.attribute("hairis:huang", value); });
+    };
+    // distinct_tables(): 3 θ_o × 2 φ_o × 4 θ_i × 5 φ, an image of 5 × 24.
+    expect_refused(with_huang("row=0;theta_o=3;phi_o=2;theta_i=4;phi=6"), "needs 6x24");
+    expect_refused(with_huang("row=0;theta_o=4;phi_o=2;theta_i=4;phi=5"), "needs 5x32");
+    expect_refused(with_huang("row=0;theta_o=3;phi_o=1;theta_i=8;phi=5"), "hairis:huang_phi_o_nodes must hold 1");
+    expect_refused(with_huang("row=2;theta_o=3;phi_o=2;theta_i=4;phi=5"), "row");
+    expect_refused(with_huang("row=0;theta_o=3;phi_o=2;theta_i=4"), "phi");
+    expect_refused(with_huang("row=0;theta_o=3;phi_o=2;theta_i=4;phi=5;n_h=2"), "n_h");
+    expect_refused(with_huang("row=0;theta_o=0;phi_o=2;theta_i=4;phi=5"), "theta_o");
+    expect_refused(tamper(distinct_tables(), [](Image &im) {
+                       const float nodes[2] = {0.1f, 0.2f};
+                       im.spec.attribute("hairis:huang_theta_o_nodes", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 2), nodes);
+                   }),
+                   "hairis:huang_theta_o_nodes must hold 3");
+    expect_refused(tamper(distinct_tables(), [](Image &im) {
+                       const float nodes[2] = {0.5f, 0.2f};
+                       im.spec.attribute("hairis:huang_phi_o_nodes", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 2), nodes);
+                   }),
+                   "phi_o_nodes must be strictly increasing");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.erase_attribute("hairis:huang"); }),
+                   "no string attribute hairis:huang");
+}
+
+TEST(HuangTableFile, RefusesAbsurdCountsBeforeAllocating) {
+    // The claimed table would hold 2^36 cells; only the header says so.
+    expect_refused(tamper(distinct_tables(),
+                          [](Image &im) {
+                              im.spec.attribute("hairis:huang", "row=0;theta_o=1024;phi_o=256;theta_i=4096;phi=64");
+                          }),
+                   "at most");
+}
+
+TEST(HuangTableFile, RefusesPartsAndModelsThatDoNotMatch) {
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.attribute("hairis:model", "chiang2016"); }),
+                   "model huang2022");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.attribute("hairis:parts", "far"); }),
+                   "hairis:parts \"huang\"");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.attribute("hairis:parts", "far,huang"); }),
+                   "hairis:parts");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.attribute("hairis:theta_r_count", 3); }),
+                   "hairis:theta_r_count");
+    expect_refused(tamper(distinct_tables(), [](Image &im) { im.spec.attribute("hairis:source", "gaussian"); }),
+                   "source \"exact\"");
+}
+
+TEST(HuangTableFile, RefusesParametersThatAreNotAHuangFibers) {
+    // A Chiang fiber's parameter list (no aspect ratio, no lobe multipliers) on a Huang part.
+    expect_refused(tamper(distinct_tables(),
+                          [](Image &im) {
+                              im.spec.attribute("hairis:parameters",
+                                                "sigma_a.r=0.2;sigma_a.g=0.5;sigma_a.b=1;roughness=0.3;"
+                                                "radial_roughness=0.3;coat=0;ior=1.55;offset=0.03");
+                          }),
+                   "huang2022 tables record the parameters sigma_a_r,sigma_a_g");
+    expect_refused(tamper(distinct_tables(),
+                          [](Image &im) {
+                              std::string p = im.spec.get_string_attribute("hairis:parameters");
+                              im.spec.attribute("hairis:parameters", p.substr(0, p.rfind(';')));
+                          }),
+                   "secondary_reflection");
+}
+
+TEST(HuangTableFile, TheSetsRulesAreCheckedBeforeEncoding) {
+    TableSet t = distinct_tables();
+    t.theta_r_nodes = {0.0f};
+    auto far = encode_table_exr(t);
+    ASSERT_FALSE(far.ok());
+    EXPECT_NE(far.error().message.find("only the Huang part"), std::string::npos) << far.error().message;
+    TableSet other = distinct_tables();
+    other.parameters[6].second = 0.5;  // aspect_ratio, not what the Huang part was baked for
+    auto stale = encode_table_exr(other);
+    ASSERT_FALSE(stale.ok());
+    EXPECT_NE(stale.error().message.find("aspect_ratio=0.5"), std::string::npos) << stale.error().message;
+    TableSet missing = distinct_tables();
+    missing.huang = nullptr;
+    auto none = encode_table_exr(missing);
+    ASSERT_FALSE(none.ok());
+    EXPECT_NE(none.error().message.find("Huang part"), std::string::npos) << none.error().message;
+    TableSet chiang = distinct_tables();
+    chiang.model = "chiang2016";
+    auto foreign = encode_table_exr(chiang);
+    ASSERT_FALSE(foreign.ok());
+    EXPECT_NE(foreign.error().message.find("only for huang2022"), std::string::npos) << foreign.error().message;
+}
+
+}  // namespace
+}  // namespace hairis
