@@ -716,7 +716,8 @@ std::array<double, 3> ChiangFarField::azimuthal_graded(int p, double phi) const 
             const double lifted = target + kTwoPi * std::ceil((lo - target) / kTwoPi);
             if (lifted <= hi) points[point_count++] = deflection.solve(a, b, lifted);
         }
-        std::sort(points, points + point_count);
+        for (int i = 1; i < point_count; ++i)  // insertion sort of at most 4 points
+            for (int j = i; j > 0 && points[j] < points[j - 1]; --j) std::swap(points[j], points[j - 1]);
 
         for (int i = 0; i + 1 < point_count; ++i) {
             const double c = points[i], d = points[i + 1];

@@ -731,7 +731,9 @@ TEST_P(ChiangWhiteFurnace, AlbedoOfAClearFiber) {
 
         std::printf("[ furnace ] %5.0f  %+.2e", theta_o_deg, far - 1);
         EXPECT_NEAR(far, predicted_far, 2e-3) << "far field, θo " << theta_o_deg;
-        if (exact) EXPECT_NEAR(far, 1.0, 0.01) << "far field, θo " << theta_o_deg;
+        if (exact) {
+            EXPECT_NEAR(far, 1.0, 0.01) << "far field, θo " << theta_o_deg;
+        }
 
         for (double h : h_list) {
             const double gamma_o = std::asin(h);
@@ -749,7 +751,9 @@ TEST_P(ChiangWhiteFurnace, AlbedoOfAClearFiber) {
             for (int lobe = 0; lobe < 4; ++lobe) predicted += a[std::size_t(lobe)] * c[lobe];
             std::printf("  %+.2e", near - 1);
             EXPECT_NEAR(near, predicted, 2e-3) << "near field, θo " << theta_o_deg << " h " << h;
-            if (exact) EXPECT_NEAR(near, 1.0, 0.01) << "near field, θo " << theta_o_deg << " h " << h;
+            if (exact) {
+                EXPECT_NEAR(near, 1.0, 0.01) << "near field, θo " << theta_o_deg << " h " << h;
+            }
 
             if (exact) {
                 // An absorbing fiber returns less, in every channel.

@@ -130,8 +130,8 @@ TEST(NearFieldTable, CellMassesAreTheLobesIntegralsOnANode) {
                     // N_p is ~0.1 wide: 128 panels over φ resolve it.
                     double ring = 0;
                     const double ct = std::sqrt(std::max(0.0, 1 - st * st));
-                    for (int k = 0; k < 128; ++k)
-                        ring += GaussLegendre::rule(8).integrate(-kPi + kTwoPi * k / 128, -kPi + kTwoPi * (k + 1) / 128,
+                    for (int panel = 0; panel < 128; ++panel)
+                        ring += GaussLegendre::rule(8).integrate(-kPi + kTwoPi * panel / 128, -kPi + kTwoPi * (panel + 1) / 128,
                                                                  [&](double phi) {
                                                                      return double(table.density(q, point.direction(st, ct, phi)));
                                                                  });
