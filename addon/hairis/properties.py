@@ -17,10 +17,10 @@ STRATEGY_ITEMS = (
 INTEGRATOR_ITEMS = (
     ("PATH", "Path Tracing",
      "Unbiased path tracing of every bounce, as Cycles renders hair", 0),
-    ("DUAL_SCATTERING", "Dual Scattering",
+    ("DUAL_SCATTERING", "Dual Scattering (Experimental)",
      "Zinke et al. 2008: light reaching hair through other strands in closed form from shadow "
      "rays that count the strands, multiple scattering sampled from the baked tables (needs "
-     "baked tables)", 1),
+     "baked tables). Experimental: biased, renders dense hair brighter than Cycles", 1),
 )
 """Values match the C API's ``integrator`` (path | dual_scattering)."""
 
