@@ -103,6 +103,20 @@ def tile_means(images):
     return images.reshape(seeds, height // TILE, TILE, width // TILE, TILE, 3).mean(axis=(2, 4))
 
 
+def f12_pixels(name):
+    """The Render Result of an F12 render as floats."""
+    bpy.ops.render.render()
+    path = os.path.join(ARGS.workdir, "%s.exr" % name)
+    SCENE.render.image_settings.file_format = "OPEN_EXR"
+    SCENE.render.image_settings.color_depth = "32"
+    bpy.data.images["Render Result"].save_render(path, scene=SCENE)
+    image = bpy.data.images.load(path, check_existing=False)
+    pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    bpy.data.images.remove(image)
+    return pixels
+
+
 def test_library_loads():
     """API version 1 and a version string."""
     lib = library()
@@ -131,15 +145,7 @@ def test_each_strategy_renders():
     for strategy in STRATEGIES:
         SCENE.hairis.strategy = strategy
         SCENE.hairis.samples = 4
-        bpy.ops.render.render()
-        path = os.path.join(ARGS.workdir, "strategy_%s.exr" % strategy)
-        SCENE.render.image_settings.file_format = "OPEN_EXR"
-        SCENE.render.image_settings.color_depth = "32"
-        bpy.data.images["Render Result"].save_render(path, scene=SCENE)
-        image = bpy.data.images.load(path, check_existing=False)
-        pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-        bpy.data.images.remove(image)
+        pixels = f12_pixels("strategy_%s" % strategy)
         assert pixels.size == 40 * 32 * 4, pixels.size
         assert np.all(np.isfinite(pixels)), strategy
         assert pixels.reshape(-1, 4)[:, :3].mean() > 1e-3, "%s rendered black" % strategy
@@ -154,15 +160,7 @@ def test_dual_scattering_renders():
         SCENE.hairis.integrator = integrator
         SCENE.hairis.strategy = "TABLE"
         SCENE.hairis.samples = 16
-        bpy.ops.render.render()
-        path = os.path.join(ARGS.workdir, "integrator_%s.exr" % integrator)
-        SCENE.render.image_settings.file_format = "OPEN_EXR"
-        SCENE.render.image_settings.color_depth = "32"
-        bpy.data.images["Render Result"].save_render(path, scene=SCENE)
-        image = bpy.data.images.load(path, check_existing=False)
-        pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-        image.pixels.foreach_get(pixels)
-        bpy.data.images.remove(image)
+        pixels = f12_pixels("integrator_%s" % integrator)
         assert np.all(np.isfinite(pixels)), integrator
         means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
     SCENE.hairis.integrator = "PATH"
@@ -290,20 +288,6 @@ def test_cancel_within_one_second():
     latency = stopped - (stub.start + stub.seconds)
     print("cancel latency %.3f s (render of %d spp)" % (latency, samples))
     assert latency < 1.0, latency
-
-
-def f12_pixels(name):
-    """The Render Result of an F12 render as floats."""
-    bpy.ops.render.render()
-    path = os.path.join(ARGS.workdir, "%s.exr" % name)
-    SCENE.render.image_settings.file_format = "OPEN_EXR"
-    SCENE.render.image_settings.color_depth = "32"
-    bpy.data.images["Render Result"].save_render(path, scene=SCENE)
-    image = bpy.data.images.load(path, check_existing=False)
-    pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    return pixels
 
 
 def test_packed_tables_render_without_their_file():
