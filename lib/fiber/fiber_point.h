@@ -64,6 +64,9 @@ class ShadingModel {
     virtual ~ShadingModel() = default;
     /// The model at `hit`, made in `scratch` (valid until its reset).
     virtual const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const = 0;
+    /// Whether prepare() reads FiberHit::normal, pixel_coverage and seed (a renderer may leave
+    /// them at their defaults otherwise).
+    virtual bool reads_orientation() const { return false; }
 };
 
 }  // namespace hairis

@@ -227,6 +227,7 @@ class HuangFiber final : public FiberModel, public ShadingModel {
     bool rotationally_symmetric() const override { return aspect_ == 1.0; }
 
     /// The point for the renderer (in scratch).
+    bool reads_orientation() const override { return true; }
     const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
         return scratch.make<HuangPoint>(*this, hit);
     }

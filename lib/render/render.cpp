@@ -85,10 +85,13 @@ struct HitContext {
     bool cycles_huang = false;  // RenderSettings::huang_sampling == Cycles
 };
 
-FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context) {
+// `oriented`: fill the fields only models that read_orientation() use (Huang).
+FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context,
+                   bool oriented = true) {
     FiberHit hit;
     hit.wo = frame.to_local(wo);
     hit.h = std::clamp(dot(cross(sp.normal, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    if (!oriented) return hit;
     // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
     const Vec3 axis = HuangFiber::major_axis(sp.tangent, sp.curve_normal);
     hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(sp.tangent));
@@ -108,7 +111,8 @@ class Bsdf {
          const HairInputValues *inputs, ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
             frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-            FiberHit hit = fiber_hit(sp, wo, frame_, context);
+            const ShadingModel *model = hair->shading.model();
+            FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
             hit.inputs = inputs;
             const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
             if (huang) {
