@@ -2,8 +2,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "fiber/dual_scattering.h"
+#include "fiber/fiber_spec.h"
 
 namespace hairis::cli {
 
@@ -17,8 +21,20 @@ void add_inspect_command(CLI::App &app, int &exit_code);
 void add_figures_command(CLI::App &app, int &exit_code);
 void add_fits_command(CLI::App &app, int &exit_code);
 
+/// A fiber the seed's figures and fits are drawn for: the model and its dual-scattering tables.
+struct FigureFiber {
+    std::string label;  ///< the preset, and any settings applied over it
+    std::unique_ptr<FiberModel> model;
+    std::unique_ptr<DualScattering> dual;
+    int grid_points = 3;  ///< Gauss–Legendre points per axis in each figure cell
+};
+/// The model of `spec` and its dual-scattering tables. Huang is evaluated with the bake's
+/// expectation rule (figures show what tables hold), its dual-scattering quadrature and figure
+/// cells sized to its GGX lobes (see fits_command.cpp).
+Expected<FigureFiber> make_figure_fiber(const FiberSpec &spec, const std::string &label);
+
 /// Writes fits.md, fits_multiple.csv and fits_direct.csv into `output`; returns an exit code.
-int write_fit_tables(const std::string &output, const std::vector<std::string> &presets, int theta_count,
+int write_fit_tables(const std::string &output, const std::vector<const FigureFiber *> &fibers, int theta_count,
                      int phi_count);
 
 /// True once SIGINT or SIGTERM arrived; long work polls it and stops cleanly.

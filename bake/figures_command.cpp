@@ -1,4 +1,6 @@
 // hairis-bake figures: the seed's Figures 1–4 and fit tables, regenerated from our models.
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -24,6 +26,25 @@ struct FiguresFlags {
     int theta_count = 90;
     int phi_count = 180;
     bool data_only = false;
+};
+
+// Names each stage of a long run on stderr and how long the one before took.
+class Stage {
+  public:
+    explicit Stage(const std::string &what) { next(what); }
+    void next(const std::string &what) {
+        const auto now = std::chrono::steady_clock::now();
+        if (!what_.empty())
+            std::cerr << "hairis-bake figures: " << what_ << " took "
+                      << std::lround(std::chrono::duration<double>(now - start_).count()) << " s\n";
+        what_ = what;
+        start_ = now;
+        if (!what_.empty()) std::cerr << "hairis-bake figures: computing " << what_ << "\n";
+    }
+
+  private:
+    std::string what_;
+    std::chrono::steady_clock::time_point start_;
 };
 
 int fail(const std::string &message) {
@@ -126,10 +147,15 @@ int run_figures(const FiguresFlags &flags) {
     if (!flags.table.empty()) return run_table_figures(flags, dir);
     Expected<FiberSpec> spec = flags.fiber.resolve();
     if (!spec) return fail(spec.error().message);
-    auto model = spec.value().create_model();
-    if (!model) return fail(model.error().message);
-    auto ds = DualScattering::create(*model.value(), DualScatteringParams{});
-    if (!ds) return fail(ds.error().message);
+    std::string label = flags.fiber.preset;
+    if (!flags.fiber.param_file.empty()) label += " + " + std::filesystem::path(flags.fiber.param_file).filename().string();
+    for (const std::string &setting : flags.fiber.settings) label += " + " + setting;
+    Stage stage("the dual-scattering tables of " + label);
+    Expected<FigureFiber> fiber = make_figure_fiber(spec.value(), label);
+    if (!fiber) return fail(fiber.error().message);
+    stage.next("Figure 1 (35 direct distributions)");
+    const FiberModel &model = *fiber.value().model;
+    const DualScattering &ds = *fiber.value().dual;
     const int n_i = flags.theta_count, n_p = flags.phi_count;
 
     // Figure 1: S_direct over (θ_i, φ_i) for 5 φ_r rows × 7 θ_r columns.
@@ -137,30 +163,32 @@ int run_figures(const FiguresFlags &flags) {
     DirectGridSpec direct_spec;
     direct_spec.theta_count = n_i;
     direct_spec.phi_count = n_p;
+    direct_spec.quadrature_points = fiber.value().grid_points;
     for (double phi_r : kSeedPhiR) {
         for (double theta_r : kSeedThetaR) {
             if (interrupted()) return kExitInterrupted;
-            auto g = direct_distribution(*model.value(), evaluated_theta_r(theta_r), radians(phi_r), direct_spec);
+            auto g = direct_distribution(model, evaluated_theta_r(theta_r), radians(phi_r), direct_spec);
             if (!g) return fail(g.error().message);
             for (double v : g.value().values) fig1.push_back(float(v));
         }
     }
+    stage.next("Figures 2-4");
     // Figures 2 and 3: S_multiple over θ_i (azimuthally uniform).
     ThetaGridSpec theta_spec;
     theta_spec.theta_count = n_i;
     std::vector<float> fig2, fig3;
     for (double theta_r : kSeedThetaR) {
-        auto g = multiple_distribution(ds.value(), evaluated_theta_r(theta_r), 2, theta_spec);
+        auto g = multiple_distribution(ds, evaluated_theta_r(theta_r), 2, theta_spec);
         if (!g) return fail(g.error().message);
         for (double v : g.value().values) fig2.push_back(float(v));
     }
     for (int n_h : kSeedStrands) {
-        auto g = multiple_distribution(ds.value(), 0.0, n_h, theta_spec);
+        auto g = multiple_distribution(ds, 0.0, n_h, theta_spec);
         if (!g) return fail(g.error().message);
         for (double v : g.value().values) fig3.push_back(float(v));
     }
     // Figure 4: profiles at θ_r ∈ {−60, 0, 60}° for n_h = 1, 2, 4, 8 with the fitted Gaussians.
-    auto rows = fit_multiple(ds.value(), {1, 2, 4, 8}, n_i);
+    auto rows = fit_multiple(ds, {1, 2, 4, 8}, n_i);
     if (!rows) return fail(rows.error().message);
     std::vector<float> fig4_profiles, fig4_fits;
     for (const MultipleFitRow &r : rows.value()) {
@@ -177,12 +205,14 @@ int run_figures(const FiguresFlags &flags) {
     for (const auto &[name, status] : writes)
         if (status) return fail(status->message);
 
-    const int fits = write_fit_tables(flags.output, {flags.fiber.preset}, 2 * n_i, n_p);
+    stage.next("the fit tables");
+    const int fits = write_fit_tables(flags.output, {&fiber.value()}, 2 * n_i, n_p);
     if (fits != 0) return fits;
+    stage.next("");
     if (flags.data_only) return 0;
 
     return plot("HAIRIS_FIGURES_SCRIPT", HAIRIS_FIGURES_SCRIPT, flags.output,
-                model.value()->name() + " (" + flags.fiber.preset + ")", "figure1..4 PNGs and fit tables");
+                model.name() + " (" + label + ")", "figure1..4 PNGs and fit tables");
 }
 
 }  // namespace

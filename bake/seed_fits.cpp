@@ -52,11 +52,13 @@ Expected<std::vector<MultipleFitRow>> fit_multiple(const DualScattering &ds, con
     return rows;
 }
 
-Expected<std::vector<DirectFitRow>> fit_direct(const FiberModel &model, int theta_count, int phi_count) {
+Expected<std::vector<DirectFitRow>> fit_direct(const FiberModel &model, int theta_count, int phi_count,
+                                               int quadrature_points) {
     std::vector<DirectFitRow> rows;
     DirectGridSpec spec;
     spec.theta_count = theta_count;
     spec.phi_count = phi_count;
+    spec.quadrature_points = quadrature_points;
     for (double theta_r_deg : kSeedThetaR) {
         const double theta_r = evaluated_theta_r(theta_r_deg);
         Expected<Grid2D> g = direct_distribution_relative(model, theta_r, spec);

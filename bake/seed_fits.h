@@ -37,6 +37,7 @@ struct DirectFitRow {
     double error_sigma_l_044;   ///< ... with σ = 0.44
 };
 
-Expected<std::vector<DirectFitRow>> fit_direct(const FiberModel &model, int theta_count, int phi_count);
+Expected<std::vector<DirectFitRow>> fit_direct(const FiberModel &model, int theta_count, int phi_count,
+                                               int quadrature_points = 3);
 
 }  // namespace hairis::cli

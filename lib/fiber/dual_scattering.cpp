@@ -83,10 +83,21 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
     const std::vector<double> orient = orientations(model, q.orientation_count);
     const double weight_scale = double(q.energy_scale) / double(orient.size());
 
+    // θ_h moments of each lobe's energy, per (lobe, θ node): Σw, Σwθ_h, Σwθ_h².
+    struct Moments {
+        double m0 = 0, m1 = 0, m2 = 0;
+        void add(double w, double theta_h) {
+            m0 += w;
+            m1 += w * theta_h;
+            m2 += w * theta_h * theta_h;
+        }
+    };
+    ds.shapes_measured_ = q.measure_lobe_shapes || !model.lobe_shapes_analytic();
+    std::vector<Moments> moments(nl * nk);
+
     // Each task writes only its own table entries: the result does not depend on scheduling.
     tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
-        std::vector<Rgbd> af(nl), ab(nl), num(nl);
-        std::vector<double> den(nl);
+        std::vector<Rgbd> af(nl), ab(nl);
         for (int k = range.begin(); k != range.end(); ++k) {
             const double theta_k = ds.table_theta(k);
             // (1) a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction
@@ -95,29 +106,38 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             // ω_L) integrated against dω = cos θ dθ dφ.
             std::fill(af.begin(), af.end(), Rgbd{});
             std::fill(ab.begin(), ab.end(), Rgbd{});
+            Moments *mk = &moments[std::size_t(k)];  // lobe p at mk[p * nk]
             for (const double phi_l : orient) {
                 const std::unique_ptr<const FarFieldView> view = model.view(dir(theta_k, phi_l));
                 if (view->separable()) {
                     // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
                     for (int p = 0; p < lobes; ++p) {
                         double longitudinal = 0;
-                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
-                            longitudinal += theta_rule.w[m] * std::cos(theta_rule.x[m]) * weight_scale *
-                                            view->longitudinal(p, theta_rule.x[m]);
+                        std::vector<double> lw(theta_rule.x.size());
+                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
+                            lw[m] = theta_rule.w[m] * std::cos(theta_rule.x[m]) * weight_scale *
+                                    view->longitudinal(p, theta_rule.x[m]);
+                            longitudinal += lw[m];
+                        }
+                        double azimuthal_sum = 0;
                         for (int half = 0; half < 2; ++half) {
                             const QuadratureRule &rule = half == 0 ? fwd : back;
                             Rgbd &acc = (half == 0 ? af : ab)[std::size_t(p)];
                             for (std::size_t n = 0; n < rule.x.size(); ++n) {
                                 const Rgb v = view->azimuthal(p, rule.x[n]);
                                 for (int ch = 0; ch < 3; ++ch) acc.v[ch] += longitudinal * rule.w[n] * double(v[ch]);
+                                azimuthal_sum += rule.w[n] * (double(v[0]) + double(v[1]) + double(v[2]));
                             }
                         }
+                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
+                            mk[std::size_t(p) * nk].add(lw[m] * azimuthal_sum, 0.5 * (theta_rule.x[m] + theta_k));
                     }
                     continue;
                 }
                 for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
                     const double th = theta_rule.x[m];
                     const double wm = theta_rule.w[m] * std::cos(th) * weight_scale;
+                    const double theta_h = 0.5 * (th + theta_k);
                     for (int half = 0; half < 2; ++half) {
                         const QuadratureRule &rule = half == 0 ? fwd : back;
                         std::vector<Rgbd> &acc = half == 0 ? af : ab;
@@ -127,11 +147,43 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                             for (int p = 0; p < lobes; ++p) {
                                 const Rgb v = view->lobe_f_cos(p, w);
                                 for (int ch = 0; ch < 3; ++ch) acc[std::size_t(p)].v[ch] += weight * double(v[ch]);
+                                mk[std::size_t(p) * nk].add(weight * (double(v[0]) + double(v[1]) + double(v[2])),
+                                                            theta_h);
                             }
                         }
                     }
                 }
             }
+            for (std::size_t p = 0; p < nl; ++p) {
+                ds.a_f_lobe_[p * nk + std::size_t(k)] = af[p];
+                ds.a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
+            }
+        }
+    });
+
+    // Measured shapes: the moments pooled over θ_L with weight cos θ_L (serial, fixed order).
+    if (ds.shapes_measured_) {
+        for (std::size_t p = 0; p < nl; ++p) {
+            Moments pooled;
+            for (std::size_t k = 0; k < nk; ++k) {
+                const Moments &m = moments[p * nk + k];
+                const double c = std::cos(ds.table_theta(int(k)));
+                pooled.m0 += c * m.m0;
+                pooled.m1 += c * m.m1;
+                pooled.m2 += c * m.m2;
+            }
+            if (!(pooled.m0 > 0)) continue;  // a lobe with no energy keeps the model's guess
+            const double alpha = pooled.m1 / pooled.m0;
+            const double variance = std::max(0.0, pooled.m2 / pooled.m0 - alpha * alpha);
+            ds.shapes_[p] = {float(alpha), float(std::sqrt(variance))};
+        }
+    }
+
+    tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
+        std::vector<Rgbd> num(nl);
+        std::vector<double> den(nl);
+        for (int k = range.begin(); k != range.end(); ++k) {
+            const double theta_k = ds.table_theta(k);
             // (2) N_p^G at Marschner's difference angle θ_d = θ_k.
             std::fill(num.begin(), num.end(), Rgbd{});
             std::fill(den.begin(), den.end(), 0.0);
@@ -164,8 +216,6 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 }
             }
             for (std::size_t p = 0; p < nl; ++p) {
-                ds.a_f_lobe_[p * nk + std::size_t(k)] = af[p];
-                ds.a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
                 Rgbd ng;
                 for (int ch = 0; ch < 3; ++ch) ng.v[ch] = den[p] > 0 ? num[p].v[ch] / den[p] : 0.0;
                 ds.n_g_lobe_[p * nk + std::size_t(k)] = ng;

@@ -29,6 +29,10 @@
 //                                               equal-mean Gaussians has)
 //         LobeShape is read as fiber.h defines it: shift and standard deviation of a Gaussian
 //         in θ_h = (θ_i + θ_o)/2, for every model.
+//   Measured lobe shapes (models whose lobe_shapes_analytic() is false, e.g. Huang's GGX
+//   lobes): α_p and β_p² are the mean and variance of θ_h under lobe p's energy density
+//   f_p|cos θ| dω (channels summed), pooled over the light inclinations θ_L with weight cos θ_L,
+//   from the same quadrature as a_f,p and a_b,p.
 //   Ā_b = ā_b ā_f²/(1−ā_f²) + ā_b³ ā_f²/(1−ā_f²)³                                  (eq. 14)
 //   Δ̄_b = ᾱ_b (1 − 2ā_b²/(1−ā_f²)²) + ᾱ_f (2(1−ā_f²)² + 4ā_f²ā_b²)/(1−ā_f²)³     (eq. 16)
 //   σ̄_b = (1 + d_b ā_f²) (ā_b √(2β̄_f²+β̄_b²) + ā_b³ √(2β̄_f²+3β̄_b²)) / (ā_b + ā_b³)  (eq. 17)
@@ -111,6 +115,9 @@ struct DualScatteringParams {
     /// in red, where the series in Ā_b diverge); 0.5 puts it on the same footing.
     float energy_scale = 1.0f;
     float min_lobe_width = 1e-3f;          ///< β_p floor (radians) for N_p^G, [1e-6, 0.1]
+    /// Measure every lobe's shift and width from f even when the model's lobe_shape() is
+    /// analytic (models whose lobe_shapes_analytic() is false are always measured).
+    bool measure_lobe_shapes = false;
 };
 
 /// The dual-scattering tables of one fiber model and the multiple-scattering term.
@@ -133,7 +140,9 @@ class DualScattering {
     Rgb lobe_backward_attenuation(int p, double theta) const;  ///< a_b,p
     /// N_p^G at Marschner's difference angle θ_d (see the header comment).
     Rgb lobe_forward_azimuthal(int p, double theta_d) const;
-    LobeShape lobe_shape(int p) const;  ///< α_p, β_p as given by the model
+    /// α_p, β_p: the model's, or measured (see "Measured lobe shapes" above).
+    LobeShape lobe_shape(int p) const;
+    bool lobe_shapes_measured() const { return shapes_measured_; }
 
     // --- Averages (paper §4) ------------------------------------------------------------
     Rgb forward_attenuation(double theta) const;    ///< ā_f
@@ -188,6 +197,7 @@ class DualScattering {
     DualScatteringParams params_;
     int lobe_count_ = 0;
     int clamped_entries_ = 0;
+    bool shapes_measured_ = false;
     std::vector<LobeShape> shapes_;
     // Per lobe, per θ node (index p * theta_count + k).
     std::vector<Rgbd> a_f_lobe_, a_b_lobe_, n_g_lobe_;

@@ -68,6 +68,9 @@ class FiberModel {
 
     /// Longitudinal shift and width of lobe p, for dual scattering.
     virtual LobeShape lobe_shape(int p) const = 0;
+    /// False when lobe_shape() is only a rough guess (lobes that are not Gaussians in θ_h):
+    /// dual scattering then measures each lobe's shift and width from f itself.
+    virtual bool lobe_shapes_analytic() const { return true; }
 
     /// True when f depends on φ_i and φ_o only through φ_i − φ_o (false for an elliptical
     /// Marschner fiber, whose response also depends on the half angle).

@@ -207,7 +207,7 @@ std::string FiberSpec::options() const {
     return out;
 }
 
-Expected<std::unique_ptr<FiberModel>> FiberSpec::create_model() const {
+Expected<std::unique_ptr<FiberModel>> FiberSpec::create_model(const HuangQuadrature &huang_rule) const {
     if (kind == FiberKind::Marschner) {
         Expected<MarschnerFiber> m = MarschnerFiber::create(marschner);
         if (!m) return m.error();
@@ -216,7 +216,7 @@ Expected<std::unique_ptr<FiberModel>> FiberSpec::create_model() const {
     if (kind == FiberKind::Huang) {
         Expected<HuangParams> p = to_huang_params(node);
         if (!p) return p.error();
-        Expected<HuangFiber> h = HuangFiber::create(p.value());
+        Expected<HuangFiber> h = HuangFiber::create(p.value(), huang_rule);
         if (!h) return h.error();
         return std::unique_ptr<FiberModel>(std::make_unique<HuangFiber>(std::move(h).value()));
     }

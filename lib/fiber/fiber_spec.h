@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fiber/chiang.h"
+#include "fiber/huang.h"
 #include "core/expected.h"
 #include "fiber/marschner.h"
 #include "fiber/principled_hair.h"
@@ -34,8 +35,8 @@ struct FiberSpec {
 
     /// Every key of the spec's model with its value, as "key=value;..." that set() reads back.
     std::string options() const;
-    /// The model, validated.
-    Expected<std::unique_ptr<FiberModel>> create_model() const;
+    /// The model, validated; a Huang fiber evaluates its far field with `huang_rule`.
+    Expected<std::unique_ptr<FiberModel>> create_model(const HuangQuadrature &huang_rule = {}) const;
 
     /// The parameters that determine the model's scattering, as name/value pairs in a fixed
     /// order (Chiang and Huang: the mapped closure parameters, so two nodes that scatter alike

@@ -223,6 +223,7 @@ class HuangFiber final : public FiberModel, public ShadingModel {
     /// A Gaussian in θ_h for dual scattering, from the mesonormal tilt and the GGX width
     /// (an approximation: GGX lobes are not Gaussian).
     LobeShape lobe_shape(int p) const override;
+    bool lobe_shapes_analytic() const override { return false; }
     /// True only for aspect ratio 1.
     bool rotationally_symmetric() const override { return aspect_ == 1.0; }
 

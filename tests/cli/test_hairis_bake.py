@@ -257,6 +257,23 @@ class HairisBakeTest(unittest.TestCase):
         with open(os.path.join(out, "figure1.png"), "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 
+    def test_figures_for_huang_with_settings(self):
+        # The fits are of the fiber drawn (settings included), and the Huang figures exist.
+        out = self.path("huang_seed_figures")
+        r = run("figures", "--preset", "cycles-default-huang", "--set", "roughness=0.6",
+                "--theta-i", "12", "--phi", "16", "--data-only", "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(out, "fits.md")) as f:
+            text = f.read()
+        self.assertIn("## huang2022 (preset cycles-default-huang + roughness=0.6)", text)
+        import numpy as np
+        fig3 = np.load(os.path.join(out, "figure3.npy"))  # S_multiple at θ_r = 0 per n_h
+        self.assertEqual(fig3.shape, (5, 12))
+        self.assertTrue(np.all(np.isfinite(fig3)) and np.all(fig3 >= 0))
+        # More strands between the light and the fiber pass less light forward.
+        totals = fig3.sum(axis=1)
+        self.assertTrue(np.all(np.diff(totals) < 0), totals)
+
     def test_figures_of_a_table(self):
         table = self.path("t.exr")
         self.assertEqual(run("bake", *SMALL, "-q", "-o", table).returncode, 0)
