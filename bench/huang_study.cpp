@@ -6,6 +6,7 @@
 //  3. The uniform sphere's weight in TABLE's mixture (the support guarantee) and its cost.
 //  4. The near field (camera rays on hair wider than the pixel) sampled with the far-field table.
 //  5. Time per sample.
+//  6. TABLE weighted with the renderer's f (one Cycles eval, a Monte Carlo estimate).
 //
 // The integrand is luminance(f) with f = HuangExpectation (f·cos θ_i, the expectation of
 // Cycles' eval) at the rule (6,4). For samplers with a density the relative variance of
@@ -257,6 +258,37 @@ double mc_variance(const HuangFiber &fiber, const HairShading &shading, const Fi
     for (double x : y) sum += x, sum2 += x * x;
     const double mean = sum / n;
     return (sum2 / n - mean * mean) / (mean * mean);
+}
+
+// Monte Carlo relative variance of luminance(f)/pdf where f is what the renderer weights a BSDF
+// sample with: one Cycles eval (HuangPoint::f, a Monte Carlo estimate of the expectation), drawn
+// afresh per sample as at every shading point of a render.
+double mc_variance_renderer_f(const HuangFiber &fiber, const HairShading &shading, const FiberHit &hit, int n,
+                              int evals = 1) {
+    ScratchBuffer scratch;
+    std::mt19937_64 rng(4243);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    double sum = 0, sum2 = 0;
+    for (int k = 0; k < n; ++k) {
+        scratch.reset();
+        FiberHit h = hit;
+        h.seed = std::uint32_t(k) * 2654435761u + 7u;  // each sample its own shading point's LCG
+        const HairBsdf bsdf = shading.at(h, scratch);
+        const auto s = bsdf.sample(u(rng), u(rng), u(rng));
+        double f = s ? double(luminance(s->f)) : 0.0;
+        if (s && evals > 1) {
+            // The mean of `evals` independent Cycles evals at the sampled direction.
+            const HuangPoint &p = static_cast<const HuangPoint &>(fiber.prepare(h, scratch));
+            CyclesLcg lcg{h.seed ^ 0x9e3779b9u};
+            for (int e = 1; e < evals; ++e) f += double(luminance(p.f_estimate(s->wi, lcg)));
+            f /= evals;
+        }
+        const double y = s ? f / double(s->pdf) : 0.0;
+        sum += y;
+        sum2 += y * y;
+    }
+    const double mean = sum / n;
+    return mean > 0 ? (sum2 / n - mean * mean) / (mean * mean) : 0.0;
 }
 
 std::shared_ptr<const HuangFiber> make_fiber(const HuangParams &p) {
@@ -542,6 +574,39 @@ void section_near_field() {
 
 // ---------------------------------------------------------------------------------------------
 
+void section_renderer_f() {
+    print("## 6. TABLE with the renderer's f\n\n"
+          "The sections above weight TABLE's samples with the expectation of Cycles' eval; a render weights "
+          "them with one Cycles eval (HuangPoint::f: Simpson nodes in h with one microfacet chain each), a "
+          "Monte Carlo estimate whose own variance adds to the sampler's. Relative variance per sample "
+          "(Monte Carlo, %d samples per view, each at its own shading point's LCG) of luminance(f)/pdf: "
+          "TABLE with the expectation, TABLE with one eval and with the mean of four, and Cycles' sampler with its own "
+          "weight.\n\n"
+          "| aspect | roughness | view (θ_o, φ_o) | TABLE, expectation f | TABLE, one Cycles eval | TABLE, mean of 4 evals | "
+          "Cycles' sampler | TABLE (one eval) / Cycles |\n|---|---|---|---|---|---|---|---|\n",
+          quick ? 4000 : 40000);
+    for (const FiberCase &c : {FiberCase{0.85f, 0.3f}, FiberCase{0.5f, 0.25f}, FiberCase{0.85f, 0.05f}}) {
+        const auto fiber = make_fiber(params_of(c.aspect, c.roughness));
+        HuangBakeOptions o;
+        o.threads = 2;
+        const TableStrategy t = bake(*fiber, o);
+        const HairShading table = shading_of(fiber, StrategyKind::Table, &t.table);
+        for (const ViewAngles &a : {ViewAngles{-35, 40}, ViewAngles{0, 10}, ViewAngles{30, 75}, ViewAngles{65, 40}}) {
+            const FiberHit hit = hit_at(a.theta_o, a.phi_o);
+            const int n = quick ? 4000 : 40000;
+            const double expectation = mc_variance(*fiber, table, hit, n);
+            const double one_eval = mc_variance_renderer_f(*fiber, table, hit, n);
+            const double four_evals = mc_variance_renderer_f(*fiber, table, hit, n, 4);
+            const double cycles = cycles_moments(*fiber, hit, n).relative_variance;
+            print("| %.2f | %.2f | (%.0f°, %.0f°) | %s | %s | %s | %s | %s |\n", c.aspect, c.roughness, a.theta_o,
+                  a.phi_o, number(expectation).c_str(), number(one_eval).c_str(), number(four_evals).c_str(),
+                  number(cycles).c_str(),
+                  number(one_eval / cycles).c_str());
+        }
+    }
+    print("\n");
+}
+
 // Nanoseconds (thread CPU time) per sample on one thread, best of three passes over random hits.
 template <typename PerHit>
 double time_per_sample(PerHit &&per_hit) {
@@ -629,7 +694,7 @@ void section_time() {
 int main(int argc, char **argv) {
     const std::string folder = argc > 1 ? argv[1] : "";
     quick = argc > 2 && std::string(argv[2]) == "quick";
-    const std::string sections = argc > 3 ? argv[3] : "12345";
+    const std::string sections = argc > 3 ? argv[3] : "123456";
     auto run = [&](char section) { return sections.find(section) != std::string::npos; };
     tbb::task_arena arena(2);
     arena.execute([&] {
@@ -647,6 +712,7 @@ int main(int argc, char **argv) {
         if (run('3')) section_uniform_weight();
         if (run('4')) section_near_field();
         if (run('5')) section_time();
+        if (run('6')) section_renderer_f();
         print("Total study time %.0f s.\n", seconds_since(t0));
     });
     if (!folder.empty()) {

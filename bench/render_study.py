@@ -33,12 +33,9 @@ Environment: HAIRIS_STUDY_RESOLUTION (64x48), HAIRIS_STUDY_REF_SPP (512), HAIRIS
 
 import math
 import os
-import platform
-import subprocess
 import sys
 import time
 
-import bpy
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -72,34 +69,6 @@ def log(message):
 START = time.monotonic()
 
 
-def machine_info():
-    """nproc, CPU model, load, Blender version, git commit."""
-    model = ""
-    try:
-        with open("/proc/cpuinfo") as cpuinfo:
-            for line in cpuinfo:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                universal_newlines=True).stdout.strip()
-    except OSError:
-        commit = ""
-    return {
-        "nproc": len(os.sched_getaffinity(0)),
-        "cpu_count": os.cpu_count(),
-        "cpu_model": model,
-        "platform": platform.platform(),
-        "blender_version": bpy.app.version_string,
-        "git_commit": commit,
-        "load_average_start": list(os.getloadavg()),
-    }
-
-
 def configure(scene, method, samples):
     """Engine, strategy and sample count of ``method`` (a strategy name or CYCLES)."""
     helpers.set_samples(scene, samples)
@@ -122,7 +91,7 @@ def render(scene, method, samples, seed):
 
 def study():
     """Renders everything and returns the results dictionary (and the images to keep)."""
-    info = machine_info()
+    info = helpers.machine_info()
     scene = helpers.make_compare_scene(SPPS[0], BOUNCES, "ANALYTIC", resolution=RESOLUTION)
     pixels = RESOLUTION[0] * RESOLUTION[1]
     log("scene %dx%d, %d bounces; %s" % (RESOLUTION[0], RESOLUTION[1], BOUNCES, info))
@@ -219,6 +188,7 @@ def main():
     np.savez_compressed(os.path.join(OUT, "render_study_images.npz"),
                         **{k: v.astype(np.float16) for k, v in keep.items()})
     log("wrote %s" % OUT)
+    helpers.result("PASSED")
     sys.exit(0)
 
 
@@ -227,4 +197,5 @@ try:
 except Exception:  # noqa: BLE001 - report and fail
     import traceback
     traceback.print_exc()
+    helpers.result("FAILED")
     sys.exit(1)

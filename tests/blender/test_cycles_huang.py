@@ -26,7 +26,6 @@ same blocks differ in 4.5 at 256 samples, where 32 samples' noise hides them): R
 "Comparing with Cycles".
 """
 
-import math
 import os
 import sys
 
@@ -49,67 +48,9 @@ BOUNCES = 4
 BLOCK = 4
 
 
-def huang_material(name, color, aspect, lobes=(1.0, 1.0, 1.0), roughness=0.3):
-    """A Principled Hair BSDF with the Huang model (Direct Coloring)."""
-    material = helpers.make_hair_material(name, "COLOR", **{
-        "Color": color, "Roughness": roughness, "IOR": 1.55, "Offset": math.radians(2.0),
-        "Aspect Ratio": aspect, "R lobe": lobes[0], "TT lobe": lobes[1], "TRT lobe": lobes[2]})
-    material.node_tree.nodes["Principled Hair BSDF"].model = "HUANG"
-    return material
-
-
-def fresh_curves(scene, name, material, count, points, radius, seed, location, spread):
-    """A Curves object of `count` wavy strands, its points set before anything asks for its
-    normals (Blender keeps normals cached when positions are written through position_data)."""
-    curves = bpy.data.hair_curves.new(name)
-    curves.add_curves([points] * count)
-    rng = np.random.default_rng(seed)
-    roots = rng.uniform(-spread, spread, (count, 3)) * np.array([1.0, 0.3, 1.0])
-    lean = rng.uniform(-0.4, 0.4, (count, 3)) + np.array([0.0, 0.0, 1.0])
-    t = np.linspace(0.0, 1.0, points)[None, :, None]
-    wave = 0.08 * np.sin(7.0 * t + rng.uniform(0.0, 6.3, (count, 1, 1)))
-    positions = roots[:, None, :] + 0.8 * lean[:, None, :] * t + wave * np.array([1.0, 0.5, 0.0])
-    curves.position_data.foreach_set("vector", positions.astype(np.float32).reshape(-1))
-    radii = curves.attributes.new("radius", "FLOAT", "POINT")
-    radii.data.foreach_set("value", np.full(count * points, radius, np.float32))
-    curves.materials.append(material)
-    obj = bpy.data.objects.new(name, curves)
-    obj.location = location
-    scene.collection.objects.link(obj)
-    return obj
-
-
 def make_scene(huang_sampling):
     """The comparison scene with Hairis' Huang Sampling set to ``huang_sampling``."""
-    scene = helpers.reset()
-    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(64, 48), percentage=100)
-    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
-    blond = huang_material("Blond", (0.55, 0.4, 0.25, 1.0), 0.85)
-    dark = huang_material("Dark", (0.12, 0.06, 0.03, 1.0), 0.85, roughness=0.4)
-    oval = huang_material("Oval", (0.2, 0.5, 0.8, 1.0), 0.5, lobes=(1.0, 0.5, 0.2),
-                          roughness=0.25)
-    skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    fresh_curves(scene, "Curls", blond, 120, 8, 0.006, 3, (0.45, 0.0, -0.6), 0.35)
-    fresh_curves(scene, "Ribbons", oval, 6, 6, 0.05, 5, (-0.55, -0.3, -0.5), 0.25)
-    helpers.make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
-                               hair_material=dark, skin_material=skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
-                       rotation=(0.6, 0.3, 0.0))
-    helpers.make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
-                       shadow_soft_size=0.2)
-    helpers.make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
-                       shape="RECTANGLE", size=0.6, size_y=0.3,
-                       rotation=(math.radians(60), 0.0, math.radians(-40)))
-    helpers.match_cycles(scene, SAMPLES, BOUNCES)
-    settings = scene.hairis
-    settings.samples = SAMPLES
-    settings.max_bounces = BOUNCES
-    settings.max_transparent_bounces = BOUNCES
-    settings.strategy = "UNIFORM"
-    settings.huang_sampling = huang_sampling
-    settings.threads = 0
-    bpy.context.view_layer.update()
-    return scene
+    return helpers.make_huang_scene(SAMPLES, BOUNCES, huang_sampling)
 
 
 def render_stack(scene, engine):
