@@ -7,6 +7,7 @@
 //  4. The near field (camera rays on hair wider than the pixel) sampled with the far-field table.
 //  5. Time per sample.
 //  6. TABLE weighted with the renderer's f (one Cycles eval, a Monte Carlo estimate).
+//  7. The tails of TABLE's and Cycles' sample weights.
 //
 // The integrand is luminance(f) with f = HuangExpectation (f·cos θ_i, the expectation of
 // Cycles' eval) at the rule (6,4). For samplers with a density the relative variance of
@@ -607,6 +608,63 @@ void section_renderer_f() {
     print("\n");
 }
 
+// The largest weights: max / mean and the share of the second moment from the top 0.1%.
+struct Tail {
+    double max_over_mean = 0, top_share = 0;
+};
+Tail tail_of(std::vector<double> w) {
+    std::sort(w.begin(), w.end());
+    double sum = 0, sum2 = 0, top2 = 0;
+    const size_t top = w.size() - std::max<size_t>(1, w.size() / 1000);
+    for (size_t k = 0; k < w.size(); ++k) {
+        sum += w[k];
+        sum2 += w[k] * w[k];
+        if (k >= top) top2 += w[k] * w[k];
+    }
+    const double mean = sum / double(w.size());
+    return {mean > 0 ? w.back() / mean : 0.0, sum2 > 0 ? top2 / sum2 : 0.0};
+}
+
+void section_tails() {
+    print("## 7. The largest weights\n\n"
+          "Per view, over %d samples: the largest weight over the mean, and the share of the second moment "
+          "carried by the largest 0.1%% of the weights: TABLE with one Cycles eval (a render's BSDF sample) "
+          "and Cycles' sampler with its own weight. Default fiber (aspect 0.85, roughness 0.3).\n\n"
+          "| view (θ_o, φ_o) | TABLE max / mean | TABLE top 0.1%% share | Cycles max / mean | Cycles top 0.1%% share |\n"
+          "|---|---|---|---|---|\n",
+          quick ? 20000 : 200000);
+    const auto fiber = make_fiber(params_of(0.85f, 0.3f));
+    HuangBakeOptions o;
+    o.threads = 2;
+    const TableStrategy t = bake(*fiber, o);
+    const HairShading table = shading_of(fiber, StrategyKind::Table, &t.table);
+    const int n = quick ? 20000 : 200000;
+    for (const ViewAngles &a : {ViewAngles{-85, 40}, ViewAngles{-60, 10}, ViewAngles{0, 40}, ViewAngles{60, 75},
+                                ViewAngles{85, 40}}) {
+        const FiberHit hit = hit_at(a.theta_o, a.phi_o);
+        ScratchBuffer scratch;
+        std::mt19937_64 rng(77);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        std::vector<double> wt, wc;
+        const HuangPoint point = fiber->at(hit);
+        CyclesLcg lcg{12345u};
+        for (int k = 0; k < n; ++k) {
+            scratch.reset();
+            FiberHit h = hit;
+            h.seed = std::uint32_t(k) * 2654435761u + 7u;
+            const HairBsdf bsdf = table.at(h, scratch);
+            const auto s = bsdf.sample(u(rng), u(rng), u(rng));
+            wt.push_back(s ? double(luminance(s->f)) / double(s->pdf) : 0.0);
+            const auto c = point.sample_cycles(u(rng), u(rng), u(rng), lcg);
+            wc.push_back(c ? double(luminance(c->weight)) : 0.0);
+        }
+        const Tail tt = tail_of(wt), tc = tail_of(wc);
+        print("| (%.0f°, %.0f°) | %.1f | %.3f | %.1f | %.3f |\n", a.theta_o, a.phi_o, tt.max_over_mean, tt.top_share,
+              tc.max_over_mean, tc.top_share);
+    }
+    print("\n");
+}
+
 // Nanoseconds (thread CPU time) per sample on one thread, best of three passes over random hits.
 template <typename PerHit>
 double time_per_sample(PerHit &&per_hit) {
@@ -694,7 +752,7 @@ void section_time() {
 int main(int argc, char **argv) {
     const std::string folder = argc > 1 ? argv[1] : "";
     quick = argc > 2 && std::string(argv[2]) == "quick";
-    const std::string sections = argc > 3 ? argv[3] : "123456";
+    const std::string sections = argc > 3 ? argv[3] : "1234567";
     auto run = [&](char section) { return sections.find(section) != std::string::npos; };
     tbb::task_arena arena(2);
     arena.execute([&] {
@@ -713,6 +771,7 @@ int main(int argc, char **argv) {
         if (run('4')) section_near_field();
         if (run('5')) section_time();
         if (run('6')) section_renderer_f();
+        if (run('7')) section_tails();
         print("Total study time %.0f s.\n", seconds_since(t0));
     });
     if (!folder.empty()) {
