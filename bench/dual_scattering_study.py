@@ -295,6 +295,7 @@ def main():
         json.dump(results, handle, indent=1)
     np.savez_compressed(os.path.join(OUT, "dual_scattering_images%s.npz" % suffix), **keep)
     log("wrote %s" % OUT)
+    helpers.result("PASSED")
     sys.exit(0)
 
 
@@ -303,4 +304,5 @@ try:
 except Exception:  # noqa: BLE001 - report and fail
     import traceback
     traceback.print_exc()
+    helpers.result("FAILED")
     sys.exit(1)

@@ -67,7 +67,7 @@
 //         Single scattering f_s here is an energy-conserving fiber (Chiang) and f_s^scatter is
 //         normalised like it (N_p^G below), so f_back is too: half the printed value, which
 //         keeps the paper's balance between f_back and f_s (its d_b = 0.7 was chosen with both
-//         in Marschner's normalisation). bench/results/dual_scattering.md has the effect.
+//         in Marschner's normalisation). bench/results/dual_scattering.md measures the bias left.
 //   f_s^scatter    = Σ_p g(θ_h − α_p; β_p² + σ_f²) N_p^G(θ_d) / cos²θ_d      (M_p^G N_p^G)
 //   n_h ≥ 1: F = T_f d_f (f_s^scatter + π d_b f_back^scatter)          (F_direct = 0)
 //   n_h = 0: F = d_b f_back^direct (the local multiple scattering; single scattering f_s is
