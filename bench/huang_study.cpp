@@ -8,6 +8,7 @@
 //  5. Time per sample.
 //  6. TABLE weighted with the renderer's f (one Cycles eval, a Monte Carlo estimate).
 //  7. The tails of TABLE's and Cycles' sample weights.
+//  8. The noise of one Cycles eval, lobe by lobe.
 //
 // The integrand is luminance(f) with f = HuangExpectation (f·cos θ_i, the expectation of
 // Cycles' eval) at the rule (6,4). For samplers with a density the relative variance of
@@ -665,6 +666,52 @@ void section_tails() {
     print("\n");
 }
 
+void section_eval_noise() {
+    print("## 8. The noise of one Cycles eval, lobe by lobe\n\n"
+          "One Cycles eval (HuangPoint::f_estimate) at a fixed pair of directions, drawn %d times from the point's LCG: "
+          "its relative variance and its largest draw over the mean, at 300 random (ω_o, ω_i) pairs (pairs where "
+          "the lobe's mean is 0 left out), with the other lobes' multipliers at 0. Default fiber otherwise.\n\n"
+          "| lobes | pairs | mean relative variance | largest draw / mean |\n|---|---|---|---|\n",
+          quick ? 500 : 2000);
+    struct Variant {
+        const char *label;
+        float r, tt, trt;
+    };
+    for (const Variant &v : {Variant{"all (R, TT, TRT; TRRT+ follows TT and TRT)", 1, 1, 1}, Variant{"R", 1, 0, 0},
+                             Variant{"TT", 0, 1, 0}, Variant{"TRT", 0, 0, 1}}) {
+        HuangParams p = params_of(0.85f, 0.3f);
+        p.reflection = v.r;
+        p.transmission = v.tt;
+        p.secondary_reflection = v.trt;
+        const auto fiber = make_fiber(p);
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        double largest = 0, variance_sum = 0;
+        int pairs = 0;
+        const int draws = quick ? 500 : 2000;
+        for (int d = 0; d < 300; ++d) {
+            FiberHit hit = hit_at(170.0 * (u(rng) - 0.5), 360.0 * (u(rng) - 0.5));
+            const HuangPoint point = fiber->at(hit);
+            const Vec3 wi = direction_of(3.1f * (u(rng) - 0.5f), 6.28f * (u(rng) - 0.5f));
+            CyclesLcg lcg{std::uint32_t(d) * 7919u + 1u};
+            double sum = 0, sum2 = 0, top = 0;
+            for (int k = 0; k < draws; ++k) {
+                const double y = luminance(point.f_estimate(wi, lcg));
+                sum += y;
+                sum2 += y * y;
+                top = std::max(top, y);
+            }
+            const double mean = sum / draws;
+            if (!(mean > 1e-9)) continue;
+            variance_sum += sum2 / draws / (mean * mean) - 1.0;
+            largest = std::max(largest, top / mean);
+            ++pairs;
+        }
+        print("| %s | %d | %s | %.0f |\n", v.label, pairs, number(variance_sum / std::max(pairs, 1)).c_str(), largest);
+    }
+    print("\n");
+}
+
 // Nanoseconds (thread CPU time) per sample on one thread, best of three passes over random hits.
 template <typename PerHit>
 double time_per_sample(PerHit &&per_hit) {
@@ -752,7 +799,7 @@ void section_time() {
 int main(int argc, char **argv) {
     const std::string folder = argc > 1 ? argv[1] : "";
     quick = argc > 2 && std::string(argv[2]) == "quick";
-    const std::string sections = argc > 3 ? argv[3] : "1234567";
+    const std::string sections = argc > 3 ? argv[3] : "12345678";
     auto run = [&](char section) { return sections.find(section) != std::string::npos; };
     tbb::task_arena arena(2);
     arena.execute([&] {
@@ -772,6 +819,7 @@ int main(int argc, char **argv) {
         if (run('5')) section_time();
         if (run('6')) section_renderer_f();
         if (run('7')) section_tails();
+        if (run('8')) section_eval_noise();
         print("Total study time %.0f s.\n", seconds_since(t0));
     });
     if (!folder.empty()) {
