@@ -36,8 +36,6 @@ blonde_area, brunette_area, black_area), HAIRIS_DUAL_OUT (bench/results), HAIRIS
 import json
 import math
 import os
-import platform
-import subprocess
 import sys
 import time
 
@@ -76,28 +74,6 @@ START = time.monotonic()
 def log(message):
     """Prints with a timestamp, flushed (Blender buffers stdout)."""
     print("[dual_study %7.1f s] %s" % (time.monotonic() - START, message), flush=True)
-
-
-def machine_info():
-    """nproc, CPU model, load, Blender version, git commit."""
-    model = ""
-    try:
-        with open("/proc/cpuinfo") as cpuinfo:
-            for line in cpuinfo:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                universal_newlines=True).stdout.strip()
-    except OSError:
-        commit = ""
-    return {"nproc": len(os.sched_getaffinity(0)), "cpu_model": model,
-            "platform": platform.platform(), "blender_version": bpy.app.version_string,
-            "git_commit": commit, "load_average_start": list(os.getloadavg())}
 
 
 def look_at(obj, target):
@@ -275,7 +251,7 @@ def study_case(name, keep):
 
 def main():
     """Runs every case and writes the results."""
-    info = machine_info()
+    info = helpers.machine_info()
     log("cases %s, %dx%d, %d bounces; %s" % (CASES, RESOLUTION[0], RESOLUTION[1], BOUNCES, info))
     keep = {}
     cases = {}
@@ -295,14 +271,6 @@ def main():
         json.dump(results, handle, indent=1)
     np.savez_compressed(os.path.join(OUT, "dual_scattering_images%s.npz" % suffix), **keep)
     log("wrote %s" % OUT)
-    helpers.result("PASSED")
-    sys.exit(0)
 
 
-try:
-    main()
-except Exception:  # noqa: BLE001 - report and fail
-    import traceback
-    traceback.print_exc()
-    helpers.result("FAILED")
-    sys.exit(1)
+helpers.run_script(main)

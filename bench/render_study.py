@@ -188,14 +188,6 @@ def main():
     np.savez_compressed(os.path.join(OUT, "render_study_images.npz"),
                         **{k: v.astype(np.float16) for k, v in keep.items()})
     log("wrote %s" % OUT)
-    helpers.result("PASSED")
-    sys.exit(0)
 
 
-try:
-    main()
-except Exception:  # noqa: BLE001 - report and fail
-    import traceback
-    traceback.print_exc()
-    helpers.result("FAILED")
-    sys.exit(1)
+helpers.run_script(main)

@@ -237,14 +237,6 @@ def main():
     with open(os.path.join(OUT, "render_study_huang.md"), "w") as out:
         out.write(markdown(results))
     log("wrote %s" % OUT)
-    helpers.result("PASSED")
-    sys.exit(0)
 
 
-try:
-    main()
-except Exception:  # noqa: BLE001 - report and fail
-    import traceback
-    traceback.print_exc()
-    helpers.result("FAILED")
-    sys.exit(1)
+helpers.run_script(main)

@@ -420,6 +420,17 @@ def set_samples(scene, samples):
     scene.hairis.samples = samples
 
 
+def make_comparison_lights(scene):
+    """The comparison scenes' lights: a 3° sun, a point light with a radius and an area light."""
+    make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
+               rotation=(0.6, 0.3, 0.0))
+    make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
+               shadow_soft_size=0.2)
+    make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
+               shape="RECTANGLE", size=0.6, size_y=0.3,
+               rotation=(math.radians(60), 0.0, math.radians(-40)))
+
+
 def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_offset=None,
                        extras=()):
     """The Hairis-against-Cycles scene: particle hair, Curves, a diffuse sphere, three kinds
@@ -444,13 +455,7 @@ def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_o
     make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0), scale=1.4)
     make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
                        hair_material=hair, skin_material=skin)
-    make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
-               rotation=(0.6, 0.3, 0.0))
-    make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
-               shadow_soft_size=0.2)
-    make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
-               shape="RECTANGLE", size=0.6, size_y=0.3,
-               rotation=(math.radians(60), 0.0, math.radians(-40)))
+    make_comparison_lights(scene)
     for extra in extras:
         extra(scene)
     match_engines(scene, samples, bounces)
@@ -506,13 +511,7 @@ def make_huang_scene(samples, bounces, huang_sampling, resolution=(64, 48)):
     make_fresh_curves(scene, "Ribbons", oval, 6, 6, 0.05, 5, (-0.55, -0.3, -0.5), 0.25)
     make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
                        hair_material=dark, skin_material=skin)
-    make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
-               rotation=(0.6, 0.3, 0.0))
-    make_light(scene, "POINT", "Bulb", location=(1.5, -1.5, 1.5), energy=60.0,
-               shadow_soft_size=0.2)
-    make_light(scene, "AREA", "Panel", location=(-1.5, -1.0, 1.0), energy=40.0,
-               shape="RECTANGLE", size=0.6, size_y=0.3,
-               rotation=(math.radians(60), 0.0, math.radians(-40)))
+    make_comparison_lights(scene)
     match_cycles(scene, samples, bounces)
     settings = scene.hairis
     settings.samples = samples
@@ -526,6 +525,19 @@ def make_huang_scene(samples, bounces, huang_sampling, resolution=(64, 48)):
 
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def run_script(main):
+    """Runs a study script's ``main``: prints its result line (FAILED with the traceback when
+    it raises) and exits with 0 or 1, so run_test.py reports it."""
+    try:
+        main()
+    except Exception:  # noqa: BLE001 - report and fail
+        traceback.print_exc()
+        result("FAILED")
+        sys.exit(1)
+    result("PASSED")
+    sys.exit(0)
 
 
 def machine_info():
