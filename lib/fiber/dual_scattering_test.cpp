@@ -13,6 +13,7 @@
 #include "core/frame.h"
 
 #include "fiber/chiang.h"
+#include "fiber/huang.h"
 #include "fiber/marschner.h"
 
 namespace hairis {
@@ -517,6 +518,40 @@ TEST(DualScatteringRealModels, Chiang) {
     Expected<ChiangFiber> fiber = ChiangFiber::create(params);
     ASSERT_TRUE(fiber.ok()) << fiber.error().message;
     check_real_model(fiber.value(), "chiang");
+}
+
+// Huang's lobes are measured: reflection off scales tilted by the offset puts R's mean θ_h
+// at −offset (Cycles' tilt), transmission shifts the other way, and R's spread is close to
+// the GGX slope's Beckmann-equivalent α/√2 (within 20%: GGX's tails are heavier). A coarse
+// quadrature keeps the test short; R's and TT's shifts move by under 0.1° with the full one
+// (TRT's, a sum of several exit paths, is too sensitive to it to test here).
+TEST(DualScatteringRealModels, HuangLobeShapesAreMeasured) {
+    HuangParams p;  // Blender's default node: roughness 0.3, offset 2°
+    HuangQuadrature rule;
+    rule.first_order = 3;
+    rule.second_order = 2;
+    Expected<HuangFiber> fiber = HuangFiber::create(p, rule);
+    ASSERT_TRUE(fiber.ok()) << fiber.error().message;
+    DualScatteringParams params;
+    params.theta_count = 16;
+    params.theta_panels = 12;
+    params.phi_panels = 4;
+    params.orientation_count = 2;
+    Expected<DualScattering> ds = DualScattering::create(fiber.value(), params);
+    ASSERT_TRUE(ds.ok()) << ds.error().message;
+    ASSERT_TRUE(ds.value().lobe_shapes_measured());
+    const LobeShape r = ds.value().lobe_shape(0), tt = ds.value().lobe_shape(1), trt = ds.value().lobe_shape(2);
+    std::printf("huang lobes: R (%.2f°, %.2f°), TT (%.2f°, %.2f°), TRT (%.2f°, %.2f°)\n", degrees(r.alpha),
+                degrees(r.beta), degrees(tt.alpha), degrees(tt.beta), degrees(trt.alpha), degrees(trt.beta));
+    EXPECT_NEAR(degrees(r.alpha), -degrees(p.offset), 0.5);
+    EXPECT_GT(tt.alpha, 0.0f);
+    EXPECT_NEAR(r.beta / (p.roughness / std::sqrt(2.0)), 1.0, 0.2);
+    // The forward fraction dominates at normal incidence (TT), and both are below 1.
+    const Rgb a_f = ds.value().forward_attenuation(0.0), a_b = ds.value().backward_attenuation(0.0);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(a_f[c], a_b[c]) << "channel " << c;
+        EXPECT_LT(a_f[c] + a_b[c], 1.0f) << "channel " << c;
+    }
 }
 
 TEST(DualScatteringRealModels, MarschnerBlonde) {
