@@ -26,7 +26,12 @@ struct FigureFiber {
     std::string label;  ///< the preset, and any settings applied over it
     std::unique_ptr<FiberModel> model;
     std::unique_ptr<DualScattering> dual;
-    int grid_points = 3;  ///< Gauss–Legendre points per axis in each figure cell
+    /// The narrowest lobe's width (radians) when the figures may use fewer points per cell
+    /// (Huang's GGX lobes); 0: always the full rule.
+    double lobe_width = 0;
+    /// Gauss–Legendre points per axis in a cell of a theta_count × phi_count grid over
+    /// [−π/2, π/2] × [−π, π]: 3, or fewer where the cells are narrow against lobe_width.
+    int grid_points(int theta_count, int phi_count) const;
 };
 /// The model of `spec` and its dual-scattering tables. Huang is evaluated with the bake's
 /// expectation rule (figures show what tables hold), its dual-scattering quadrature and figure

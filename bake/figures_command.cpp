@@ -163,7 +163,7 @@ int run_figures(const FiguresFlags &flags) {
     DirectGridSpec direct_spec;
     direct_spec.theta_count = n_i;
     direct_spec.phi_count = n_p;
-    direct_spec.quadrature_points = fiber.value().grid_points;
+    direct_spec.quadrature_points = fiber.value().grid_points(n_i, n_p);
     for (double phi_r : kSeedPhiR) {
         for (double theta_r : kSeedThetaR) {
             if (interrupted()) return kExitInterrupted;

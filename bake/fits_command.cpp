@@ -1,4 +1,5 @@
 // hairis-bake fits: the seed's Tables 1 and 2 and its direct fit, recomputed from our models.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -53,28 +54,44 @@ Expected<FigureFiber> make_figure_fiber(const FiberSpec &spec, const std::string
     Expected<std::unique_ptr<FiberModel>> model = spec.create_model(rule);
     if (!model) return model.error();
     DualScatteringParams params;
-    int grid_points = 3;
+    double lobe_width = 0;
     if (const auto *huang = dynamic_cast<const HuangFiber *>(model.value().get())) {
-        // GGX lobes at least ~20·α degrees wide: at α ≥ 0.2 half the default panels and one
-        // point per 2° cell change the averages and grids by under 0.3% (measured at Blender's
-        // default node, α = 0.3) for a fifth and a ninth of the evaluations; narrower lobes
-        // keep more.
+        // R's GGX lobe is about α/√2 wide (13° at α = 0.3). At α ≥ 0.2 half the default
+        // panels change the averages by under 0.2% (measured at Blender's default node).
         const double alpha = huang->roughness();
         if (alpha >= 0.2) {
             params.theta_panels = 12;
             params.phi_panels = 4;
         }
-        grid_points = alpha >= 0.2 ? 1 : alpha >= 0.08 ? 2 : 3;
+        lobe_width = alpha / std::sqrt(2.0);
     }
     Expected<DualScattering> ds = DualScattering::create(*model.value(), params);
     if (!ds) return ds.error();
     FigureFiber out;
-    out.grid_points = grid_points;
+    out.lobe_width = lobe_width;
     out.label = label;
     out.model = std::move(model).value();
     out.dual = std::make_unique<DualScattering>(std::move(ds).value());
     return out;
 }
+
+int FigureFiber::grid_points(int theta_count, int phi_count) const {
+    if (!(lobe_width > 0)) return 3;
+    // One point per cell where a cell is under a third of the lobe's width (Figure 1 within
+    // 0.4% L1 of 3 points for Blender's default Huang node on 2° cells), up to 3 at a lobe's width.
+    const double cell = std::max(kPi / theta_count, kTwoPi / phi_count);
+    return std::clamp(int(std::ceil(3.0 * cell / lobe_width)), 1, 3);
+}
+
+namespace {
+// A CSV field: quoted when it holds a comma or a quote (a --set color=r,g,b label).
+std::string csv_field(const std::string &s) {
+    if (s.find_first_of(",\"") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
+}
+}  // namespace
 
 int write_fit_tables(const std::string &output, const std::vector<const FigureFiber *> &fibers, int theta_count,
                      int phi_count) {
@@ -105,7 +122,8 @@ int write_fit_tables(const std::string &output, const std::vector<const FigureFi
         const DualScattering &ds = *fiber->dual;
         Expected<std::vector<MultipleFitRow>> rows =
             fit_multiple(ds, {1, 2, 4, 8, 16}, flags.theta_count);
-        Expected<std::vector<DirectFitRow>> direct = fit_direct(model, flags.theta_count / 2, flags.phi_count, fiber->grid_points);
+        Expected<std::vector<DirectFitRow>> direct = fit_direct(model, flags.theta_count / 2, flags.phi_count,
+                       fiber->grid_points(flags.theta_count / 2, flags.phi_count));
         if (!rows || !direct) {
             std::cerr << "hairis-bake fits: " << (!rows ? rows.error() : direct.error()).message << "\n";
             return kExitFailure;
@@ -125,7 +143,7 @@ int write_fit_tables(const std::string &output, const std::vector<const FigureFi
             const int k = strand_index(r.n_h), t = theta_index(r.theta_r_deg);
             const bool in_seed = k >= 0 && k < 4;
             const SeedFit seed = in_seed ? kSeedTable2[k][t] : SeedFit{0, 0, 0};
-            csv_m << name << "," << preset << "," << r.n_h << "," << r.theta_r_deg << "," << r.fit.scale << ","
+            csv_m << name << "," << csv_field(preset) << "," << r.n_h << "," << r.theta_r_deg << "," << r.fit.scale << ","
                   << r.fit.sigma << "," << degrees(r.fit.mean) << "," << r.peak_deg << "," << r.fit.relative_error
                   << "," << r.albedo << "," << (in_seed ? std::to_string(seed.scale) : "") << ","
                   << (in_seed ? std::to_string(seed.sigma) : "") << ","
@@ -140,7 +158,7 @@ int write_fit_tables(const std::string &output, const std::vector<const FigureFi
            << "| θ_r | our σ_L | error of seed σ_L = 0.22 | error of seed σ_L = 0.44 | our σ_A | seed σ_A = 0.52 + (θ_r/π)² |\n"
            << "|---|---|---|---|---|---|\n";
         for (const DirectFitRow &d : direct.value()) {
-            csv_d << name << "," << preset << "," << d.theta_r_deg << "," << d.longitudinal.sigma << ","
+            csv_d << name << "," << csv_field(preset) << "," << d.theta_r_deg << "," << d.longitudinal.sigma << ","
                   << d.azimuthal.sigma << "," << d.seed_sigma_a << "," << d.error_sigma_l_022 << ","
                   << d.error_sigma_l_044 << "\n";
             md << "| " << fmt(d.theta_r_deg, 0) << "° | " << fmt(d.longitudinal.sigma) << " | "

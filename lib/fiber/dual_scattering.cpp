@@ -98,6 +98,8 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
     // Each task writes only its own table entries: the result does not depend on scheduling.
     tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
         std::vector<Rgbd> af(nl), ab(nl);
+        std::vector<double> lw(theta_rule.x.size());  // a separable lobe's θ weights
+        const bool measure = ds.shapes_measured_;
         for (int k = range.begin(); k != range.end(); ++k) {
             const double theta_k = ds.table_theta(k);
             // (1) a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction
@@ -113,7 +115,6 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                     // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
                     for (int p = 0; p < lobes; ++p) {
                         double longitudinal = 0;
-                        std::vector<double> lw(theta_rule.x.size());
                         for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
                             lw[m] = theta_rule.w[m] * std::cos(theta_rule.x[m]) * weight_scale *
                                     view->longitudinal(p, theta_rule.x[m]);
@@ -129,8 +130,10 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                                 azimuthal_sum += rule.w[n] * (double(v[0]) + double(v[1]) + double(v[2]));
                             }
                         }
-                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
-                            mk[std::size_t(p) * nk].add(lw[m] * azimuthal_sum, 0.5 * (theta_rule.x[m] + theta_k));
+                        if (measure)
+                            for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
+                                mk[std::size_t(p) * nk].add(lw[m] * azimuthal_sum,
+                                                            0.5 * (theta_rule.x[m] + theta_k));
                     }
                     continue;
                 }
@@ -147,8 +150,9 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                             for (int p = 0; p < lobes; ++p) {
                                 const Rgb v = view->lobe_f_cos(p, w);
                                 for (int ch = 0; ch < 3; ++ch) acc[std::size_t(p)].v[ch] += weight * double(v[ch]);
-                                mk[std::size_t(p) * nk].add(weight * (double(v[0]) + double(v[1]) + double(v[2])),
-                                                            theta_h);
+                                if (measure)
+                                    mk[std::size_t(p) * nk].add(
+                                        weight * (double(v[0]) + double(v[1]) + double(v[2])), theta_h);
                             }
                         }
                     }

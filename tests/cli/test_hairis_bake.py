@@ -274,6 +274,18 @@ class HairisBakeTest(unittest.TestCase):
         totals = fig3.sum(axis=1)
         self.assertTrue(np.all(np.diff(totals) < 0), totals)
 
+    def test_fits_csv_quotes_a_label_with_commas(self):
+        out = self.path("comma_figures")
+        r = run("figures", "--preset", "cycles-default", "--set", "parametrization=color",
+                "--set", "color=0.1,0.2,0.3", "--theta-i", "8", "--phi", "8", "--data-only",
+                "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        import csv
+        with open(os.path.join(out, "fits_multiple.csv"), newline="") as f:
+            rows = list(csv.reader(f))
+        self.assertTrue(all(len(row) == len(rows[0]) for row in rows), rows[:3])
+        self.assertEqual(rows[1][1], "cycles-default + parametrization=color + color=0.1,0.2,0.3")
+
     def test_figures_of_a_table(self):
         table = self.path("t.exr")
         self.assertEqual(run("bake", *SMALL, "-q", "-o", table).returncode, 0)
