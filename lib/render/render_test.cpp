@@ -838,17 +838,23 @@ TEST(Render, HuangIsTransparentOutsideItsEllipse) {
     EXPECT_NEAR(hair_coverage({along}, 1.0f, 8), r, tolerance * r);
 }
 
-TEST(Render, TransparentCrossingsStopAfterTheLimit) {
-    // Three such fibers stacked under the camera: a ray outside the ellipses crosses all three
-    // (and escapes: alpha 0) when max_transparent_bounces allows 3 crossings (limit 2, Cycles'
-    // setting + 1), but ends on the third fiber (alpha 1) when it allows 2.
-    const float r = 0.2f, b = 0.5f;
+// Three straight fibers of radius r stacked one unit apart under the camera, major axis on z.
+std::vector<HairCurves> stacked_fibers(float r) {
     std::vector<HairCurves> stack;
     for (int k = 0; k < 3; ++k) {
         HairCurves c = straight_hair(0.0f, -float(k), r, 3.0f);
         c.normals.assign(c.points.size(), Vec3{0, 0, 1});
         stack.push_back(c);
     }
+    return stack;
+}
+
+TEST(Render, TransparentCrossingsStopAfterTheLimit) {
+    // Three such fibers stacked under the camera: a ray outside the ellipses crosses all three
+    // (and escapes: alpha 0) when max_transparent_bounces allows 3 crossings (limit 2, Cycles'
+    // setting + 1), but ends on the third fiber (alpha 1) when it allows 2.
+    const float r = 0.2f, b = 0.5f;
+    const std::vector<HairCurves> stack = stacked_fibers(r);
     EXPECT_NEAR(hair_coverage(stack, b, 2), r * b, 0.01 * r);
     EXPECT_NEAR(hair_coverage(stack, b, 1), r, 0.01 * r);
 }
@@ -858,12 +864,7 @@ TEST(Render, Cycles50TransparentLimitIsTheSetting) {
     // 3 allows the 3 crossings (alpha r·b), 2 ends on the third fiber (alpha r); 0 and 1 both
     // allow one crossing (the second fiber ends the ray), as Cycles 5.0's path state does.
     const float r = 0.2f, b = 0.5f;
-    std::vector<HairCurves> stack;
-    for (int k = 0; k < 3; ++k) {
-        HairCurves c = straight_hair(0.0f, -float(k), r, 3.0f);
-        c.normals.assign(c.points.size(), Vec3{0, 0, 1});
-        stack.push_back(c);
-    }
+    const std::vector<HairCurves> stack = stacked_fibers(r);
     const TransparentLimit setting = TransparentLimit::Setting;
     EXPECT_NEAR(hair_coverage(stack, b, 3, setting), r * b, 0.01 * r);
     EXPECT_NEAR(hair_coverage(stack, b, 2, setting), r, 0.01 * r);
