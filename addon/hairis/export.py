@@ -387,12 +387,6 @@ def is_render_depsgraph(depsgraph):
 
 # ---- Node trees ------------------------------------------------------------------------------
 
-def _follow_link(socket):
-    """The (node, socket) feeding ``socket``, through reroutes and muted nodes; (None, None)
-    if unlinked (node_eval.source)."""
-    return node_eval.source(socket)
-
-
 def output_node(node_tree):
     """The active output node Cycles would use (target CYCLES, else ALL)."""
     if node_tree is None:
@@ -429,7 +423,7 @@ def surface_node(material):
     surface = _input(output, "Surface")
     if surface is None:
         return None
-    node, _ = _follow_link(surface)
+    node, _ = node_eval.source(surface)
     return node
 
 
@@ -602,7 +596,7 @@ def read_surface_nodes(material, warn, add_texture):
     node = surface_node(material)
     if node is None:
         return [{"type": "diffuse", "cycles": version, "color": (0.0, 0.0, 0.0)}]
-    reader = surfaces.SurfaceReader(material, warn, add_texture, _follow_link, version)
+    reader = surfaces.SurfaceReader(material, warn, add_texture, node_eval.source, version)
     return reader.read(node)
 
 
@@ -684,7 +678,7 @@ def _mapping_vector(world, node, warn):
 def _coordinates(world, vector_socket, warn):
     """The world → texture matrix of what feeds a Vector input: a Texture Coordinate's
     Generated (identity) or Object output, or nothing; None for anything else."""
-    node, socket = _follow_link(vector_socket)
+    node, socket = node_eval.source(vector_socket)
     if node is None:
         return np.eye(4)
     if node.bl_idname != "ShaderNodeTexCoord":
@@ -719,7 +713,7 @@ def read_environment(world, color_socket, warn):
     """The :class:`EnvironmentData` of a Background Color fed by an Environment Texture
     (optionally through a Mapping node, fed by a Texture Coordinate or nothing), or None
     with a warning naming the node that is not supported."""
-    node, _ = _follow_link(color_socket)
+    node, _ = node_eval.source(color_socket)
     if node is None:
         return None
     if node.bl_idname != ENVIRONMENT_NODE_IDNAME:
@@ -746,7 +740,7 @@ def read_environment(world, color_socket, warn):
     data = EnvironmentData(image_name=image.name, path=path, pixels=pixels,
                            color_space=color_space)
     vector = _input(node, "Vector")
-    source, source_socket = _follow_link(vector) if vector is not None else (None, None)
+    source, source_socket = node_eval.source(vector) if vector is not None else (None, None)
     if source is not None and source.bl_idname == "ShaderNodeMapping":
         mapping = _mapping_vector(world, source, warn)
         if mapping is not None:
@@ -939,7 +933,7 @@ class _Exporter:
             return
         output = output_node(world.node_tree)
         surface = _input(output, "Surface") if output is not None else None
-        node, _ = _follow_link(surface) if surface is not None else (None, None)
+        node, _ = node_eval.source(surface) if surface is not None else (None, None)
         if node is None:
             return  # Cycles: black
         if node.bl_idname != "ShaderNodeBackground":
