@@ -85,16 +85,27 @@ struct HitContext {
     bool cycles_huang = false;  // RenderSettings::huang_sampling == Cycles
 };
 
-// `oriented`: fill the fields only models that read_orientation() use (Huang).
+// Cycles turns Ng, N and dP/du towards ω_o at a back-facing hit (shader_setup_from_ray; on a
+// curve, the inside of the tube seen through its open end): the hair frame follows −tangent.
+bool back_facing(const SurfacePoint &sp, Vec3 wo) { return dot(sp.normal, wo) < 0.0f; }
+
+FiberFrame hair_frame(const SurfacePoint &sp, Vec3 wo) {
+    return FiberFrame::from_tangent_and_view(back_facing(sp, wo) ? -sp.tangent : sp.tangent, wo);
+}
+
+// `frame`: hair_frame(sp, wo). `oriented`: fill the fields only models that read_orientation()
+// use (Huang).
 FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context,
                    bool oriented = true) {
     FiberHit hit;
     hit.wo = frame.to_local(wo);
-    hit.h = std::clamp(dot(cross(sp.normal, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    const bool back = back_facing(sp, wo);
+    const Vec3 ng = back ? -sp.normal : sp.normal, tangent = back ? -sp.tangent : sp.tangent;
+    hit.h = std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
     if (!oriented) return hit;
     // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
-    const Vec3 axis = HuangFiber::major_axis(sp.tangent, sp.curve_normal);
-    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(sp.tangent));
+    const Vec3 axis = HuangFiber::major_axis(tangent, sp.curve_normal);
+    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(tangent));
     hit.pixel_coverage = context.camera_ray ? cycles_pixel_coverage(context.footprint, sp.curve_radius) : 1.0f;
     hit.seed = context.seed;
     return hit;
@@ -110,7 +121,7 @@ class Bsdf {
     Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
          const HairInputValues *inputs, ScratchBuffer &scratch) {
         if (const auto *hair = std::get_if<HairMaterial>(&material)) {
-            frame_ = FiberFrame::from_tangent_and_view(sp.tangent, wo);
+            frame_ = hair_frame(sp, wo);
             const ShadingModel *model = hair->shading.model();
             FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
             hit.inputs = inputs;
@@ -402,18 +413,13 @@ int transparent_crossings(TransparentLimit limit, int setting) {
     return limit == TransparentLimit::Setting ? std::max(setting, 1) : setting + 1;
 }
 
-float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo) {
-    const FiberFrame frame = FiberFrame::from_tangent_and_view(tangent, wo);
-    return std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);
-}
-
 float cycles_pixel_coverage(float footprint, float curve_radius) {
     return curve_radius > 0.0f ? 0.5f * footprint / curve_radius : INFINITY;
 }
 
 FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
                           std::uint32_t seed) {
-    return fiber_hit(sp, wo, FiberFrame::from_tangent_and_view(sp.tangent, wo),
+    return fiber_hit(sp, wo, hair_frame(sp, wo),
                      HitContext{camera_ray, footprint, seed});
 }
 

@@ -196,7 +196,9 @@ Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
 float cycles_pixel_coverage(float footprint, float curve_radius);
 
 /// The FiberHit the renderer gives a hair material at a curve hit, as Cycles sets up the
-/// Principled Hair closure: ω_o and h in the frame FiberFrame::from_tangent_and_view; the
+/// Principled Hair closure: ω_o and h = dot(cross(Ng, X), Z) in the frame
+/// FiberFrame::from_tangent_and_view, where a back-facing hit (the inside of a tube) turns Ng and
+/// the tangent, as Cycles turns Ng, N and dP/du towards ω_o; the
 /// major axis from the curve normal, or, where the curve has none (or it is parallel to the
 /// tangent), Cycles' fallback frame around the world tangent (HuangFiber::fallback_major_axis);
 /// pixel_coverage from `footprint` for camera rays, 1 for every other ray; `seed` for the
@@ -209,10 +211,6 @@ FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, floa
 /// no hair or meets something else first.
 std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v);
 
-/// Cycles' fiber offset for 3D curves (bsdf_principled_hair_setup): with the frame
-/// X = tangent, Y = normalize(cross(X, ω_o)), Z = cross(X, Y) (FiberFrame's), and Ng the
-/// thick-curve normal, h = dot(cross(Ng, X), Z), clamped to [−1, 1].
-float cycles_hair_offset(Vec3 ng, Vec3 tangent, Vec3 wo);
 
 /// The radiance estimate of one camera sample (for tests and debugging): the path of sample
 /// `sample` through raster position (x + u, y + v) where (u, v) are the sample's own jitter.

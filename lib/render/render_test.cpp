@@ -677,18 +677,19 @@ TEST(Render, HairOffsetIsCyclesH) {
     d.curves = {parallel_hairs(1, 0.1f, 0.1f)};
     d.camera = ortho_down(1, 1, 2, 2);
     const Scene scene = build(std::move(d));
-    for (const float y : {0.05f, -0.05f, 0.0f, 0.099f}) {
-        const Vec3 o{0.2f, y, 3.0f}, dir{0, 0, -1};
+    const Vec3 dir{0, 0, -1};
+    auto offset = [&](float y) {
+        const Vec3 o{0.2f, y, 3.0f};
         const auto hit = scene.intersect(o, dir, 0.0f, INFINITY);
-        ASSERT_TRUE(hit.has_value());
-        const SurfacePoint sp = scene.surface_point(o, dir, *hit);
-        const float h = cycles_hair_offset(sp.normal, sp.tangent, -dir);
+        EXPECT_TRUE(hit.has_value());
+        return hit ? cycles_fiber_hit(scene.surface_point(o, dir, *hit), -dir, false, 0.0f, 0).h : NAN;
+    };
+    for (const float y : {0.05f, -0.05f, 0.0f, 0.099f}) {
+        const float h = offset(y);
         // |h| is the offset across the width over the radius; its sign follows the side.
         EXPECT_NEAR(std::fabs(h), std::fabs(y) / 0.1f, 2e-2f) << y;
         if (y != 0.0f) {
-            const auto mirrored = scene.intersect({0.2f, -y, 3.0f}, dir, 0.0f, INFINITY);
-            const SurfacePoint sm = scene.surface_point({0.2f, -y, 3.0f}, dir, *mirrored);
-            EXPECT_LT(h * cycles_hair_offset(sm.normal, sm.tangent, -dir), 0.0f);
+            EXPECT_LT(h * offset(-y), 0.0f) << y;
         }
     }
 }
@@ -726,6 +727,36 @@ HairCurves straight_hair(float y, float z, float radius, float half_length, int 
     return c;
 }
 
+TEST(Render, BackFacingHairHitTurnsTheFrameAsCycles) {
+    // A ray from inside the tube (as through an open curve end) meets its far wall from behind.
+    // Cycles turns Ng, N and dP/du towards ω_o there: θ_o is mirrored (the tangent reversed)
+    // while h, from both turned vectors, is the front hit's on the same line.
+    SceneDesc d;
+    d.materials = {hair(fiber_with(Rgb(0.5f)), std::make_shared<const UniformSampler>())};
+    d.curves = {straight_hair(0.0f, 0.0f, 0.1f, 1.5f)};
+    d.curve_backfaces = CurveBackfaces::Hit;
+    d.camera = ortho_down(1, 1, 2, 2);
+    const Scene scene = build(std::move(d));
+    const Vec3 dir = safe_normalize(Vec3{0.6f, 0.0f, -1.0f});
+    for (const float y : {0.06f, -0.03f}) {
+        const Vec3 inside{0.2f, y, 0.0f}, outside = inside - 3.0f * dir;
+        const auto front = scene.intersect(outside, dir, 0.0f, INFINITY);
+        const auto back = scene.intersect(inside, dir, 0.0f, INFINITY);
+        ASSERT_TRUE(front && back) << y;
+        const SurfacePoint sf = scene.surface_point(outside, dir, *front);
+        const SurfacePoint sb = scene.surface_point(inside, dir, *back);
+        ASSERT_GT(dot(sb.normal, dir), 0.0f) << "the far wall is hit from inside";
+        const FiberHit hf = cycles_fiber_hit(sf, -dir, false, 0.0f, 0);
+        const FiberHit hb = cycles_fiber_hit(sb, -dir, false, 0.0f, 0);
+        EXPECT_NEAR(std::fabs(hf.h), std::fabs(y) / 0.1f, 2e-2f) << y;
+        EXPECT_NEAR(hb.h, hf.h, 2e-2f) << y;
+        const float sin_theta = dot(-dir, sf.tangent);  // along the tangent, which is ±x
+        EXPECT_NEAR(std::fabs(sin_theta), 0.6f / std::sqrt(1.36f), 1e-3f);
+        EXPECT_NEAR(hf.wo.x, sin_theta, 1e-5f) << y;
+        EXPECT_NEAR(hb.wo.x, -sin_theta, 1e-5f) << y;
+    }
+}
+
 TEST(Render, HuangMajorAxisFollowsTheCurveNormal) {
     // Huang's frame (x tangent, y major axis) for a view in the renderer's frame: the major axis
     // is the normal's part across the tangent (Gram-Schmidt here; Cycles writes a double cross
@@ -744,7 +775,9 @@ TEST(Render, HuangMajorAxisFollowsTheCurveNormal) {
     const HuangPoint point = fiber->at(hit);
     const HuangHit hh = point.huang_hit();
     expect_vec(hh.wo, {dot(wo, x), dot(wo, y), dot(wo, z)}, 2e-6f, "ω_o in Huang's frame");
-    EXPECT_EQ(hh.h, cycles_hair_offset(sp.normal, sp.tangent, wo));
+    ASSERT_GT(dot(sp.normal, wo), 0.0f);  // front-facing: the frame's x is the tangent
+    // Cycles' h = dot(cross(Ng, X), Z) = −Ng·Y.
+    EXPECT_NEAR(hh.h, -dot(sp.normal, safe_normalize(cross(sp.tangent, wo))), 1e-6f);
     EXPECT_EQ(hit.pixel_coverage, 1.0f);  // not a camera ray
     EXPECT_EQ(hit.seed, 7u);
 }
@@ -752,25 +785,29 @@ TEST(Render, HuangMajorAxisFollowsTheCurveNormal) {
 TEST(Render, HuangFallbackFrameWithoutCurveNormals) {
     // Cycles' make_orthonormals(tangent): c = normalize((1, 1, 1) × t) (with (−1, 1, 1) and the
     // middle component negated when t's components are equal), major axis t × c. Closed forms
-    // for two tangents; a normal along the tangent falls back the same way.
+    // for two tangents; a normal along the tangent falls back the same way; at a back-facing
+    // hit the tangent is reversed first (make_orthonormals((0, 0, −1)) has the axis (1, 1, 0)/√2).
     const auto fiber = huang_fiber(0.85f);
     struct Case {
         Vec3 tangent, axis, normal;
+        bool back;
     };
     const float r2 = 1.0f / std::sqrt(2.0f), r3 = 1.0f / std::sqrt(3.0f), r6 = 1.0f / std::sqrt(6.0f);
-    const Case cases[] = {{{0, 0, 1}, {r2, r2, 0}, {0, 0, 0}},
-                          {{r3, r3, r3}, {-2 * r6, r6, r6}, {0, 0, 0}},
-                          {{0, 0, 1}, {r2, r2, 0}, {0, 0, 2}}};
+    const Case cases[] = {{{0, 0, 1}, {r2, r2, 0}, {0, 0, 0}, false},
+                          {{r3, r3, r3}, {-2 * r6, r6, r6}, {0, 0, 0}, false},
+                          {{0, 0, 1}, {r2, r2, 0}, {0, 0, 2}, false},
+                          {{0, 0, 1}, {r2, r2, 0}, {0, 0, 0}, true}};
     for (const Case &c : cases) {
+        const Vec3 wo = safe_normalize(Vec3{0.3f, -0.8f, 0.2f});
         SurfacePoint sp;
         sp.tangent = c.tangent;
         sp.curve_normal = c.normal;
-        sp.normal = safe_normalize(cross(c.tangent, Vec3{1, 0, 0}) + cross(c.tangent, Vec3{0, 1, 0}));
-        const Vec3 wo = safe_normalize(Vec3{0.3f, -0.8f, 0.2f});
+        const Vec3 facing = safe_normalize(wo - c.tangent * dot(wo, c.tangent));
+        sp.normal = c.back ? -facing : facing;
         const FiberHit hit = cycles_fiber_hit(sp, wo, false, 0.0f, 0);
-        const Vec3 x = c.tangent, y = c.axis, z = cross(x, y);
+        const Vec3 x = c.back ? -c.tangent : c.tangent, y = c.axis, z = cross(x, y);
         expect_vec(fiber->at(hit).huang_hit().wo, {dot(wo, x), dot(wo, y), dot(wo, z)}, 2e-6f,
-                   "fallback frame");
+                   c.back ? "fallback frame, back-facing" : "fallback frame");
     }
 }
 

@@ -21,9 +21,8 @@ are printed, not asserted.
 Cycles 5.0 stores Max Bounces: Transparent as set (4.5: the setting + 1), so in 5.0 a path
 crosses one transparent surface fewer: the add-on passes transparent_limit=setting there. Without
 it the two interpenetrating thick fibers differ far beyond the noise in 5.0 (mean t² 14 against
-1.93). What remains in 5.0 is one block at a thick fiber's tip (|t| about 9.7 against 6.2; the
-same blocks differ in 4.5 at 256 samples, where 32 samples' noise hides them): README.md,
-"Comparing with Cycles".
+1.93). Where a ray looks into a thick fiber's cut end it meets the inside of the tube, and
+Cycles turns the hair frame there (README.md, "Comparing with Cycles").
 """
 
 import os
