@@ -371,12 +371,29 @@ Rgb DualScattering::forward_spread_variance(double theta, int n_h) const {
 // ------------------------------------------------------------------------------------------
 // Shading
 
-DualScattering::Rgbd DualScattering::local_term(double theta_i, double theta_o) const {
+DualScattering::Rgbd DualScattering::backscatter(double theta, int depth) const {
+    if (depth < 0) return lookup(big_a_b_, theta);
+    const double amax = params_.max_series_attenuation;
+    const Rgbd a_f = lookup(a_f_, theta), a_b = lookup(a_b_, theta);
+    Rgbd out;
+    for (int ch = 0; ch < 3; ++ch) {
+        const double af = std::clamp(a_f.v[ch], 0.0, amax), ab = std::clamp(a_b.v[ch], 0.0, amax);
+        const double x = af * af, om = 1.0 - x, cut = 1.0 - std::pow(x, depth);
+        out.v[ch] = ab * x * cut / om + ab * ab * ab * x * cut * cut * cut / (om * om * om);
+    }
+    return out;
+}
+
+Rgb DualScattering::backscatter_attenuation(double theta, int depth) const {
+    return to_rgb(backscatter(theta, depth));
+}
+
+DualScattering::Rgbd DualScattering::local_term(double theta_i, double theta_o, int depth) const {
     const double theta_h = 0.5 * (theta_i + theta_o);
     const double theta_d = 0.5 * (theta_o - theta_i);
     const double cos_i = std::max(0.0, std::cos(theta_i));
     const double cos_d2 = std::max(sqr(std::cos(theta_d)), 1e-12);
-    const Rgbd big_a = lookup(big_a_b_, theta_i);
+    const Rgbd big_a = backscatter(theta_i, depth);
     const Rgbd delta = lookup(delta_b_, theta_i);
     const Rgbd sig2 = lookup(sigma2_b_, theta_i);
     Rgbd out;
@@ -389,13 +406,13 @@ DualScattering::Rgbd DualScattering::local_term(double theta_i, double theta_o) 
 }
 
 DualScattering::Rgbd DualScattering::scattered_term(double theta_i, double theta_o, const Rgbd &t_f,
-                                                    const Rgbd &s_f2) const {
+                                                    const Rgbd &s_f2, int depth) const {
     const double theta_h = 0.5 * (theta_i + theta_o);
     const double theta_d = 0.5 * (theta_o - theta_i);
     const double cos_i = std::max(0.0, std::cos(theta_i));
     const double cos_d2 = std::max(sqr(std::cos(theta_d)), 1e-12);
     const double db = params_.d_b, df = params_.d_f;
-    const Rgbd big_a = lookup(big_a_b_, theta_i);
+    const Rgbd big_a = backscatter(theta_i, depth);
     const Rgbd delta = lookup(delta_b_, theta_i);
     const Rgbd sig2 = lookup(sigma2_b_, theta_i);
     std::array<Rgbd, 16> ng{};
@@ -417,23 +434,24 @@ DualScattering::Rgbd DualScattering::scattered_term(double theta_i, double theta
     return out;
 }
 
-Rgb DualScattering::local_f_cos(float theta_i, float theta_o) const {
-    return to_rgb(local_term(theta_i, theta_o));
+Rgb DualScattering::local_f_cos(float theta_i, float theta_o, int depth) const {
+    return to_rgb(local_term(theta_i, theta_o, depth));
 }
 
-Rgb DualScattering::scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance) const {
+Rgb DualScattering::scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance,
+                                    int depth) const {
     Rgbd t_f, s_f2;
     for (int ch = 0; ch < 3; ++ch) {
         t_f.v[ch] = transmittance[ch];
         s_f2.v[ch] = spread_variance[ch];
     }
-    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2));
+    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2, depth));
 }
 
 Rgb DualScattering::multiple_f_cos(float theta_i_f, float theta_o_f, int n_h) const {
     if (n_h < 0) return {};
     const double theta_i = theta_i_f, theta_o = theta_o_f;
-    if (n_h == 0) return to_rgb(local_term(theta_i, theta_o));
+    if (n_h == 0) return to_rgb(local_term(theta_i, theta_o, -1));
     const Rgbd a_f = lookup(a_f_, theta_i);
     const Rgbd b2f = lookup(beta2_f_, theta_i);
     Rgbd t_f, s_f2;
@@ -441,7 +459,7 @@ Rgb DualScattering::multiple_f_cos(float theta_i_f, float theta_o_f, int n_h) co
         t_f.v[ch] = params_.d_f * std::pow(std::max(0.0, a_f.v[ch]), n_h);
         s_f2.v[ch] = n_h * b2f.v[ch];
     }
-    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2));
+    return to_rgb(scattered_term(theta_i, theta_o, t_f, s_f2, -1));
 }
 
 }  // namespace hairis

@@ -167,13 +167,22 @@ class DualScattering {
     /// The local multiple-scattering term of a point the light reaches directly (n_h = 0):
     /// d_b f_back^direct cos θ_i, per unit solid angle of ω_i (single scattering f_s is not in
     /// it). The same as multiple_f_cos(θ_i, θ_o, 0).
-    Rgb local_f_cos(float theta_i, float theta_o) const;
+    /// `depth`: the strands behind the point that light can go on through and be scattered back
+    /// from (backscatter_attenuation); negative for the paper's unbounded hair volume.
+    Rgb local_f_cos(float theta_i, float theta_o, int depth = -1) const;
     /// The global term of light that crossed strands on its way, for a forward transmittance
     /// T_f (d_f included) and spread σ_f² (radians²) gathered strand by strand along the light's
     /// path: T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i, per channel. With
     /// T_f = forward_transmittance(θ_i, n) and σ_f² = forward_spread_variance(θ_i, n) it is
     /// multiple_f_cos(θ_i, θ_o, n) for n ≥ 1. Negative σ_f² is taken as 0.
-    Rgb scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance) const;
+    Rgb scattered_f_cos(float theta_i, float theta_o, Rgb transmittance, Rgb spread_variance,
+                        int depth = -1) const;
+
+    /// Ā_b at θ with the forward series cut at `depth` strands behind the point: the paper's
+    /// Σ_{i≥1} ā_f^{2i} (first term) and its cube (third) summed over i ≤ depth, so with x = ā_f²
+    /// Ā_b = ā_b x (1 − x^depth)/(1 − x) + ā_b³ x (1 − x^depth)³/(1 − x)³ (0 for depth 0);
+    /// backscatter_attenuation(θ) for depth < 0. Light that goes deeper leaves the hair.
+    Rgb backscatter_attenuation(double theta, int depth) const;
 
     /// The multiple-scattering term F·cos θ_i, averaged over azimuth, per unit solid angle of
     /// ω_i (see "Measure" above). n_h < 0 is a precondition violation and returns 0.
@@ -190,8 +199,10 @@ class DualScattering {
         double v[3] = {0, 0, 0};
     };
     Rgbd lookup(const std::vector<Rgbd> &table, double theta, std::size_t offset = 0) const;
-    Rgbd local_term(double theta_i, double theta_o) const;
-    Rgbd scattered_term(double theta_i, double theta_o, const Rgbd &t_f, const Rgbd &s_f2) const;
+    Rgbd backscatter(double theta, int depth) const;
+    Rgbd local_term(double theta_i, double theta_o, int depth) const;
+    Rgbd scattered_term(double theta_i, double theta_o, const Rgbd &t_f, const Rgbd &s_f2,
+                        int depth) const;
     static Rgb to_rgb(const Rgbd &c);
 
     DualScatteringParams params_;

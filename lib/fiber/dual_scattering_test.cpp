@@ -15,6 +15,7 @@
 #include "fiber/chiang.h"
 #include "fiber/huang.h"
 #include "fiber/marschner.h"
+#include "fiber/principled_hair.h"
 
 namespace hairis {
 namespace {
@@ -346,6 +347,42 @@ TEST(DualScattering, MultipleTermDarkensWithMoreStrands) {
         const double a = albedo(n);
         EXPECT_LT(a, previous) << n;
         previous = a;
+    }
+}
+
+TEST(DualScattering, BackscatterCutAtDepthIsThePartialSeries) {
+    // Ā_b with the series over the strands behind cut at `depth`: with x = ā_f² and
+    // S = Σ_{i<depth} x^i (summed here term by term), ā_b x S + ā_b³ x S³; 0 with nothing
+    // behind; the unbounded table's value for a deep layer.
+    ChiangParams cp;
+    cp.sigma_a = principled_hair::sigma_from_concentration(0.05, 0.05);  // blonde: ā_f up to 0.83
+    cp.roughness = 0.3f;
+    cp.radial_roughness = 0.3f;
+    const ChiangFiber fiber = ChiangFiber::create(cp).value();
+    const DualScattering ds = DualScattering::create(fiber, {}).value();
+    ASSERT_EQ(ds.clamped_entries(), 0);
+    // At table nodes, where Ā_b's table holds the paper's closed form of the same ā_f and ā_b.
+    const int n = ds.theta_count();
+    for (int k : {n / 2, n / 2 + 6, 5}) {
+        const double theta = -kHalfPi + (k + 0.5) * kPi / n;
+        const Rgb a_f = ds.forward_attenuation(theta), a_b = ds.backward_attenuation(theta);
+        const Rgb unbounded = ds.backscatter_attenuation(theta);
+        const Rgb none = ds.backscatter_attenuation(theta, 0);
+        EXPECT_TRUE(none.r == 0.0f && none.g == 0.0f && none.b == 0.0f) << theta;
+        for (int depth : {1, 2, 5}) {
+            const Rgb cut = ds.backscatter_attenuation(theta, depth);
+            for (int ch = 0; ch < 3; ++ch) {
+                const double x = double(a_f[ch]) * a_f[ch], ab = a_b[ch];
+                double sum = 0, power = 1;
+                for (int i = 0; i < depth; ++i, power *= x) sum += power;
+                const double want = ab * x * sum + ab * ab * ab * x * sum * sum * sum;
+                EXPECT_NEAR(cut[ch], want, 1e-6 * want + 1e-9) << theta << " depth " << depth;
+                EXPECT_LT(cut[ch], unbounded[ch]) << theta << " depth " << depth;
+            }
+        }
+        const Rgb deep = ds.backscatter_attenuation(theta, 400);
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_NEAR(deep[ch], unbounded[ch], 1e-5 * unbounded[ch]) << theta << " ch " << ch;
     }
 }
 

@@ -54,10 +54,10 @@ ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCros
 }
 
 Rgb dual_multiple_f_cos(const DualScattering &dual, float theta_i, float theta_o,
-                        const ForwardScattering &forward) {
-    if (forward.strands == 0) return dual.local_f_cos(theta_i, theta_o);
+                        const ForwardScattering &forward, int depth) {
+    if (forward.strands == 0) return dual.local_f_cos(theta_i, theta_o, depth);
     return dual.scattered_f_cos(theta_i, theta_o, forward.attenuation * dual.params().d_f,
-                                forward.spread_variance);
+                                forward.spread_variance, depth);
 }
 
 int nearest_strand_index(const MultipleTable &table, int strands) {
@@ -119,6 +119,15 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                                               work.probe);
         ++work.rays;
     }
+    // The strands behind the vertex, away from that light point: where Ā_b's series stop.
+    int depth = -1;
+    if (v.layer) {
+        const Vec3 dir = -(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
+        scene.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {}, work.behind);
+        ++work.rays;
+        depth = int(work.behind.size());
+    }
+    work.last_depth = depth;
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;
     work.last_probe_strands = int(work.probe.size());
@@ -149,7 +158,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                     const Rgb f = v.bsdf->f_and_pdf(l, pdf_bsdf);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
-                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward);
+                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth);
                 const float pdf_table = multiple_table_pdf(table, strand, v.frame, wo_local, ls->wi);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
@@ -176,7 +185,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             const float t_hi = k < work.table.size() ? work.table[k].t : t_end;
             const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true);
             if (!is_black(lamps))
-                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward) * lamps * inv_pdf;
+                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * lamps * inv_pdf;
             if (k < work.table.size()) add_crossing(forward, scene, work.table[k], wi, dual);
             t_lo = t_hi;
         }
@@ -195,7 +204,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                 }
         }
         if (!is_black(arriving))
-            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward) * arriving * inv_pdf;
+            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * arriving * inv_pdf;
     }
     return out;
 }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cmath>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "chi2.h"
@@ -108,9 +109,11 @@ Scene build(SceneDesc d) {
     return std::move(s).value();
 }
 
-RenderSettings dual_settings(int max_bounces = 0) {
+// The paper's unbounded hair volume, whose closed forms most tests here check.
+RenderSettings dual_settings(int max_bounces = 0, DualHairVolume volume = DualHairVolume::Unbounded) {
     RenderSettings s;
     s.integrator = int(Integrator::DualScattering);
+    s.dual_hair_volume = int(volume);
     s.max_bounces = max_bounces;
     s.film_transparent = true;
     s.threads = 1;
@@ -398,6 +401,111 @@ TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
     }
 }
 
+struct Estimate {
+    double mean[3] = {0, 0, 0}, sigma[3] = {0, 0, 0};
+};
+
+// The mean and standard error of the single pixel's samples that hit hair.
+Estimate hair_pixel(const Scene &scene, const RenderSettings &s, int n) {
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    int hits = 0;
+    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+        float alpha = 0;
+        const Rgb l = render_sample(scene, s, 0, 0, i, &alpha);
+        if (alpha == 0.0f) continue;
+        ++hits;
+        for (int ch = 0; ch < 3; ++ch) {
+            sum[ch] += l[ch];
+            sum2[ch] += double(l[ch]) * l[ch];
+        }
+    }
+    EXPECT_GT(hits, n / 2);
+    Estimate e;
+    for (int ch = 0; ch < 3; ++ch) {
+        e.mean[ch] = sum[ch] / std::max(hits, 1);
+        e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / std::max(hits, 1) - e.mean[ch] * e.mean[ch]) / std::max(hits, 1));
+    }
+    return e;
+}
+
+TEST(DualScatteringRender, ALayersMeshLightThroughStrandsIsTheGlobalTerm) {
+    // A hair above a mat of touching strands above a sunlit white floor: every direction from
+    // the hair to the floor crosses the mat. With Layer, the floor's light is the global term
+    // M(n) of the strands crossed: the render with the floor less the render without it (the
+    // same random numbers) against an estimate over uniform directions from the hair's hits.
+    const float strength = 3.0f, r = 0.02f;
+    const Vec3 to_sun{0, 0, 1};
+    std::vector<Vec3> centres{{0, 0, 0}};
+    for (int k = -3; k <= 3; ++k) centres.push_back({0, float(k) * 2.0f * r, -0.05f});
+    auto scene_with = [&](bool floor) {
+        SceneDesc d;
+        d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(0.8f)}};
+        d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
+        if (floor) d.meshes = {quad_at(1.0f, -1.0f, 1)};
+        SunLight sun;
+        sun.to_sun = to_sun;
+        sun.strength = strength;
+        d.suns = {sun};
+        d.camera = looking_down(0.01f, 0.01f, 1, 1);
+        return build(std::move(d));
+    };
+    const Scene with = scene_with(true), without = scene_with(false);
+    const RenderSettings s = dual_settings(1, DualHairVolume::Layer);
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    const int n = 20000;
+    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+        const Rgb a = render_sample(with, s, 0, 0, i), b = render_sample(without, s, 0, 0, i);
+        for (int ch = 0; ch < 3; ++ch) {
+            const double v = double(a[ch]) - double(b[ch]);
+            sum[ch] += v;
+            sum2[ch] += v * v;
+        }
+    }
+    // Independent: ω uniform on the sphere from a camera ray's hit on the hair.
+    const DualScattering &dual = *blonde().dual;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    double ind[3] = {0, 0, 0}, ind2[3] = {0, 0, 0};
+    const int m = 100000;
+    std::vector<StrandCrossing> strands, behind;
+    for (int i = 0; i < m; ++i) {
+        const CameraRay cr = with.camera().generate_ray(0, 0, uniform(rng), uniform(rng));
+        const auto hit = with.intersect(cr.origin, cr.direction, cr.tmin, cr.tmax);
+        ASSERT_TRUE(hit.has_value());
+        const SurfacePoint sp = with.surface_point(cr.origin, cr.direction, *hit);
+        const Vec3 wo = -cr.direction;
+        const FiberFrame frame = FiberFrame::from_tangent_and_view(sp.tangent, wo);
+        with.trace_through_hair(sp.spawn_point(-to_sun), -to_sun, 0.0f, INFINITY, sp.self, {}, behind);
+        const float z = 1.0f - 2.0f * uniform(rng), phi = float(kTwoPi) * uniform(rng);
+        const float rho = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        const Vec3 w{rho * std::cos(phi), rho * std::sin(phi), z};
+        const auto floor = with.trace_through_hair(sp.spawn_point(w), w, 0.0f, INFINITY, sp.self, {}, strands);
+        Rgb value;
+        if (floor && floor->prim.geometry != PrimRef::kNone) {
+            EXPECT_FALSE(strands.empty()) << "the mat covers the floor";
+            const SurfacePoint fp = with.surface_point(sp.spawn_point(w), w, *floor);
+            const bool lit = !with.occluded(fp.spawn_point(to_sun), to_sun, 0.0f, INFINITY, fp.self);
+            const ForwardScattering forward =
+                gather_forward_scattering(with, strands.data(), strands.size(), w, dual);
+            const float theta_i = std::asin(std::clamp(frame.to_local(w).x, -1.0f, 1.0f));
+            const float theta_o = std::asin(std::clamp(frame.to_local(wo).x, -1.0f, 1.0f));
+            const Rgb floor_radiance = Rgb(0.8f * strength / float(kPi)) * (lit ? 1.0f : 0.0f);
+            value = dual_multiple_f_cos(dual, theta_i, theta_o, forward, int(behind.size())) *
+                    floor_radiance * float(4.0 * kPi);
+        }
+        for (int ch = 0; ch < 3; ++ch) {
+            ind[ch] += value[ch];
+            ind2[ch] += double(value[ch]) * value[ch];
+        }
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        const double mean = sum[ch] / n, var = std::max(0.0, sum2[ch] / n - mean * mean) / n;
+        const double want = ind[ch] / m, var_ind = std::max(0.0, ind2[ch] / m - want * want) / m;
+        ASSERT_GT(want, 0.0);
+        EXPECT_NEAR(mean, want, 5.0 * std::sqrt(var + var_ind)) << "ch " << ch;
+    }
+}
+
 TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter) {
     // No strand under the hair: F = f_s + d_b f_back^direct. Over the hair's width (h uniform,
     // samples that miss it left out) f_s averages to the far field f_cos.
@@ -417,33 +525,43 @@ TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter
     const Vec3 wi = frame.to_local({float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))});
     const Vec3 wo = frame.to_local({0, 0, 1});
     const Rgb want = (blonde().fiber->f_cos(wi, wo) + blonde().dual->local_f_cos(0.4f, 0.0f)) * strength;
-    const RenderSettings s = dual_settings(0);
-    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-    int hits = 0;
-    for (std::uint64_t i = 0; i < 40000; ++i) {
-        float alpha = 0;
-        const Rgb l = render_sample(scene, s, 0, 0, i, &alpha);
-        if (alpha == 0.0f) continue;
-        ++hits;
-        for (int ch = 0; ch < 3; ++ch) {
-            sum[ch] += l[ch];
-            sum2[ch] += double(l[ch]) * l[ch];
-        }
-    }
-    ASSERT_GT(hits, 20000);
+    const Estimate e = hair_pixel(scene, dual_settings(0), 40000);
+    for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "ch " << ch;
+}
+
+TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
+    // The sun lights the top hair directly; three strands lie behind it along the light's way
+    // on (out of the camera's window). Layer: F = f_s + d_b f_back^direct with Ā_b cut at 3
+    // strands; Unbounded: the paper's series.
+    const float strength = 2.0f, a = 0.6f, step = 0.1f;
+    std::vector<Vec3> centres{{0, 0, 0}};
+    for (int k = 1; k <= 3; ++k) centres.push_back({0, -float(k) * step * std::tan(a), -float(k) * step});
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), 0.02f))};
+    SunLight sun;
+    sun.to_sun = {0.0f, std::sin(a), std::cos(a)};
+    sun.strength = strength;
+    d.suns = {sun};
+    d.camera = looking_down(0.4f, 0.03f, 1, 1);
+    const Scene scene = build(std::move(d));
+    const FiberFrame frame = FiberFrame::from_tangent_and_view({1, 0, 0}, {0, 0, 1});
+    const Rgb f_s = blonde().fiber->f_cos(frame.to_local(sun.to_sun), frame.to_local({0, 0, 1}));
+    const Rgb layer = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f, 3)) * strength;
+    const Rgb unbounded = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f)) * strength;
+    const Estimate cut = hair_pixel(scene, dual_settings(0, DualHairVolume::Layer), 40000);
+    const Estimate paper = hair_pixel(scene, dual_settings(0, DualHairVolume::Unbounded), 40000);
     for (int ch = 0; ch < 3; ++ch) {
-        const double mean = sum[ch] / hits;
-        const double sigma = std::sqrt(std::max(0.0, sum2[ch] / hits - mean * mean) / hits);
-        EXPECT_NEAR(mean, want[ch], 5.0 * sigma + 1e-4 * want[ch]) << "ch " << ch;
+        EXPECT_NEAR(cut.mean[ch], layer[ch], 5.0 * cut.sigma[ch] + 1e-4 * layer[ch]) << "ch " << ch;
+        EXPECT_NEAR(paper.mean[ch], unbounded[ch], 5.0 * paper.sigma[ch] + 1e-4 * unbounded[ch]) << "ch " << ch;
     }
+    EXPECT_GT(unbounded.r - layer.r, 10.0f * float(cut.sigma[0])) << "the test tells the two apart";
 }
 
 // The same sample's radiance minus the path tracer's, over n samples of pixel (0, 0): at depth
 // 0 both draw the same light sample and continuation with the same numbers, so the difference
 // is the multiple-scattering term M alone.
-struct Estimate {
-    double mean[3] = {0, 0, 0}, sigma[3] = {0, 0, 0};
-};
 Estimate multiple_part(const Scene &scene, int n) {
     RenderSettings dual = dual_settings(0), path = dual_settings(0);
     path.integrator = int(Integrator::Path);

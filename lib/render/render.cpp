@@ -200,6 +200,11 @@ class Bsdf {
     SurfaceBsdf surface_;
 };
 
+const DualScattering *hair_dual(const Material &material) {
+    const auto *hair = std::get_if<HairMaterial>(&material);
+    return hair ? hair->dual.get() : nullptr;
+}
+
 // The seed of the random numbers of the point at vertex `depth` of a path (Huang's eval).
 std::uint32_t vertex_seed(const SampleRng &key, int depth) {
     return std::uint32_t(mix64(key.key() ^ (std::uint64_t(depth + 1) * 0xd1b54a32d192ed03ull)) >> 32);
@@ -228,7 +233,15 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                                                 settings.max_transparent_bounces);
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     const bool dual = settings.integrator == int(Integrator::DualScattering);
+    const bool dual_layer = settings.dual_hair_volume == int(DualHairVolume::Layer);
     bool from_dual_hair = false;  // the ray left a hair vertex shaded by dual scattering
+    struct {
+        const DualScattering *dual = nullptr;
+        FiberFrame frame;
+        float theta_o = 0;
+        int depth = -1;
+        Rgb beta;  // the path's throughput at that vertex
+    } dual_from;
     alpha = 1.0f;
 
     auto add = [&](Rgb contribution) {
@@ -241,13 +254,39 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
 
     // depth counts scattering vertices; a transparent crossing keeps it (and the camera ray).
     for (int depth = 0;;) {
-        const std::optional<Hit> hit = scene.intersect(origin, dir, tmin, tmax, skip);
-        ++counters.rays;
+        std::optional<Hit> hit;
+        bool through_hair = false;  // a dual continuation that crossed strands to a mesh
+        if (from_dual_hair && dual_layer) {
+            // Light meshes reflect onto the hair vertex through n ≥ 1 strands is the dual
+            // estimate's global term: T_f d_f (f_s^scatter + π d_b f_back^scatter) for the
+            // sampled direction, in place of f_s (lamps, suns and the world beyond hair are M's).
+            std::vector<StrandCrossing> &strands = counters.dual.continuation;
+            hit = scene.trace_through_hair(origin, dir, tmin, tmax, skip, {}, strands);
+            ++counters.rays;
+            if (!strands.empty()) {
+                const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, strands[0].t, bsdf_pdf, use_mis);
+                if (!is_black(lamps)) add(beta * lamps);
+                if (!hit || hit->prim.geometry == PrimRef::kNone) break;
+                const ForwardScattering forward =
+                    gather_forward_scattering(scene, strands.data(), strands.size(), dir, *dual_from.dual);
+                const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+                const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward,
+                                                  dual_from.depth);
+                beta = dual_from.beta * m / bsdf_pdf;
+                if (is_black(beta) || !finite(beta)) break;
+                through_hair = true;
+            }
+        } else {
+            hit = scene.intersect(origin, dir, tmin, tmax, skip);
+            ++counters.rays;
+        }
         const float t_end = hit ? hit->t : tmax;
 
         // Lamps are transparent: every one crossed before the surface contributes.
-        const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis);
-        if (!is_black(lamps)) add(beta * lamps);
+        if (!through_hair) {
+            const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis);
+            if (!is_black(lamps)) add(beta * lamps);
+        }
 
         if (!hit) {
             const bool transparent = depth == 0 && settings.film_transparent;
@@ -263,7 +302,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const Vec3 wo = -dir;
 
         // Surface emission (mesh triangles are light-sampled, curves are not).
-        if (const Rgb emission = material_emission(material); !is_black(emission)) {
+        if (const Rgb emission = material_emission(material); !is_black(emission) && !through_hair) {
             float w = 1.0f;
             if (use_mis && sp.is_light) {
                 const float abs_cos = std::fabs(dot(sp.normal, dir));
@@ -315,6 +354,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             v.bsdf = bsdf.hair();
             v.frame = bsdf.frame();
             v.wo = wo;
+            v.layer = dual_layer;
             const std::uint64_t before = counters.dual.rays;
             add(beta * dual_scattering_light(scene, v, dual_random(rng, depth), counters.dual));
             counters.shadow_rays += counters.dual.rays - before;
@@ -348,6 +388,13 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                          rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy))
             break;
         from_dual_hair = dual_vertex;
+        if (dual_vertex) {
+            dual_from.dual = hair_dual(material);
+            dual_from.frame = bsdf.frame();
+            dual_from.theta_o = std::asin(std::clamp(bsdf.frame().to_local(wo).x, -1.0f, 1.0f));
+            dual_from.depth = counters.dual.last_depth;
+            dual_from.beta = beta;
+        }
         if (bsdf.is_hair())
             last_segment = ++transmission_bounces > settings.max_transmission_bounces;
         else if (glossy)
@@ -387,7 +434,8 @@ Status validate(const RenderSettings &s) {
                        check::count_in_range("threads", s.threads, 0, 1024),
                        check::count_in_range("tile_size", s.tile_size, 1, 4096),
                        check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024),
-                       check::count_in_range("huang_sampling", s.huang_sampling, 0, 1));
+                       check::count_in_range("huang_sampling", s.huang_sampling, 0, 1),
+                       check::count_in_range("dual_hair_volume", s.dual_hair_volume, 0, 1));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.

@@ -93,6 +93,17 @@ enum class HuangSampling {
     Cycles = 1,
 };
 
+/// What the dual-scattering integrator takes the hair around a vertex to be.
+enum class DualHairVolume {
+    /// A layer over what is under it: the backscatter series (Ā_b) are cut at the strands a
+    /// probe finds behind the vertex, and light meshes reflect onto the vertex through n ≥ 1
+    /// strands is the global term (render/dual_scattering_integrator.h).
+    Layer = 0,
+    /// Zinke et al.'s semi-infinite hair volume: Ā_b unbounded, and the continuation ends at
+    /// hair (mesh light reaches a hair vertex only where no strand is in the way).
+    Unbounded = 1,
+};
+
 /// How Max Bounces: Transparent limits a path's transparent crossings, as each Cycles stores
 /// the setting.
 enum class TransparentLimit {
@@ -146,6 +157,8 @@ struct RenderSettings {
     bool film_transparent = false;
     /// A HuangSampling: how Huang hair samples directions.
     int huang_sampling = int(HuangSampling::Strategy);
+    /// A DualHairVolume for integrator=dual_scattering: "layer" or "unbounded".
+    int dual_hair_volume = int(DualHairVolume::Layer);
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -165,6 +178,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("rr_start_bounce", s.rr_start_bounce, 1, 1024);
     f.field("film_transparent", s.film_transparent);
     f.choice("huang_sampling", s.huang_sampling, {"strategy", "cycles"});
+    f.choice("dual_hair_volume", s.dual_hair_volume, {"layer", "unbounded"});
 }
 
 /// What a render did.

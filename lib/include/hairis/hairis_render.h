@@ -191,7 +191,9 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
  * called on the calling thread. integrator=dual_scattering shades hair by dual scattering
  * (lib/render/dual_scattering_integrator.h) and needs every hair material's tables
- * (HAIRIS_ERROR_INVALID_TABLE naming the material otherwise). A scene without camera or
+ * (HAIRIS_ERROR_INVALID_TABLE naming the material otherwise); its dual_hair_volume = layer
+ * (default: the hair is a layer over what is under it, whose light reaches hair through the
+ * strands) | unbounded (Zinke et al.'s semi-infinite hair volume). A scene without camera or
  * geometry is refused. Each call builds the scene anew, so
  * a scene can be rendered again with other settings, also from several threads at once.
  */
