@@ -5,7 +5,8 @@
 //     blonde, brunette and black Principled Hair at two roughnesses, and the efficiency
 //     1 / (variance × time per sample+pdf).
 //  2. Far field (h-averaged f, what the 2D tables tabulate) for the Cycles-default fiber.
-//  3. Multiple scattering: the same estimate of ∫ F_multiple cos dω_i at n_h ∈ {1, 2, 4, 8, 16}.
+//  3. Multiple scattering: the same estimate of ∫ F_multiple cos dω_i at n_h ∈ {1, 2, 4, 8, 16},
+//     and the multiple table sampling the layer's term (Ā_b cut at 1, 2, 4 strands behind).
 //  4. Resolution sweeps: near-field table (θ_o nodes × θ_i cells) and far-field tables
 //     (θ_r × θ_i × φ), variance against memory.
 //
@@ -284,6 +285,42 @@ int main(int argc, char **argv) {
         }
         json << "}";
         out.section("multiple_median", json.str());
+
+        // The layer (dual_hair_volume=layer) cuts Ā_b at the strands behind the vertex: the same
+        // baked table (the unbounded term's) then samples a term it was not baked for.
+        print(out, "\nThe multiple table (baked for the unbounded term) sampling the layer's term, Ā_b cut at "
+                   "`depth` strands behind:\n\n| depth | n_h = 1 | 2 | 4 | 8 | 16 |\n|---|---|---|---|---|---|\n");
+        StrategyInputs in;
+        in.tables = &cycles_default.sampling;
+        in.multiple_weight = 1.0f;
+        std::ostringstream layer_json;
+        layer_json << "{";
+        const int depths[] = {1, 2, 4, -1};
+        for (int d = 0; d < 4; ++d) {
+            const int depth = depths[d];
+            print(out, "| %s |", depth < 0 ? "unbounded" : std::to_string(depth).c_str());
+            std::vector<double> row;
+            for (int n_h : n_h_values) {
+                in.n_h = n_h;
+                const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(StrategyKind::Table, in).value(), cycles_default.fiber);
+                std::vector<double> v;
+                for (double t : kThetaR) {
+                    const Vec3 wo = direction_of(float(radians(t)), -float(kHalfPi));
+                    v.push_back(relative_variance(*sampler, wo, std::max(1000LL, n / 5), [&](Vec3 wi, float) {
+                        const float theta_i = safe_asin(wi.x);
+                        return double(luminance(dual.scattered_f_cos(theta_i, float(radians(t)),
+                                                                     dual.forward_transmittance(theta_i, n_h),
+                                                                     dual.forward_spread_variance(theta_i, n_h), depth)));
+                    }));
+                }
+                row.push_back(median(v));
+                print(out, " %.3g |", row.back());
+            }
+            print(out, "\n");
+            layer_json << (d ? ", " : "") << "\"" << depth << "\": " << json_list(row);
+        }
+        layer_json << "}";
+        out.section("multiple_layer_median", layer_json.str());
     }
 
     // ---- 4. Resolution sweeps -------------------------------------------------------------------

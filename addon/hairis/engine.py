@@ -89,6 +89,7 @@ def render_settings(settings):
             "transparent_limit": compat.transparent_limit(),
             "strategy": settings.strategy.lower(),
             "huang_sampling": settings.huang_sampling.lower(),
+            "dual_hair_volume": settings.dual_hair_volume.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces()}

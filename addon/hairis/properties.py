@@ -20,7 +20,8 @@ INTEGRATOR_ITEMS = (
     ("DUAL_SCATTERING", "Dual Scattering (Experimental)",
      "Zinke et al. 2008: light reaching hair through other strands in closed form from shadow "
      "rays that count the strands, multiple scattering sampled from the baked tables (needs "
-     "baked tables). Experimental: biased, renders dense hair brighter than Cycles", 1),
+     "baked tables). Experimental: biased (within about 6% of path tracing on the study's "
+     "hair over a head)", 1),
 )
 """Values match the C API's ``integrator`` (path | dual_scattering)."""
 
@@ -42,6 +43,16 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     integrator: EnumProperty(
         name="Integrator", description="How light reaching hair is computed",
         items=INTEGRATOR_ITEMS, default="PATH")
+    dual_hair_volume: EnumProperty(
+        name="Hair Volume",
+        description="What Dual Scattering takes the hair around a point to be",
+        items=(("LAYER", "Layer",
+                "A layer over what is under it: light scattered back from the strands behind "
+                "the point only, and the head's light reaching hair through strands", 0),
+               ("UNBOUNDED", "Unbounded",
+                "Zinke et al.'s semi-infinite hair volume (too bright and too red on light hair "
+                "over a head)", 1)),
+        default="LAYER")
     max_transparent_bounces: IntProperty(
         name="Transparent Max Bounces",
         description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "

@@ -137,6 +137,9 @@ class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
         settings = context.scene.hairis
         column = layout.column()
         column.prop(settings, "integrator")
+        sub = column.column()
+        sub.active = settings.integrator == "DUAL_SCATTERING"
+        sub.prop(settings, "dual_hair_volume")
         column.prop(settings, "samples")
         column.prop(settings, "seed")
         column.prop(settings, "max_bounces")

@@ -153,13 +153,14 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                 const ForwardScattering forward =
                     gather_forward_scattering(scene, crossings->data(), crossings->size(), ls->wi, dual);
                 Rgb sum;
+                const float pdf_table = multiple_table_pdf(table, strand, v.frame, wo_local, ls->wi);
                 if (forward.strands == 0) {
                     float pdf_bsdf = 0.0f;
                     const Rgb f = v.bsdf->f_and_pdf(l, pdf_bsdf);
+                    if (v.layer) pdf_bsdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
                 const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth);
-                const float pdf_table = multiple_table_pdf(table, strand, v.frame, wo_local, ls->wi);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
             }

@@ -125,8 +125,9 @@ struct DualVertex {
     const HairBsdf *bsdf = nullptr;          ///< the material's fiber and sampler at this hit
     FiberFrame frame;                        ///< the fiber frame the BSDF was prepared in
     Vec3 wo;                                 ///< unit, towards the viewer
-    /// DualHairVolume::Layer: Ā_b cut at the strands behind the vertex (below); false: the
-    /// paper's unbounded series.
+    /// DualHairVolume::Layer: Ā_b cut at the strands behind the vertex, and the continuation
+    /// drawn from dual_mixture_pdf (D's light samples MIS against it); false: the paper's
+    /// unbounded series and the material's sampler.
     bool layer = false;
 };
 
@@ -138,6 +139,13 @@ struct DualWork {
     int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
     int last_strand_index = -1;   ///< the index into the table's n_h values it chose
 };
+
+/// The share of the material's sampler in a layer vertex's continuation (DualVertex::layer),
+/// the rest the multiple table's, and the mixture's density.
+constexpr float kDualMixture = 0.5f;
+inline float dual_mixture_pdf(float pdf_bsdf, float pdf_table) {
+    return kDualMixture * pdf_bsdf + (1.0f - kDualMixture) * pdf_table;
+}
 
 /// The radiance the vertex sends towards ω_o from emitters by dual scattering (light and
 /// multiple-table samples, MIS-weighted as described above; the continuation's share is the

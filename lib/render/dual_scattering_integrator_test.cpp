@@ -648,6 +648,42 @@ TEST(DualScatteringRender, AreaLightMultipleScatteringMisMatchesQuadrature) {
         EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 3e-3 * want[ch]) << "ch " << ch;
 }
 
+TEST(DualScatteringRender, ALoneHairUnderAnAreaLightIsSingleScatteringInALayer) {
+    // Nothing behind the hair and nothing between it and the light: a layer's M is 0, and D
+    // (light samples and the continuation's mixture, power heuristic over the mixture's
+    // density) must equal the path tracer's single scattering, sample for sample in the mean.
+    SceneDesc d = single_hair();
+    AreaLight a;
+    a.light_to_world = Mat4::translation({0.3f, 0, 1});
+    a.shape = AreaShape::Rectangle;
+    a.size_x = 1.5f;
+    a.size_y = 1.0f;
+    a.power = 20.0f;
+    d.area_lights = {a};
+    const Scene scene = build(std::move(d));
+    const RenderSettings dual = dual_settings(0, DualHairVolume::Layer);
+    RenderSettings path = dual;
+    path.integrator = int(Integrator::Path);
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0}, level[3] = {0, 0, 0};
+    const int n = 40000;
+    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+        const Rgb x = render_sample(scene, dual, 0, 0, i), y = render_sample(scene, path, 0, 0, i);
+        for (int ch = 0; ch < 3; ++ch) {
+            const double v = double(x[ch]) - double(y[ch]);
+            sum[ch] += v;
+            sum2[ch] += v * v;
+            level[ch] += y[ch];
+        }
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        const double mean = sum[ch] / n, sigma = std::sqrt(std::max(0.0, sum2[ch] / n - mean * mean) / n);
+        ASSERT_GT(level[ch] / n, 0.0);
+        EXPECT_NEAR(mean, 0.0, 5.0 * sigma) << "ch " << ch;
+        EXPECT_LT(5.0 * sigma, 0.02 * level[ch] / n) << "resolves 2% of D, ch " << ch;
+    }
+}
+
+
 // A tuft of wavy hairs standing on the XY plane: `count` curves of `points` points.
 HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
     std::uint32_t state = seed;

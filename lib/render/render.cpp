@@ -384,9 +384,35 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         Rgb weight;
         float pdf = 0.0f;
         bool glossy = false;
-        if (!bsdf.sample(rng.get(dim(depth, kDimBsdf0)), rng.get(dim(depth, kDimBsdf1)),
-                         rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy))
+        if (dual_vertex && dual_layer) {
+            // A layer's continuation also carries the light meshes send through strands, the
+            // multiple term's: a one-sample mixture of the material's sampler and the vertex's
+            // multiple table (DualVertex::layer; its light samples MIS against the same).
+            const float u0 = rng.get(dim(depth, kDimBsdf0)), u1 = rng.get(dim(depth, kDimBsdf1)),
+                        u2 = rng.get(dim(depth, kDimBsdf2));
+            const MultipleTable &table = *hair->multiple;
+            const int strand = counters.dual.last_strand_index;
+            const Vec3 wo_local = bsdf.frame().to_local(wo);
+            float pdf_bsdf = 0.0f, pdf_table = 0.0f;
+            Rgb f_cos;
+            if (rng.get(kDimDualFirst + std::uint32_t(depth) * kDimsPerVertex + 6) < kDualMixture) {
+                if (!bsdf.sample(u0, u1, u2, wi, weight, pdf_bsdf, glossy)) break;
+                f_cos = weight * pdf_bsdf;
+                pdf_table = multiple_table_pdf(table, strand, bsdf.frame(), wo_local, wi);
+            } else {
+                const MultipleTableSample t = sample_multiple_table(table, strand, bsdf.frame(), wo_local, u0, u1, u2);
+                if (!(t.pdf > 0.0f)) break;
+                wi = t.wi;
+                pdf_table = t.pdf;
+                f_cos = bsdf.eval(wi, pdf_bsdf);
+            }
+            pdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
+            if (!(pdf > 0.0f)) break;
+            weight = f_cos / pdf;
+        } else if (!bsdf.sample(rng.get(dim(depth, kDimBsdf0)), rng.get(dim(depth, kDimBsdf1)),
+                                rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy)) {
             break;
+        }
         from_dual_hair = dual_vertex;
         if (dual_vertex) {
             dual_from.dual = hair_dual(material);
