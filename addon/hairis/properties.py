@@ -63,13 +63,17 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
         items=STRATEGY_ITEMS, default="TABLE")
     huang_sampling: EnumProperty(
         name="Huang Sampling",
-        description="How Huang hair is sampled",
+        description="How Huang hair is sampled. Cycles (the default) renders what Cycles "
+                    "renders, and at equal time with less noise than the strategy's tables "
+                    "(bench/results/bpy45/render_study_huang.md)",
         items=(("STRATEGY", "Strategy",
-                "The strategy above, with its exact density (converges to Cycles' Huang eval)", 0),
+                "The strategy above, with its exact density (converges to Cycles' Huang eval, "
+                "about 1% from Cycles' image; noisier in renders: Cycles' eval, which weights "
+                "every sample, is itself a noisy estimate)", 0),
                ("CYCLES", "Cycles",
                 "Cycles' own Huang sampler with its weight and pdf 1 for MIS (converges to what "
                 "Cycles renders, which mixes that sampler with its eval)", 1)),
-        default="STRATEGY")
+        default="CYCLES")
     multiple_weight: FloatProperty(
         name="Multiple Weight",
         description="One-sample mixture weight of the multiple-scattering distribution "

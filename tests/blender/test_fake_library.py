@@ -360,6 +360,9 @@ def test_huang_material_by_bake_and_render():
     assert status.tables.info.get("huang_theta_o") == "24", status.tables.info
     status.tables.close()
     _pixels, summary = render(scene)
+    assert summary_value(summary, "huang_sampling") == "1", summary  # Cycles', the default
+    scene.hairis.huang_sampling = "STRATEGY"
+    _pixels, summary = render(scene)
     assert summary_value(summary, "huang_sampling") == "0", summary
     assert re.search(r"hair \d+ tables=1 huang=1 ", summary), summary
     assert summary.count("tables=1") == 2, summary
