@@ -184,7 +184,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         float t_lo = 0.0f;
         for (std::size_t k = 0; k <= work.table.size(); ++k) {
             const float t_hi = k < work.table.size() ? work.table[k].t : t_end;
-            const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true);
+            const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true, sp.position);
             if (!is_black(lamps))
                 out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * lamps * inv_pdf;
             if (k < work.table.size()) add_crossing(forward, scene, work.table[k], wi, dual);
@@ -192,17 +192,17 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         }
         Rgb arriving;
         if (!mesh) {
-            arriving = lights.escaped(wi, s.pdf, true, true);
+            arriving = lights.escaped(sp.position, wi, s.pdf, true, true);
         } else if (mesh->prim.geometry != PrimRef::kNone) {
             const SurfacePoint hit = scene.surface_point(origin, wi, *mesh);
-            if (const auto *d = std::get_if<DiffuseMaterial>(&scene.materials()[hit.material]))
-                if (!is_black(d->emission)) {
-                    const float w = hit.is_light
-                                        ? power_heuristic(s.pdf, lights.emissive_triangle_pdf(
-                                                                     mesh->t, std::fabs(dot(hit.normal, wi))))
-                                        : 1.0f;
-                    arriving = d->emission * w;
-                }
+            const Rgb emission = material_emission(scene.materials()[hit.material]);
+            if (!is_black(emission)) {
+                const float w = hit.is_light
+                                    ? power_heuristic(s.pdf, lights.emissive_triangle_pdf(
+                                                                 mesh->t, std::fabs(dot(hit.normal, wi))))
+                                    : 1.0f;
+                arriving = emission * w;
+            }
         }
         if (!is_black(arriving))
             out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * arriving * inv_pdf;

@@ -241,6 +241,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.cycles = s.cycles;
         lamp.value = cycles_light::strength(s.color, s.strength);
         lamp.direction = safe_normalize(s.to_sun);
+        lamp.importance = luminance(cycles_light::strength(s.color, s.strength));
         lamp.radius = std::tan(0.5f * s.angle);
         lamp.cos_half = std::cos(0.5f * s.angle);
         lamp.invarea = cycles_light::sun_invarea(s.angle);
@@ -271,6 +272,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.invarea = cycles_light::point_invarea(p.radius);
         lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
                                      : cycles_light::point_intensity(p.color, p.power);
+        lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
         set.lamps_.push_back(lamp);
     }
 
@@ -306,6 +308,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.invarea = cycles_light::point_invarea(p.radius);
         lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
                                      : cycles_light::point_intensity(p.color, p.power);
+        lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
         lamp.cos_half = std::cos(0.5f * p.spot_size);
         lamp.smooth = (1.0f - lamp.cos_half) * p.spot_blend;
         set.lamps_.push_back(lamp);
@@ -350,6 +353,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
                                1e-5f * length(lamp.axis_u) * length(lamp.axis_v);
         lamp.invarea = 1.0f / area;
         lamp.value = cycles_light::area_radiance(a.color, a.power, area, a.cycles);
+        lamp.importance = luminance(lamp.value) * area;  // its intensity along the normal
         set.lamps_.push_back(lamp);
     }
 
@@ -366,6 +370,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         if (set.environment_sampled_) {
             Lamp lamp;
             lamp.type = LampType::Environment;
+            lamp.importance = float(world.environment->luminance_integral() / 4.0);  // πL̄
             set.lamps_.push_back(lamp);
         }
     } else {
@@ -393,6 +398,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
     const bool has_lamps = !set.lamps_.empty(), has_triangles = !set.triangles_.empty();
     set.triangle_pick_ = has_triangles ? (has_lamps ? 0.5f : 1.0f) : 0.0f;
     set.lamp_pick_ = has_lamps ? (1.0f - set.triangle_pick_) / float(set.lamps_.size()) : 0.0f;
+    set.by_importance_ = set.lamps_.size() > 1 && set.lamps_.size() <= kMaxImportanceLamps;
     return set;
 }
 
@@ -405,23 +411,73 @@ std::optional<LightSample> LightSet::sample(Vec3 p, float u_select, float u0, fl
         u = 2.0f * (u - 0.5f);
     }
     const int n = int(lamps_.size());
-    const int i = std::min(int(u * float(n)), n - 1);
-    return sample_lamp(lamps_[std::size_t(i)], p, u0, u1);
+    if (!by_importance_) {
+        const int i = std::min(int(u * float(n)), n - 1);
+        return sample_lamp(lamps_[std::size_t(i)], p, u0, u1, lamp_pick_);
+    }
+    const float total = importance_total(p);
+    float cumulative = 0.0f;
+    for (int i = 0; i < n; ++i) {
+        const Lamp &lamp = lamps_[std::size_t(i)];
+        const float share = lamp_share(lamp, p, total);
+        cumulative += share;
+        if (u < cumulative || i == n - 1) return sample_lamp(lamp, p, u0, u1, (1.0f - triangle_pick_) * share);
+    }
+    return std::nullopt;
+}
+
+float LightSet::importance_at(const Lamp &lamp, Vec3 p) {
+    switch (lamp.type) {
+        case LampType::Point:
+        case LampType::Spot: {
+            const Vec3 d = p - lamp.position;
+            return lamp.importance / std::max({dot(d, d), lamp.radius * lamp.radius, 1e-12f});
+        }
+        case LampType::Area: {
+            const Vec3 d = p - lamp.position;
+            const float d2 = dot(d, d), area = 1.0f / lamp.invarea;
+            if (d2 <= area) return lamp.importance / area;  // close: much of it faces p
+            return lamp.importance * std::max(0.0f, dot(d, lamp.direction)) / (d2 * std::sqrt(d2));
+        }
+        case LampType::Sun:
+        case LampType::Environment: return lamp.importance;
+    }
+    return 0.0f;
+}
+
+float LightSet::importance_total(Vec3 p) const {
+    float total = 0.0f;
+    for (const Lamp &lamp : lamps_) total += importance_at(lamp, p);
+    return total;
+}
+
+float LightSet::lamp_share(const Lamp &lamp, Vec3 p, float total) const {
+    const float uniform = 1.0f / float(lamps_.size());
+    if (!(total > 0.0f) || !std::isfinite(total)) return uniform;
+    return kUniformShare * uniform + (1.0f - kUniformShare) * importance_at(lamp, p) / total;
+}
+
+float LightSet::lamp_pick(const Lamp &lamp, Vec3 p, float total) const {
+    return by_importance_ ? (1.0f - triangle_pick_) * lamp_share(lamp, p, total) : lamp_pick_;
+}
+
+float LightSet::lamp_selection_probability(Vec3 p, std::size_t i) const {
+    return i < lamps_.size() ? lamp_pick(lamps_[i], p, by_importance_ ? importance_total(p) : 0.0f) : 0.0f;
 }
 
 std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float u0,
-                                                 float u1) const {
+                                                 float u1, float pick) const {
     LightSample s;
     switch (lamp.type) {
         case LampType::Point:
-        case LampType::Spot: return sample_point_like(lamp, p, u0, u1);
+        case LampType::Spot: return sample_point_like(lamp, p, u0, u1, pick);
         case LampType::Environment: {
             const EnvironmentSample e = environment_->sample(u0, u1);
             if (!(e.pdf > 0.0f) || is_black(e.radiance)) return std::nullopt;
             s.wi = e.wi;
             s.distance = INFINITY;
             s.value = e.radiance;
-            s.pdf = lamp_pick_ * e.pdf;
+            s.pdf = pick * e.pdf;
             return s;
         }
         case LampType::Area: {
@@ -438,7 +494,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
                 if (!(-dot(lamp.direction, s.wi) > 0.0f)) return std::nullopt;
                 s.distance = t;
                 s.value = lamp.value;
-                s.pdf = lamp_pick_ / rect.solid_angle();
+                s.pdf = pick / rect.solid_angle();
                 return s;
             }
             Vec3 q;
@@ -457,7 +513,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
             if (!(cos_light > 0.0f)) return std::nullopt;
             s.distance = t;
             s.value = lamp.value;
-            s.pdf = lamp_pick_ * lamp.invarea * t * t / cos_light;
+            s.pdf = pick * lamp.invarea * t * t / cos_light;
             return s;
         }
         case LampType::Sun: {
@@ -465,7 +521,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
             if (lamp.radius == 0.0f) {
                 s.wi = lamp.direction;
                 s.value = lamp.value;
-                s.pdf = lamp_pick_;
+                s.pdf = pick;
                 s.delta = true;
                 return s;
             }
@@ -474,7 +530,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
                 s.wi = cone_direction(lamp.direction, 1.0f - u0 * lamp.one_minus_cos_half, u1);
                 if (!(dot(s.wi, lamp.direction) >= lamp.cos_half)) return std::nullopt;
                 s.value = lamp.value;
-                s.pdf = lamp_pick_ / (2.0f * kPiF * lamp.one_minus_cos_half);
+                s.pdf = pick / (2.0f * kPiF * lamp.one_minus_cos_half);
                 return s;
             }
             Vec3 a, b;
@@ -486,7 +542,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
             if (!(c > 0.0f)) return std::nullopt;
             const float pdf = lamp.invarea / (c * c * c);
             s.value = lamp.value * pdf;
-            s.pdf = lamp_pick_ * pdf;
+            s.pdf = pick * pdf;
             return s;
         }
     }
@@ -520,7 +576,7 @@ Rgb LightSet::point_like_value(const Lamp &lamp, Vec3 p, Vec3 wi) const {
 }
 
 std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p, float u0,
-                                                       float u1) const {
+                                                       float u1, float pick) const {
     LightSample s;
     const Vec3 to_p = p - lamp.position;
     const float d2 = dot(to_p, to_p);
@@ -530,7 +586,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
         s.wi = -to_p / s.distance;
         s.value = point_like_value(lamp, p, s.wi) / d2;
         if (is_black(s.value)) return std::nullopt;
-        s.pdf = lamp_pick_;
+        s.pdf = pick;
         s.delta = true;
         return s;
     }
@@ -553,7 +609,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
         if (!(s.distance > 0.0f)) return std::nullopt;
         s.value = point_like_value(lamp, p, s.wi);
         if (is_black(s.value)) return std::nullopt;
-        s.pdf = lamp_pick_ * sphere_pdf(d2, r2);
+        s.pdf = pick * sphere_pdf(d2, r2);
         return s;
     }
     Vec3 a, b;
@@ -570,7 +626,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
     s.distance = t;
     s.value = point_like_value(lamp, p, s.wi);
     if (is_black(s.value)) return std::nullopt;
-    s.pdf = lamp_pick_ * lamp.invarea * t * t / cos_light;
+    s.pdf = pick * lamp.invarea * t * t / cos_light;
     return s;
 }
 
@@ -608,9 +664,11 @@ float LightSet::emissive_triangle_pdf(float t, float abs_cos) const {
 }
 
 template <typename Visit>
-void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax,
+void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, Vec3 from,
                                      Visit &&visit) const {
+    const float total = by_importance_ ? importance_total(from) : 0.0f;
     for (const Lamp &lamp : lamps_) {
+        const float pick = lamp_pick(lamp, from, total);
         if (lamp.type == LampType::Point || lamp.type == LampType::Spot) {
             if (lamp.radius == 0.0f) continue;
             const Vec3 to_origin = origin - lamp.position;
@@ -627,7 +685,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
                 const float t = d2 > r2 ? b - half_chord : b + half_chord;
                 if (!(t > tmin && t < tmax)) continue;
                 const Rgb value = point_like_value(lamp, origin, dir);
-                if (!is_black(value)) visit(value, lamp_pick_ * sphere_pdf(d2, r2));
+                if (!is_black(value)) visit(value, pick * sphere_pdf(d2, r2));
                 continue;
             }
             const Vec3 n = safe_normalize(to_origin);
@@ -638,7 +696,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
             const Vec3 q = origin + dir * t - lamp.position;
             if (dot(q, q) > lamp.radius * lamp.radius) continue;
             const Rgb value = point_like_value(lamp, origin, dir);
-            if (!is_black(value)) visit(value, lamp_pick_ * lamp.invarea * t * t / -denom);
+            if (!is_black(value)) visit(value, pick * lamp.invarea * t * t / -denom);
         } else if (lamp.type == LampType::Area) {
             const float denom = dot(dir, lamp.direction);
             if (!(denom < 0.0f)) continue;  // one-sided
@@ -655,9 +713,9 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
                 const SphericalRectangle rect(origin,
                                               lamp.position - (lamp.axis_u + lamp.axis_v) * 0.5f,
                                               lamp.axis_u, lamp.axis_v);
-                light_pdf = rect.solid_angle() > 0.0f ? lamp_pick_ / rect.solid_angle() : 0.0f;
+                light_pdf = rect.solid_angle() > 0.0f ? pick / rect.solid_angle() : 0.0f;
             } else {
-                light_pdf = lamp_pick_ * lamp.invarea * t * t / -denom;
+                light_pdf = pick * lamp.invarea * t * t / -denom;
             }
             visit(lamp.value, light_pdf);
         }
@@ -665,33 +723,35 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
 }
 
 template <typename Visit>
-void LightSet::visit_escaped(Vec3 dir, Visit &&visit) const {
+void LightSet::visit_escaped(Vec3 origin, Vec3 dir, Visit &&visit) const {
+    const float total = by_importance_ ? importance_total(origin) : 0.0f;
     for (const Lamp &lamp : lamps_) {
         if (lamp.type != LampType::Sun || lamp.radius == 0.0f) continue;
+        const float pick = lamp_pick(lamp, origin, total);
         if (lamp.cycles == CyclesVersion::V4_5) {
             if (!(dot(dir, lamp.direction) >= lamp.cos_half)) continue;
-            visit(lamp.value, lamp_pick_ / (2.0f * kPiF * lamp.one_minus_cos_half));
+            visit(lamp.value, pick / (2.0f * kPiF * lamp.one_minus_cos_half));
             continue;
         }
         const float c = dot(dir, lamp.direction);
         if (!(c >= lamp.cos_half) || !(c > 0.0f)) continue;
         const float pdf = lamp.invarea / (c * c * c);
-        visit(lamp.value * pdf, lamp_pick_ * pdf);
+        visit(lamp.value * pdf, pick * pdf);
     }
 }
 
 Rgb LightSet::lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, float bsdf_pdf,
-                              bool use_mis) const {
+                              bool use_mis, std::optional<Vec3> from) const {
     Rgb sum;
-    visit_lamps_along_ray(origin, dir, tmin, tmax, [&](Rgb value, float light_pdf) {
+    visit_lamps_along_ray(origin, dir, tmin, tmax, from.value_or(origin), [&](Rgb value, float light_pdf) {
         sum += value * (use_mis ? power_heuristic(bsdf_pdf, light_pdf) : 1.0f);
     });
     return sum;
 }
 
-Rgb LightSet::escaped(Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world) const {
+Rgb LightSet::escaped(Vec3 origin, Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world) const {
     Rgb sum;
-    visit_escaped(dir, [&](Rgb value, float light_pdf) {
+    visit_escaped(origin, dir, [&](Rgb value, float light_pdf) {
         sum += value * (use_mis ? power_heuristic(bsdf_pdf, light_pdf) : 1.0f);
     });
     if (!include_world) return sum;
@@ -699,17 +759,23 @@ Rgb LightSet::escaped(Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world
     const Rgb radiance = environment_->eval(dir);
     if (is_black(radiance)) return sum;
     const float w = use_mis && environment_sampled_
-                        ? power_heuristic(bsdf_pdf, lamp_pick_ * environment_->pdf(dir))
+                        ? power_heuristic(bsdf_pdf, world_pdf(origin, dir))
                         : 1.0f;
     return sum + radiance * w;
+}
+
+float LightSet::world_pdf(Vec3 p, Vec3 dir) const {
+    if (!environment_sampled_) return 0.0f;
+    const Lamp &lamp = lamps_.back();  // the environment is the last lamp
+    return lamp_pick(lamp, p, by_importance_ ? importance_total(p) : 0.0f) * environment_->pdf(dir);
 }
 
 float LightSet::pdf(Vec3 p, Vec3 wi) const {
     float total = 0.0f;
     auto add = [&](Rgb, float light_pdf) { total += light_pdf; };
-    visit_lamps_along_ray(p, wi, 0.0f, INFINITY, add);
-    visit_escaped(wi, add);
-    if (environment_sampled_) total += lamp_pick_ * environment_->pdf(wi);
+    visit_lamps_along_ray(p, wi, 0.0f, INFINITY, p, add);
+    visit_escaped(p, wi, add);
+    total += world_pdf(p, wi);
     // Emissive triangles that the ray crosses (Möller and Trumbore).
     for (const EmissiveTriangle &tri : triangles_) {
         const Vec3 e1 = tri.p1 - tri.p0, e2 = tri.p2 - tri.p0;

@@ -63,11 +63,15 @@
 //    * Emissive triangles (a mesh material with emission): radiance = the emission colour,
 //      on both sides (Cycles' emissive closure uses |cos|).
 //
-// Light selection: like Cycles 3.4's light distribution (scene/light.cpp,
-// device_update_distribution), which Cycles 4.x uses too with the Light Tree off: emissive
-// triangles as a group get probability 1/2 when there are also lamps (sun, point, spot, area,
-// environment world), otherwise all of it; a triangle within the group is chosen in proportion
-// to its area; lamps share the rest uniformly (not by power). The world is one lamp among them
+// Light selection: emissive triangles as a group get probability 1/2 when there are also
+// lamps (sun, point, spot, area, environment world), otherwise all of it, as in Cycles 3.4's
+// light distribution (scene/light.cpp, device_update_distribution); a triangle within the
+// group is chosen in proportion to its area. Lamps share the rest by their importance at the
+// shading point, an estimate of the unshadowed irradiance each brings there (importance_at),
+// as Cycles 4.x's light tree (its default) does, with a tenth of it shared uniformly so that
+// no lamp that reaches the point goes unchosen. One lamp, or more than 64, are chosen
+// uniformly (3.4's distribution). Selection changes only the noise: every density is exact.
+// The world is one lamp among them
 // when it is an Environment Texture whose Sampling is not None (Cycles' background light):
 // directions from its importance map (environment_map.h) with their exact density, and rays
 // that escape weighted against it by the power heuristic. Like Cycles, which disables the
@@ -267,12 +271,11 @@ class LightSet {
     /// True when the world is an environment sampled as a lamp.
     bool world_light_sampled() const { return environment_sampled_; }
     /// The light-sampling density (solid angle, with selection) of the world in direction
-    /// dir: 0 unless world_light_sampled().
-    float world_pdf(Vec3 dir) const {
-        return environment_sampled_ ? lamp_pick_ * environment_->pdf(dir) : 0.0f;
-    }
-    /// The probability of choosing lamp i, and of choosing the emissive-triangle group.
-    float lamp_selection_probability() const { return lamp_pick_; }
+    /// dir, seen from p: 0 unless world_light_sampled().
+    float world_pdf(Vec3 p, Vec3 dir) const;
+    /// The probability of choosing lamp i at p (0 for i past the lamps), and of choosing the
+    /// emissive-triangle group.
+    float lamp_selection_probability(Vec3 p, std::size_t i) const;
     float triangle_group_probability() const { return triangle_pick_; }
 
     /// Chooses a light with u_select and samples a point or direction on it from (u0, u1), as
@@ -284,13 +287,17 @@ class LightSet {
     /// crosses (point-light disks and area lights, which are transparent to rays as in Cycles)
     /// between tmin and tmax, combined with the BSDF density bsdf_pdf by the power heuristic:
     /// returns Σ L·w. With use_mis false (camera rays, or after a delta BSDF) w = 1.
+    /// `from`: the shading point the ray left, where its light sample was drawn (the lamps'
+    /// selection probabilities are taken there); the origin when not given.
     Rgb lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, float bsdf_pdf,
-                        bool use_mis) const;
+                        bool use_mis, std::optional<Vec3> from = std::nullopt) const;
     /// Radiance reaching a ray that escapes the scene in direction dir: suns whose disc
     /// contains dir and the world, each weighted by MIS against bsdf_pdf (when use_mis; a
     /// world that is not light-sampled takes weight 1).
     /// include_world false leaves the world out (transparent film for camera rays).
-    Rgb escaped(Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world = true) const;
+    /// `from`: the shading point the ray left (the lamps' selection probabilities are taken
+    /// there).
+    Rgb escaped(Vec3 from, Vec3 dir, float bsdf_pdf, bool use_mis, bool include_world = true) const;
     /// The density with which sample() draws the unit direction wi from p (solid angle, with
     /// the selection probabilities): the sum over every lamp and emissive triangle that wi
     /// reaches, as if nothing blocked it; delta lights have none. Directions that sample()
@@ -318,6 +325,7 @@ class LightSet {
         float cos_half = 1; // sun: cos(angle/2); spot: cos(spot_size/2)
         float one_minus_cos_half = 0;  // sun (4.5): 1 − cos(angle/2), computed stably
         float smooth = 0;   // spot: (1 − cos_half)·blend
+        float importance = 0;  // luminance: sun E, point and spot I, area L·A, environment πL̄
         float world_to_light[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // spot (4.5): M⁻¹
         bool sphere = false;// point, spot (4.5 without soft falloff): a sphere of radius r
         bool round = false; // area: disk or ellipse
@@ -335,19 +343,32 @@ class LightSet {
     // Calls visit(radiance, light-sampling density with selection) for every lamp the ray
     // crosses in (tmin, tmax), and for every sun whose disc an escaping ray meets.
     template <typename Visit>
-    void visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, Visit &&visit) const;
+    void visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, Vec3 from, Visit &&visit) const;
     template <typename Visit>
-    void visit_escaped(Vec3 dir, Visit &&visit) const;
-    std::optional<LightSample> sample_lamp(const Lamp &lamp, Vec3 p, float u0, float u1) const;
-    std::optional<LightSample> sample_point_like(const Lamp &lamp, Vec3 p, float u0,
-                                                 float u1) const;
+    void visit_escaped(Vec3 origin, Vec3 dir, Visit &&visit) const;
+    // `pick`: the lamp's selection probability at p.
+    std::optional<LightSample> sample_lamp(const Lamp &lamp, Vec3 p, float u0, float u1, float pick) const;
+    std::optional<LightSample> sample_point_like(const Lamp &lamp, Vec3 p, float u0, float u1,
+                                                 float pick) const;
+    // Selection by importance: a lamp's estimate of the irradiance it brings to p, unshadowed
+    // (sun: E; point, spot: I/max(d², r²); area: L·A·max(cos, 0)/d², or L where p is within
+    // √area of it; environment: πL̄ = ∫L dω/4), their sum over the lamps, and the lamp's share
+    // of the lamps' probability: kUniformShare uniform, the rest by importance.
+    static float importance_at(const Lamp &lamp, Vec3 p);
+    float importance_total(Vec3 p) const;
+    float lamp_share(const Lamp &lamp, Vec3 p, float total) const;
+    // The lamp's selection probability at p (with importance_total(p) as `total`).
+    float lamp_pick(const Lamp &lamp, Vec3 p, float total) const;
+    static constexpr float kUniformShare = 0.1f;
+    static constexpr std::size_t kMaxImportanceLamps = 64;  // more: uniform (O(n) per query)
     std::optional<LightSample> sample_triangle(Vec3 p, float u_select, float u0, float u1) const;
 
     std::vector<Lamp> lamps_;
     std::vector<EmissiveTriangle> triangles_;
     std::vector<float> triangle_cdf_;  // size n + 1, normalised
     float triangle_area_ = 0;
-    float lamp_pick_ = 0;      // probability of each lamp
+    float lamp_pick_ = 0;      // probability of each lamp when selection is uniform
+    bool by_importance_ = false;  // 2..kMaxImportanceLamps lamps: chosen by importance at p
     float triangle_pick_ = 0;  // probability of the triangle group
     Rgb world_;
     std::shared_ptr<const EnvironmentMap> environment_;

@@ -223,7 +223,7 @@ TEST(LightSet, HitsAgreeWithSamples) {
             if (!s) continue;
             ASSERT_FALSE(s->delta);
             const Rgb hit = std::isinf(s->distance)
-                                ? set.escaped(s->wi, s->pdf, true)
+                                ? set.escaped({0, 0, 0}, s->wi, s->pdf, true)
                                 : set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f, INFINITY, s->pdf,
                                                       true);
             ASSERT_NEAR(hit.r, 0.5f * s->value.r, 1e-3f * s->value.r)
@@ -247,12 +247,12 @@ TEST(LightSet, ConstantWorldIsFoundByBsdfSamplingOnly) {
     EXPECT_EQ(set.lamp_count(), 0);
     EXPECT_TRUE(set.empty());
     EXPECT_FALSE(set.sample({0, 0, 0}, 0.3f, 0.7f, 0.1f).has_value());
-    EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.0f, false).b, 1.0f);
-    EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.3f, true).g, 1.0f);
-    EXPECT_FLOAT_EQ(set.escaped({0, 1, 0}, 0.3f, true, false).g, 0.0f);
+    EXPECT_FLOAT_EQ(set.escaped({0, 0, 0}, {0, 1, 0}, 0.0f, false).b, 1.0f);
+    EXPECT_FLOAT_EQ(set.escaped({0, 0, 0}, {0, 1, 0}, 0.3f, true).g, 1.0f);
+    EXPECT_FLOAT_EQ(set.escaped({0, 0, 0}, {0, 1, 0}, 0.3f, true, false).g, 0.0f);
     // With a sun, the world does not dilute the sun's selection probability.
     const LightSet with_sun = build({SunLight{}}, {}, {}, {Rgb(0.5f), 2.0f});
-    EXPECT_FLOAT_EQ(with_sun.lamp_selection_probability(), 1.0f);
+    EXPECT_FLOAT_EQ(with_sun.lamp_selection_probability({0, 0, 0}, 0), 1.0f);
 }
 
 TEST(LightSet, SelectionFollowsCycles) {
@@ -261,7 +261,9 @@ TEST(LightSet, SelectionFollowsCycles) {
     const LightSet set = build({SunLight{}}, {{Vec3{0, 0, 5}, Rgb(1.0f), 1.0f, 0.0f}}, {}, {},
                                {small, big});
     EXPECT_FLOAT_EQ(set.triangle_group_probability(), 0.5f);
-    EXPECT_FLOAT_EQ(set.lamp_selection_probability(), 0.25f);
+    // The lamps share the other half (by importance: LampsAreChosenByImportanceAtThePoint).
+    const Vec3 at{0.2f, 0.2f, 1.0f};
+    EXPECT_NEAR(set.lamp_selection_probability(at, 0) + set.lamp_selection_probability(at, 1), 0.5f, 1e-6f);
     // Triangles by area: the big one (3/4 of the area) is picked 3/4 of the time.
     int big_count = 0, tri_count = 0;
     for (int i = 0; i < 8000; ++i) {
@@ -275,6 +277,34 @@ TEST(LightSet, SelectionFollowsCycles) {
     }
     EXPECT_EQ(tri_count, 4000);
     EXPECT_NEAR(double(big_count) / tri_count, 0.75, 0.01);
+}
+
+TEST(LightSet, LampsAreChosenByImportanceAtThePoint) {
+    // Two equal point lights, one near p and one far: each lamp's share is a tenth uniform and
+    // the rest in proportion to I/d²; the draws follow those shares, and each sample's pdf is
+    // its lamp's share times the sphere's density, as lamps_along_ray reports it (MIS).
+    const LightSet set = build({}, {{Vec3{0, 0, 1}, Rgb(1.0f), 50.0f, 0.1f}, {Vec3{0, 4, 0}, Rgb(1.0f), 50.0f, 0.1f}}, {});
+    const Vec3 p{0, 0, 0};
+    const double near = 1.0 / 1.0, far = 1.0 / 16.0;
+    const double want_near = 0.05 + 0.9 * near / (near + far);
+    EXPECT_NEAR(set.lamp_selection_probability(p, 0), want_near, 1e-6);
+    EXPECT_NEAR(set.lamp_selection_probability(p, 1), 1.0 - want_near, 1e-6);
+    EXPECT_EQ(set.lamp_selection_probability(p, 2), 0.0f);
+    // Seen from beside the far one, the far one is the near one.
+    EXPECT_GT(set.lamp_selection_probability({0, 4.0f, 0.3f}, 1), 0.9f);
+    int near_count = 0, n = 20000;
+    for (int i = 0; i < n; ++i) {
+        const SampleRng rng(3, 0, std::uint64_t(i));
+        const auto s = set.sample(p, rng.get(0), rng.get(1), rng.get(2));
+        ASSERT_TRUE(s.has_value());
+        const bool is_near = s->distance < 2.0f;
+        near_count += is_near;
+        const Rgb hit = set.lamps_along_ray(p, s->wi, 0.0f, INFINITY, s->pdf, true);
+        ASSERT_NEAR(hit.r, 0.5f * s->value.r, 1e-3f * s->value.r) << i;  // the same density
+        ASSERT_NEAR(set.pdf(p, s->wi), s->pdf, 1e-3f * s->pdf) << i;
+    }
+    const double share = double(near_count) / n;
+    EXPECT_NEAR(share, want_near, 4.0 * std::sqrt(want_near * (1.0 - want_near) / n));
 }
 
 TEST(LightSet, RefusesInvalidLights) {
@@ -546,7 +576,7 @@ TEST(LightSet, NewLampsHitsAgreeWithSamples) {
             if (!s) continue;
             ASSERT_FALSE(s->delta);
             const Rgb hit = std::isinf(s->distance)
-                                ? set.escaped(s->wi, s->pdf, true)
+                                ? set.escaped({0, 0, 0}, s->wi, s->pdf, true)
                                 : set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f, INFINITY, s->pdf, true);
             ASSERT_NEAR(hit.g, 0.5f * s->value.g, 1e-3f * s->value.g) << "set " << k << ", sample " << i;
             ASSERT_NEAR(set.pdf({0, 0, 0}, s->wi), s->pdf, 1e-3f * s->pdf) << "set " << k;
@@ -557,35 +587,41 @@ TEST(LightSet, NewLampsHitsAgreeWithSamples) {
 }
 
 TEST(LightSet, EnvironmentWorldIsALampAmongLamps) {
-    // Cycles 3.4 (and 4.x without the light tree): the background light shares the lamps'
-    // uniform selection; with emissive triangles the lamps share half.
+    // The background light is one of the lamps, chosen by its importance (πL̄) among them;
+    // with emissive triangles the lamps share half.
     LightsDesc d;
     d.suns = {SunLight{}};
     d.world.environment = sky();
     const LightSet set = build_lights(d);
     EXPECT_EQ(set.lamp_count(), 2);
     EXPECT_TRUE(set.world_light_sampled());
-    EXPECT_FLOAT_EQ(set.lamp_selection_probability(), 0.5f);
+    // By importance: the sun's E = 1 against the environment's ∫L dω / 4, a tenth uniform.
+    const Vec3 p{0.3f, -0.2f, 0.1f};
+    const double sun = 1.0, env = d.world.environment->luminance_integral() / 4.0;
+    const double env_pick = 0.1 * 0.5 + 0.9 * env / (sun + env);
+    EXPECT_NEAR(set.lamp_selection_probability(p, 1), env_pick, 1e-5);
+    EXPECT_NEAR(set.lamp_selection_probability(p, 0), 1.0 - env_pick, 1e-5);
     const Vec3 dir = safe_normalize(Vec3{0.2f, -0.4f, 0.7f});
-    EXPECT_FLOAT_EQ(set.world_pdf(dir), 0.5f * d.world.environment->pdf(dir));
+    EXPECT_NEAR(set.world_pdf(p, dir), env_pick * d.world.environment->pdf(dir), 1e-5 * set.world_pdf(p, dir));
     // Escaped rays get the environment's radiance, weighted against that density.
     const Rgb L = d.world.environment->eval(dir);
     const float bsdf_pdf = 0.3f;
-    EXPECT_FLOAT_EQ(set.escaped(dir, bsdf_pdf, true).b, L.b * power_heuristic(bsdf_pdf, set.world_pdf(dir)));
-    EXPECT_FLOAT_EQ(set.escaped(dir, bsdf_pdf, false).b, L.b);
-    EXPECT_EQ(set.escaped(dir, bsdf_pdf, true, false).b, 0.0f);
+    EXPECT_FLOAT_EQ(set.escaped(p, dir, bsdf_pdf, true).b, L.b * power_heuristic(bsdf_pdf, set.world_pdf(p, dir)));
+    EXPECT_FLOAT_EQ(set.escaped(p, dir, bsdf_pdf, false).b, L.b);
+    EXPECT_EQ(set.escaped(p, dir, bsdf_pdf, true, false).b, 0.0f);
 
     EmissiveTriangle tri{{0, 0, 5}, {1, 0, 5}, {0, 1, 5}, Rgb(1.0f), 0, 0};
     const LightSet with_triangle = build_lights(d, {tri});
-    EXPECT_FLOAT_EQ(with_triangle.lamp_selection_probability(), 0.25f);
+    EXPECT_NEAR(with_triangle.lamp_selection_probability(p, 0) + with_triangle.lamp_selection_probability(p, 1),
+                0.5f, 1e-6f);
 
     // Sampling None: not a lamp; escaped rays take it at full weight.
     d.world.light_sampled = false;
     const LightSet none = build_lights(d);
     EXPECT_EQ(none.lamp_count(), 1);
     EXPECT_FALSE(none.world_light_sampled());
-    EXPECT_EQ(none.world_pdf(dir), 0.0f);
-    EXPECT_FLOAT_EQ(none.escaped(dir, bsdf_pdf, true).b, L.b);
+    EXPECT_EQ(none.world_pdf(p, dir), 0.0f);
+    EXPECT_FLOAT_EQ(none.escaped(p, dir, bsdf_pdf, true).b, L.b);
     // A black environment has nothing to sample.
     LightsDesc black;
     black.world.environment = environment(8, 4, [](int, int) { return Rgb(0.0f); });
@@ -727,8 +763,8 @@ TEST(LightSet, MisOfTheEnvironmentIsUnbiased) {
         const Vec3 w = safe_normalize(a * x + b * y + n * z);
         const float bsdf_pdf = z * float(kInvPi);
         if (bsdf_pdf > 0.0f) {
-            bsdf_only = double(set.escaped(w, bsdf_pdf, false).r) * z / bsdf_pdf;
-            mis += double(set.escaped(w, bsdf_pdf, true).r) * z / bsdf_pdf;
+            bsdf_only = double(set.escaped(p, w, bsdf_pdf, false).r) * z / bsdf_pdf;
+            mis += double(set.escaped(p, w, bsdf_pdf, true).r) * z / bsdf_pdf;
         }
         const double v[3] = {light_only, bsdf_only, mis};
         for (int k = 0; k < 3; ++k) {

@@ -223,6 +223,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
 
     const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
     Vec3 origin = cr.origin, dir = cr.direction;
+    Vec3 from = cr.origin;  // the vertex the ray left: where its light sample was drawn
     float tmin = cr.tmin, tmax = cr.tmax;
     PrimRef skip;
     Rgb beta(1.0f), radiance;
@@ -263,10 +264,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             std::vector<StrandCrossing> &strands = counters.dual.continuation;
             hit = scene.trace_through_hair(origin, dir, tmin, tmax, skip, {}, strands);
             ++counters.rays;
+            if (hit && hit->prim.geometry == PrimRef::kNone) hit.reset();  // untraceable: as intersect()
             if (!strands.empty()) {
-                const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, strands[0].t, bsdf_pdf, use_mis);
+                const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, strands[0].t, bsdf_pdf, use_mis, from);
                 if (!is_black(lamps)) add(beta * lamps);
-                if (!hit || hit->prim.geometry == PrimRef::kNone) break;
+                if (!hit) break;
                 const ForwardScattering forward =
                     gather_forward_scattering(scene, strands.data(), strands.size(), dir, *dual_from.dual);
                 const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
@@ -284,14 +286,14 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
 
         // Lamps are transparent: every one crossed before the surface contributes.
         if (!through_hair) {
-            const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis);
+            const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis, from);
             if (!is_black(lamps)) add(beta * lamps);
         }
 
         if (!hit) {
             const bool transparent = depth == 0 && settings.film_transparent;
             if (transparent) alpha = 0.0f;
-            const Rgb escaped = lights.escaped(dir, bsdf_pdf, use_mis, !transparent);
+            const Rgb escaped = lights.escaped(from, dir, bsdf_pdf, use_mis, !transparent);
             if (!is_black(escaped)) add(beta * escaped);
             break;
         }
@@ -346,7 +348,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // Next-event estimation.
         // render() refuses hair without dual-scattering data; render_sample() path-traces it.
         const auto *hair = dual ? std::get_if<HairMaterial>(&material) : nullptr;
-        const bool dual_vertex = hair && hair->dual && hair->multiple;
+        const bool dual_vertex = hair && hair->dual && hair->multiple && bsdf.hair();
         if (dual_vertex) {
             DualVertex v;
             v.point = &sp;
@@ -432,8 +434,10 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             ++counters.dropped;
             break;
         }
-        if (is_black(beta)) break;
+        // A layer's continuation may carry the multiple term where f_s is 0: it decides there.
+        if (is_black(beta) && !(dual_vertex && dual_layer)) break;
         origin = sp.spawn_point(wi);
+        from = sp.position;
         dir = wi;
         tmin = 0.0f;
         tmax = INFINITY;
