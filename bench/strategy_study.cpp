@@ -3,7 +3,7 @@
 //  1. Near field (what a renderer shades, Cycles' f at the hit's h): relative variance per
 //     sample of the luminance estimate of ∫ f cos dω_i for each strategy over a θ_r grid, for
 //     blonde, brunette and black Principled Hair at two roughnesses, and the efficiency
-//     1 / (variance × time per sample+pdf).
+//     1 / (variance × time per prepare+sample+pdf).
 //  2. Far field (h-averaged f, what the 2D tables tabulate) for the Cycles-default fiber.
 //  3. Multiple scattering: the same estimate of ∫ F_multiple cos dω_i at n_h ∈ {1, 2, 4, 8, 16},
 //     and the multiple table sampling the layer's term (Ā_b cut at 1, 2, 4 strands behind).
@@ -95,7 +95,9 @@ double relative_variance(const bench::Strategy &sampler, Vec3 wo, long long coun
     return total / double(std::size(kOffsets));
 }
 
-// Nanoseconds per sample+pdf on one thread (the best of three passes over random queries).
+// Nanoseconds per prepare+sample+pdf on one thread, as a renderer spends them at a hit (one
+// preparation at (ω_o, h), then one sample and its pdf; the best of three passes over random
+// queries).
 double time_per_sample(const bench::Strategy &sampler) {
     const int queries = 1 << 18;
     std::vector<Vec3> views(static_cast<size_t>(queries));
@@ -112,9 +114,12 @@ double time_per_sample(const bench::Strategy &sampler) {
     for (int repeat = 0; repeat < 3; ++repeat) {
         float checksum = 0;
         const auto start = std::chrono::steady_clock::now();
+        ScratchBuffer scratch;
         for (size_t i = 0; i < size_t(queries); ++i) {
-            const auto s = sampler.sample(views[i], hs[i], us[3 * i], us[3 * i + 1], us[3 * i + 2]);
-            if (s) checksum += sampler.pdf(s->wi, views[i], hs[i]);
+            scratch.reset();
+            const HairBsdf bsdf = sampler.at(views[i], hs[i], scratch);
+            const auto s = bsdf.sample(us[3 * i], us[3 * i + 1], us[3 * i + 2]);
+            if (s) checksum += bsdf.pdf(s->wi);
         }
         const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
         best = std::min(best, ns / queries);
@@ -206,7 +211,7 @@ int main(int argc, char **argv) {
     out.section("near_field_variance", per_theta.str());
 
     print(out, "\n## Time and efficiency (Cycles-default fiber, one thread, random θ_r and h)\n\n"
-               "| strategy | ns per sample+pdf | million per second | near-field variance (median) | efficiency 1/(variance × µs) | vs analytic |\n|---|---|---|---|---|---|\n");
+               "| strategy | ns per prepare+sample+pdf | million per second | near-field variance (median) | efficiency 1/(variance × µs) | vs analytic |\n|---|---|---|---|---|---|\n");
     std::vector<double> efficiency;
     for (size_t s = 0; s < names.size(); ++s) efficiency.push_back(1.0 / (median(medians[s]) * ns_per_sample[s] * 1e-3));
     for (size_t s = 0; s < names.size(); ++s)
