@@ -403,6 +403,7 @@ TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
 
 struct Estimate {
     double mean[3] = {0, 0, 0}, sigma[3] = {0, 0, 0};
+    double reference[3] = {0, 0, 0};  ///< mean_difference: the second render's mean
 };
 
 // The mean and standard error of the single pixel's samples that hit hair.
@@ -424,6 +425,37 @@ Estimate hair_pixel(const Scene &scene, const RenderSettings &s, int n) {
     for (int ch = 0; ch < 3; ++ch) {
         e.mean[ch] = sum[ch] / std::max(hits, 1);
         e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / std::max(hits, 1) - e.mean[ch] * e.mean[ch]) / std::max(hits, 1));
+    }
+    return e;
+}
+
+// Per camera sample of the pixel (0, 0), render(a, sa) − render(b, sb) with the same random
+// numbers: its mean and standard error, over the samples whose first render hits something;
+// `reference` is the mean of the second render over them.
+Estimate mean_difference(const Scene &a, const RenderSettings &sa, const Scene &b, const RenderSettings &sb,
+                         int n) {
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0}, second[3] = {0, 0, 0};
+    int hits = 0;
+    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
+        float alpha = 0;
+        const Rgb x = render_sample(a, sa, 0, 0, i, &alpha);
+        if (alpha == 0.0f) continue;
+        const Rgb y = render_sample(b, sb, 0, 0, i);
+        ++hits;
+        for (int ch = 0; ch < 3; ++ch) {
+            const double v = double(x[ch]) - double(y[ch]);
+            sum[ch] += v;
+            sum2[ch] += v * v;
+            second[ch] += y[ch];
+        }
+    }
+    EXPECT_GT(hits, 0);
+    Estimate e;
+    const double k = std::max(hits, 1);
+    for (int ch = 0; ch < 3; ++ch) {
+        e.mean[ch] = sum[ch] / k;
+        e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / k - e.mean[ch] * e.mean[ch]) / k);
+        e.reference[ch] = second[ch] / k;
     }
     return e;
 }
@@ -451,16 +483,7 @@ TEST(DualScatteringRender, ALayersMeshLightThroughStrandsIsTheGlobalTerm) {
     };
     const Scene with = scene_with(true), without = scene_with(false);
     const RenderSettings s = dual_settings(1, DualHairVolume::Layer);
-    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-    const int n = 20000;
-    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
-        const Rgb a = render_sample(with, s, 0, 0, i), b = render_sample(without, s, 0, 0, i);
-        for (int ch = 0; ch < 3; ++ch) {
-            const double v = double(a[ch]) - double(b[ch]);
-            sum[ch] += v;
-            sum2[ch] += v * v;
-        }
-    }
+    const Estimate floor_light = mean_difference(with, s, without, s, 20000);
     // Independent: ω uniform on the sphere from a camera ray's hit on the hair.
     const DualScattering &dual = *blonde().dual;
     std::mt19937 rng(11);
@@ -499,10 +522,10 @@ TEST(DualScatteringRender, ALayersMeshLightThroughStrandsIsTheGlobalTerm) {
         }
     }
     for (int ch = 0; ch < 3; ++ch) {
-        const double mean = sum[ch] / n, var = std::max(0.0, sum2[ch] / n - mean * mean) / n;
+        const double sigma = floor_light.sigma[ch];
         const double want = ind[ch] / m, var_ind = std::max(0.0, ind2[ch] / m - want * want) / m;
         ASSERT_GT(want, 0.0);
-        EXPECT_NEAR(mean, want, 5.0 * std::sqrt(var + var_ind)) << "ch " << ch;
+        EXPECT_NEAR(floor_light.mean[ch], want, 5.0 * std::sqrt(sigma * sigma + var_ind)) << "ch " << ch;
     }
 }
 
@@ -562,29 +585,22 @@ TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
 // The same sample's radiance minus the path tracer's, over n samples of pixel (0, 0): at depth
 // 0 both draw the same light sample and continuation with the same numbers, so the difference
 // is the multiple-scattering term M alone.
+// The multiple-scattering part of the unbounded dual estimate: dual − path, one bounce.
 Estimate multiple_part(const Scene &scene, int n) {
-    RenderSettings dual = dual_settings(0), path = dual_settings(0);
+    RenderSettings path = dual_settings(0);
     path.integrator = int(Integrator::Path);
-    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-    int hits = 0;
-    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
-        float alpha = 0;
-        const Rgb a = render_sample(scene, dual, 0, 0, i, &alpha);
-        if (alpha == 0.0f) continue;
-        const Rgb b = render_sample(scene, path, 0, 0, i);
-        ++hits;
-        for (int ch = 0; ch < 3; ++ch) {
-            const double v = double(a[ch]) - double(b[ch]);
-            sum[ch] += v;
-            sum2[ch] += v * v;
-        }
-    }
-    Estimate e;
-    for (int ch = 0; ch < 3; ++ch) {
-        e.mean[ch] = sum[ch] / hits;
-        e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / hits - e.mean[ch] * e.mean[ch]) / hits);
-    }
-    return e;
+    return mean_difference(scene, dual_settings(0), scene, path, n);
+}
+
+// A rectangular area light of size_x × size_y centred at `centre`, facing down, of `power` W.
+AreaLight rectangle_light(Vec3 centre, float size_x, float size_y, float power) {
+    AreaLight a;
+    a.light_to_world = Mat4::translation(centre);
+    a.shape = AreaShape::Rectangle;
+    a.size_x = size_x;
+    a.size_y = size_y;
+    a.power = power;
+    return a;
 }
 
 // One hair at z = 0 seen straight down (θ_o = 0) through a 2 cm window.
@@ -622,14 +638,8 @@ TEST(DualScatteringRender, AreaLightMultipleScatteringMisMatchesQuadrature) {
     //   ∫_light local_f_cos(θ_i(ω), 0) L dω = ∫∫ local_f_cos L h / d³ dx dy,
     // computed by Gauss–Legendre over the light's area.
     SceneDesc d = single_hair();
-    AreaLight a;
-    a.light_to_world = Mat4::translation({0, 0, 1});
-    a.shape = AreaShape::Rectangle;
-    a.size_x = 6.0f;
-    a.size_y = 6.0f;
     const float radiance = 1.7f;
-    a.power = radiance * 4.0f * 36.0f;  // Cycles 3.4: L = P/(4·area)
-    d.area_lights = {a};
+    d.area_lights = {rectangle_light({0, 0, 1}, 6.0f, 6.0f, radiance * 4.0f * 36.0f)};  // 3.4: L = P/(4·area)
     const Scene scene = build(std::move(d));
     const QuadratureRule q = QuadratureRule::composite(-3.0, 3.0, 48, 8);
     double want[3] = {0, 0, 0};
@@ -653,33 +663,16 @@ TEST(DualScatteringRender, ALoneHairUnderAnAreaLightIsSingleScatteringInALayer) 
     // (light samples and the continuation's mixture, power heuristic over the mixture's
     // density) must equal the path tracer's single scattering, sample for sample in the mean.
     SceneDesc d = single_hair();
-    AreaLight a;
-    a.light_to_world = Mat4::translation({0.3f, 0, 1});
-    a.shape = AreaShape::Rectangle;
-    a.size_x = 1.5f;
-    a.size_y = 1.0f;
-    a.power = 20.0f;
-    d.area_lights = {a};
+    d.area_lights = {rectangle_light({0.3f, 0, 1}, 1.5f, 1.0f, 20.0f)};
     const Scene scene = build(std::move(d));
     const RenderSettings dual = dual_settings(0, DualHairVolume::Layer);
     RenderSettings path = dual;
     path.integrator = int(Integrator::Path);
-    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0}, level[3] = {0, 0, 0};
-    const int n = 40000;
-    for (std::uint64_t i = 0; i < std::uint64_t(n); ++i) {
-        const Rgb x = render_sample(scene, dual, 0, 0, i), y = render_sample(scene, path, 0, 0, i);
-        for (int ch = 0; ch < 3; ++ch) {
-            const double v = double(x[ch]) - double(y[ch]);
-            sum[ch] += v;
-            sum2[ch] += v * v;
-            level[ch] += y[ch];
-        }
-    }
+    const Estimate e = mean_difference(scene, dual, scene, path, 40000);
     for (int ch = 0; ch < 3; ++ch) {
-        const double mean = sum[ch] / n, sigma = std::sqrt(std::max(0.0, sum2[ch] / n - mean * mean) / n);
-        ASSERT_GT(level[ch] / n, 0.0);
-        EXPECT_NEAR(mean, 0.0, 5.0 * sigma) << "ch " << ch;
-        EXPECT_LT(5.0 * sigma, 0.02 * level[ch] / n) << "resolves 2% of D, ch " << ch;
+        ASSERT_GT(e.reference[ch], 0.0);
+        EXPECT_NEAR(e.mean[ch], 0.0, 5.0 * e.sigma[ch]) << "ch " << ch;
+        EXPECT_LT(5.0 * e.sigma[ch], 0.02 * e.reference[ch]) << "resolves 2% of D, ch " << ch;
     }
 }
 
