@@ -134,7 +134,7 @@ class Bsdf {
             }
             return;
         }
-        const bool back = dot(sp.normal, wo) < 0.0f;
+        const bool back = back_facing(sp, wo);
         const Vec3 ng = back ? -sp.normal : sp.normal;
         if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
             const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
@@ -200,11 +200,6 @@ class Bsdf {
     SurfaceBsdf surface_;
 };
 
-const DualScattering *hair_dual(const Material &material) {
-    const auto *hair = std::get_if<HairMaterial>(&material);
-    return hair ? hair->dual.get() : nullptr;
-}
-
 // The seed of the random numbers of the point at vertex `depth` of a path (Huang's eval).
 std::uint32_t vertex_seed(const SampleRng &key, int depth) {
     return std::uint32_t(mix64(key.key() ^ (std::uint64_t(depth + 1) * 0xd1b54a32d192ed03ull)) >> 32);
@@ -235,9 +230,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     bool last_segment = false;  // a bounce limit was reached: only emission at the next hit
     const bool dual = settings.integrator == int(Integrator::DualScattering);
     const bool dual_layer = settings.dual_hair_volume == int(DualHairVolume::Layer);
-    bool from_dual_hair = false;  // the ray left a hair vertex shaded by dual scattering
     struct {
-        const DualScattering *dual = nullptr;
+        const DualScattering *dual = nullptr;  // set when the ray left a hair vertex shaded by dual scattering
         FiberFrame frame;
         float theta_o = 0;
         int depth = -1;
@@ -257,7 +251,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
     for (int depth = 0;;) {
         std::optional<Hit> hit;
         bool through_hair = false;  // a dual continuation that crossed strands to a mesh
-        if (from_dual_hair && dual_layer) {
+        if (dual_from.dual && dual_layer) {
             // Light meshes reflect onto the hair vertex through n ≥ 1 strands is the dual
             // estimate's global term: T_f d_f (f_s^scatter + π d_b f_back^scatter) for the
             // sampled direction, in place of f_s (lamps, suns and the world beyond hair are M's).
@@ -299,7 +293,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         }
 
         const SurfacePoint sp = scene.surface_point(origin, dir, *hit);
-        if (from_dual_hair && sp.is_curve) break;  // hair-to-hair light is the dual estimate's
+        if (dual_from.dual && sp.is_curve) break;  // hair-to-hair light is the dual estimate's
         const Material &material = scene.materials()[sp.material];
         const Vec3 wo = -dir;
 
@@ -415,9 +409,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                                 rng.get(dim(depth, kDimBsdf2)), wi, weight, pdf, glossy)) {
             break;
         }
-        from_dual_hair = dual_vertex;
+        dual_from.dual = dual_vertex ? hair->dual.get() : nullptr;
         if (dual_vertex) {
-            dual_from.dual = hair_dual(material);
             dual_from.frame = bsdf.frame();
             dual_from.theta_o = std::asin(std::clamp(bsdf.frame().to_local(wo).x, -1.0f, 1.0f));
             dual_from.depth = counters.dual.last_depth;
