@@ -12,6 +12,14 @@ namespace hairis {
 
 namespace {
 
+// Ā_b = ā_b x c/(1 − x) + ā_b³ x c³/(1 − x)³ with x = ā_f² (Zinke et al.'s eqs. for one and three
+// backward scatterings); c = 1 − x^depth cuts both forward series at `depth` strands, c = 1 is
+// the paper's unbounded volume.
+double series_backscatter(double af, double ab, double cut) {
+    const double x = af * af, om = 1.0 - x, c3 = cut * cut * cut;
+    return ab * x * cut / om + ab * ab * ab * x * c3 / (om * om * om);
+}
+
 /// Normalised Gaussian g(x; variance).
 double gaussian(double x, double variance) {
     return std::exp(-0.5 * x * x / variance) / std::sqrt(kTwoPi * variance);
@@ -272,7 +280,7 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             const double af = std::clamp(a_f, 0.0, amax), ab = std::clamp(a_b, 0.0, amax);
             const double af2 = af * af, ab2 = ab * ab, ab3 = ab2 * ab;
             const double om = 1.0 - af2;
-            const double big_a_b = ab * af2 / om + ab3 * af2 / (om * om * om);
+            const double big_a_b = series_backscatter(af, ab, 1.0);
             const double delta_b = alpha_b * (1.0 - 2.0 * ab2 / (om * om)) +
                                    alpha_f * (2.0 * om * om + 4.0 * af2 * ab2) / (om * om * om);
             const double bf_ = beta2_f, bb_ = beta2_b;
@@ -378,8 +386,7 @@ DualScattering::Rgbd DualScattering::backscatter(double theta, int depth) const 
     Rgbd out;
     for (int ch = 0; ch < 3; ++ch) {
         const double af = std::clamp(a_f.v[ch], 0.0, amax), ab = std::clamp(a_b.v[ch], 0.0, amax);
-        const double x = af * af, om = 1.0 - x, cut = 1.0 - std::pow(x, depth);
-        out.v[ch] = ab * x * cut / om + ab * ab * ab * x * cut * cut * cut / (om * om * om);
+        out.v[ch] = series_backscatter(af, ab, 1.0 - std::pow(af * af, depth));
     }
     return out;
 }
