@@ -402,6 +402,22 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
     return set;
 }
 
+// The lamps' selection probabilities seen from p; the lamps' importance total is computed when
+// a lamp first asks (most rays cross no lamp).
+class LightSet::LampPicks {
+  public:
+    LampPicks(const LightSet &set, Vec3 p) : set_(set), p_(p) {}
+    float operator()(const Lamp &lamp) const {
+        if (set_.by_importance_ && total_ < 0.0f) total_ = set_.importance_total(p_);
+        return set_.lamp_pick(lamp, p_, total_);
+    }
+
+  private:
+    const LightSet &set_;
+    Vec3 p_;
+    mutable float total_ = -1.0f;
+};
+
 std::optional<LightSample> LightSet::sample(Vec3 p, float u_select, float u0, float u1) const {
     if (empty()) return std::nullopt;
     float u = u_select;
@@ -415,13 +431,16 @@ std::optional<LightSample> LightSet::sample(Vec3 p, float u_select, float u0, fl
         const int i = std::min(int(u * float(n)), n - 1);
         return sample_lamp(lamps_[std::size_t(i)], p, u0, u1, lamp_pick_);
     }
-    const float total = importance_total(p);
+    // The importances once (summed in importance_total's order, so the pick is the density's).
+    float importance[kMaxImportanceLamps];
+    float total = 0.0f;
+    for (int i = 0; i < n; ++i) total += importance[i] = importance_at(lamps_[std::size_t(i)], p);
     float cumulative = 0.0f;
     for (int i = 0; i < n; ++i) {
-        const Lamp &lamp = lamps_[std::size_t(i)];
-        const float share = lamp_share(lamp, p, total);
+        const float share = share_of(importance[i], total);
         cumulative += share;
-        if (u < cumulative || i == n - 1) return sample_lamp(lamp, p, u0, u1, (1.0f - triangle_pick_) * share);
+        if (u < cumulative || i == n - 1)
+            return sample_lamp(lamps_[std::size_t(i)], p, u0, u1, (1.0f - triangle_pick_) * share);
     }
     return std::nullopt;
 }
@@ -451,18 +470,18 @@ float LightSet::importance_total(Vec3 p) const {
     return total;
 }
 
-float LightSet::lamp_share(const Lamp &lamp, Vec3 p, float total) const {
+float LightSet::share_of(float importance, float total) const {
     const float uniform = 1.0f / float(lamps_.size());
     if (!(total > 0.0f) || !std::isfinite(total)) return uniform;
-    return kUniformShare * uniform + (1.0f - kUniformShare) * importance_at(lamp, p) / total;
+    return kUniformShare * uniform + (1.0f - kUniformShare) * importance / total;
 }
 
 float LightSet::lamp_pick(const Lamp &lamp, Vec3 p, float total) const {
-    return by_importance_ ? (1.0f - triangle_pick_) * lamp_share(lamp, p, total) : lamp_pick_;
+    return by_importance_ ? (1.0f - triangle_pick_) * share_of(importance_at(lamp, p), total) : lamp_pick_;
 }
 
 float LightSet::lamp_selection_probability(Vec3 p, std::size_t i) const {
-    return i < lamps_.size() ? lamp_pick(lamps_[i], p, by_importance_ ? importance_total(p) : 0.0f) : 0.0f;
+    return i < lamps_.size() ? LampPicks(*this, p)(lamps_[i]) : 0.0f;
 }
 
 std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float u0,
@@ -666,9 +685,8 @@ float LightSet::emissive_triangle_pdf(float t, float abs_cos) const {
 template <typename Visit>
 void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tmax, Vec3 from,
                                      Visit &&visit) const {
-    const float total = by_importance_ ? importance_total(from) : 0.0f;
+    const LampPicks picks(*this, from);
     for (const Lamp &lamp : lamps_) {
-        const float pick = lamp_pick(lamp, from, total);
         if (lamp.type == LampType::Point || lamp.type == LampType::Spot) {
             if (lamp.radius == 0.0f) continue;
             const Vec3 to_origin = origin - lamp.position;
@@ -685,7 +703,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
                 const float t = d2 > r2 ? b - half_chord : b + half_chord;
                 if (!(t > tmin && t < tmax)) continue;
                 const Rgb value = point_like_value(lamp, origin, dir);
-                if (!is_black(value)) visit(value, pick * sphere_pdf(d2, r2));
+                if (!is_black(value)) visit(value, picks(lamp) * sphere_pdf(d2, r2));
                 continue;
             }
             const Vec3 n = safe_normalize(to_origin);
@@ -696,7 +714,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
             const Vec3 q = origin + dir * t - lamp.position;
             if (dot(q, q) > lamp.radius * lamp.radius) continue;
             const Rgb value = point_like_value(lamp, origin, dir);
-            if (!is_black(value)) visit(value, pick * lamp.invarea * t * t / -denom);
+            if (!is_black(value)) visit(value, picks(lamp) * lamp.invarea * t * t / -denom);
         } else if (lamp.type == LampType::Area) {
             const float denom = dot(dir, lamp.direction);
             if (!(denom < 0.0f)) continue;  // one-sided
@@ -713,9 +731,9 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
                 const SphericalRectangle rect(origin,
                                               lamp.position - (lamp.axis_u + lamp.axis_v) * 0.5f,
                                               lamp.axis_u, lamp.axis_v);
-                light_pdf = rect.solid_angle() > 0.0f ? pick / rect.solid_angle() : 0.0f;
+                light_pdf = rect.solid_angle() > 0.0f ? picks(lamp) / rect.solid_angle() : 0.0f;
             } else {
-                light_pdf = pick * lamp.invarea * t * t / -denom;
+                light_pdf = picks(lamp) * lamp.invarea * t * t / -denom;
             }
             visit(lamp.value, light_pdf);
         }
@@ -724,19 +742,18 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
 
 template <typename Visit>
 void LightSet::visit_escaped(Vec3 origin, Vec3 dir, Visit &&visit) const {
-    const float total = by_importance_ ? importance_total(origin) : 0.0f;
+    const LampPicks picks(*this, origin);
     for (const Lamp &lamp : lamps_) {
         if (lamp.type != LampType::Sun || lamp.radius == 0.0f) continue;
-        const float pick = lamp_pick(lamp, origin, total);
         if (lamp.cycles == CyclesVersion::V4_5) {
             if (!(dot(dir, lamp.direction) >= lamp.cos_half)) continue;
-            visit(lamp.value, pick / (2.0f * kPiF * lamp.one_minus_cos_half));
+            visit(lamp.value, picks(lamp) / (2.0f * kPiF * lamp.one_minus_cos_half));
             continue;
         }
         const float c = dot(dir, lamp.direction);
         if (!(c >= lamp.cos_half) || !(c > 0.0f)) continue;
         const float pdf = lamp.invarea / (c * c * c);
-        visit(lamp.value * pdf, pick * pdf);
+        visit(lamp.value * pdf, picks(lamp) * pdf);
     }
 }
 
@@ -767,7 +784,7 @@ Rgb LightSet::escaped(Vec3 origin, Vec3 dir, float bsdf_pdf, bool use_mis, bool 
 float LightSet::world_pdf(Vec3 p, Vec3 dir) const {
     if (!environment_sampled_) return 0.0f;
     const Lamp &lamp = lamps_.back();  // the environment is the last lamp
-    return lamp_pick(lamp, p, by_importance_ ? importance_total(p) : 0.0f) * environment_->pdf(dir);
+    return LampPicks(*this, p)(lamp) * environment_->pdf(dir);
 }
 
 float LightSet::pdf(Vec3 p, Vec3 wi) const {

@@ -352,13 +352,14 @@ class LightSet {
                                                  float pick) const;
     // Selection by importance: a lamp's estimate of the irradiance it brings to p, unshadowed
     // (sun: E; point, spot: I/max(d², r²); area: L·A·max(cos, 0)/d², or L where p is within
-    // √area of it; environment: πL̄ = ∫L dω/4), their sum over the lamps, and the lamp's share
-    // of the lamps' probability: kUniformShare uniform, the rest by importance.
+    // √area of it; environment: πL̄ = ∫L dω/4), their sum over the lamps, and a lamp's share of
+    // the lamps' probability from its importance: kUniformShare uniform, the rest by importance.
     static float importance_at(const Lamp &lamp, Vec3 p);
     float importance_total(Vec3 p) const;
-    float lamp_share(const Lamp &lamp, Vec3 p, float total) const;
+    float share_of(float importance, float total) const;
     // The lamp's selection probability at p (with importance_total(p) as `total`).
     float lamp_pick(const Lamp &lamp, Vec3 p, float total) const;
+    class LampPicks;
     static constexpr float kUniformShare = 0.1f;
     static constexpr std::size_t kMaxImportanceLamps = 64;  // more: uniform (O(n) per query)
     std::optional<LightSample> sample_triangle(Vec3 p, float u_select, float u0, float u1) const;
