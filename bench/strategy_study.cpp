@@ -258,6 +258,17 @@ int main(int argc, char **argv) {
     // ---- 3. Multiple scattering ---------------------------------------------------------------
     {
         const DualScattering dual = DualScattering::create(*cycles_default.fiber, DualScatteringParams{}).value();
+        // The median over θ_r of the relative variance of luminance(term(θ_i, θ_r)) sampled by `sampler`.
+        auto median_over_theta_r = [&](const bench::Strategy &sampler, auto term) {
+            std::vector<double> v;
+            for (double t : kThetaR) {
+                const Vec3 wo = direction_of(float(radians(t)), -float(kHalfPi));
+                v.push_back(relative_variance(sampler, wo, std::max(1000LL, n / 5), [&](Vec3 wi, float) {
+                    return double(luminance(term(safe_asin(wi.x), float(radians(t)))));
+                }));
+            }
+            return median(v);
+        };
         const int n_h_values[] = {1, 2, 4, 8, 16};
         print(out, "\n## 3. Multiple scattering (∫ F_multiple cos dω_i through n_h strands), median over θ_r\n\n"
                    "| strategy | n_h = 1 | 2 | 4 | 8 | 16 |\n|---|---|---|---|---|---|\n");
@@ -274,15 +285,10 @@ int main(int argc, char **argv) {
                 in.n_h = n_h;
                 const StrategyKind kinds[] = {StrategyKind::Uniform, StrategyKind::Analytic, StrategyKind::Gaussian, StrategyKind::Table};
                 if (kinds[which] == StrategyKind::Analytic) in.chiang = cycles_default.fiber;
-                const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(kinds[which], in).value(), cycles_default.fiber);
-                std::vector<double> v;
-                for (double t : kThetaR) {
-                    const Vec3 wo = direction_of(float(radians(t)), -float(kHalfPi));
-                    v.push_back(relative_variance(*sampler, wo, std::max(1000LL, n / 5), [&](Vec3 wi, float) {
-                        return double(luminance(dual.multiple_f_cos(safe_asin(wi.x), float(radians(t)), n_h)));
-                    }));
-                }
-                row.push_back(median(v));
+                const bench::Strategy sampler(make_sampler(kinds[which], in).value(), cycles_default.fiber);
+                row.push_back(median_over_theta_r(sampler, [&](float theta_i, float theta_r) {
+                    return dual.multiple_f_cos(theta_i, theta_r, n_h);
+                }));
                 print(out, " %.3g |", row.back());
             }
             print(out, "\n");
@@ -307,18 +313,11 @@ int main(int argc, char **argv) {
             std::vector<double> row;
             for (int n_h : n_h_values) {
                 in.n_h = n_h;
-                const auto sampler = std::make_shared<const bench::Strategy>(make_sampler(StrategyKind::Table, in).value(), cycles_default.fiber);
-                std::vector<double> v;
-                for (double t : kThetaR) {
-                    const Vec3 wo = direction_of(float(radians(t)), -float(kHalfPi));
-                    v.push_back(relative_variance(*sampler, wo, std::max(1000LL, n / 5), [&](Vec3 wi, float) {
-                        const float theta_i = safe_asin(wi.x);
-                        return double(luminance(dual.scattered_f_cos(theta_i, float(radians(t)),
-                                                                     dual.forward_transmittance(theta_i, n_h),
-                                                                     dual.forward_spread_variance(theta_i, n_h), depth)));
-                    }));
-                }
-                row.push_back(median(v));
+                const bench::Strategy sampler(make_sampler(StrategyKind::Table, in).value(), cycles_default.fiber);
+                row.push_back(median_over_theta_r(sampler, [&](float theta_i, float theta_r) {
+                    return dual.scattered_f_cos(theta_i, theta_r, dual.forward_transmittance(theta_i, n_h),
+                                                dual.forward_spread_variance(theta_i, n_h), depth);
+                }));
                 print(out, " %.3g |", row.back());
             }
             print(out, "\n");
