@@ -144,20 +144,25 @@ def write_markdown(results, numbers, path):
                  m["load_average_start"][0], m.get("load_average_end", [float("nan")])[0],
                  m.get("total_seconds", float("nan"))), "",
              "Scene: particle hair (1500 parents × 8 interpolated children) on a diffuse sphere, "
-             "Principled Hair (Melanin 0.1 blonde, 0.5 brunette, 0.9 black; Melanin Redness 0.5; "
-             "Roughness and Radial Roughness 0.3) under a 1° sun with a world colour (`sun`) or a "
+             "Principled Hair%s (Melanin 0.1 blonde, 0.5 brunette, 0.9 black; Melanin Redness 0.5; "
+             "Roughness%s 0.3) under a 1° sun with a world colour (`sun`) or a "
              "1.2 m square area light in a black world (`area`), %dx%d pixels, %d bounces, one "
              "thread for Hairis and for Cycles. Hairis uses the TABLE strategy for its direct "
              "term in both integrators. Errors are over the %s hair pixels (a Cycles alpha render "
              "without the sphere), relative to the reference's channel means." % (
+                 " with the Huang model (its defaults: Aspect Ratio 0.85, Offset 2°; Hairis "
+                 "samples Huang with its tables in DUAL, with Cycles' sampler in PATH)"
+                 if s.get("model") == "HUANG" else "",
+                 "" if s.get("model") == "HUANG" else " and Radial Roughness",
                  s["resolution"][0], s["resolution"][1], s["bounces"],
                  "/".join(str(c["hair_pixels"]) for c in results["cases"].values())), "",
              "Reference: Hairis PATH at %d spp (two halves, seeds 1000 and 1001; their difference "
              "gives the reference's own noise, which is subtracted from every MSE). Cycles at %d "
              "spp checks it (below). Every other render is done with seeds 1 and 2; times are the "
              "wall time of `bpy.ops.render.render()` after a warm-up render of each method (the "
-             "tables' auto-bake and the dual-scattering averages, about 1.2 s per material, are "
-             "not timed)." % (s["ref_spp"], s["cycles_ref_spp"]), ""]
+             "tables' auto-bake and the dual-scattering averages, about %s s per material, are "
+             "not timed)." % (s["ref_spp"], s["cycles_ref_spp"],
+                              "12" if s.get("model") == "HUANG" else "1.2"), ""]
 
     lines += ["## Mean error per channel (hair pixels)", "",
               "DUAL at its highest spp (mean of two seeds, ± standard error); Cycles' reference "

@@ -30,7 +30,9 @@ Environment: HAIRIS_DUAL_RESOLUTION (64x64), HAIRIS_DUAL_REF_SPP (1024),
 HAIRIS_DUAL_CYCLES_REF_SPP (256; 0 leaves Cycles' reference out), HAIRIS_DUAL_SPPS (1,4,16,64),
 HAIRIS_DUAL_PATH_SPPS (4,16,64), HAIRIS_DUAL_CASES (all: blonde_sun, brunette_sun, black_sun,
 blonde_area, brunette_area, black_area), HAIRIS_DUAL_OUT (bench/results), HAIRIS_DUAL_PROBE=1
-(one render of each method at 4 spp per case, timings only).
+(one render of each method at 4 spp per case, timings only), HAIRIS_DUAL_MODEL (CHIANG, or
+HUANG: the node's Huang model, Blender 4.0 or newer, e.g. the bpy 4.5 wheel through
+run_test.py --bpy-python; Coat and Radial Roughness are Chiang's alone).
 """
 
 import json
@@ -68,6 +70,12 @@ LIGHTINGS = ("sun", "area")
 ALL_CASES = ["%s_%s" % (c, light) for light in LIGHTINGS for c in COLOURS]
 CASES = os.environ.get("HAIRIS_DUAL_CASES", ",".join(ALL_CASES)).split(",")
 METHODS = ("DUAL", "PATH", "CYCLES")
+MODEL = os.environ.get("HAIRIS_DUAL_MODEL", "CHIANG")
+if MODEL not in ("CHIANG", "HUANG"):
+    raise SystemExit("HAIRIS_DUAL_MODEL must be CHIANG or HUANG (got %r)" % MODEL)
+if MODEL == "HUANG" and bpy.app.version < (4, 0, 0):
+    helpers.skip("HAIRIS_DUAL_MODEL=HUANG needs Blender 4.0 or newer (this is %s)"
+                 % bpy.app.version_string)
 START = time.monotonic()
 
 
@@ -101,6 +109,10 @@ def make_case_scene(colour, lighting):
         "Melanin": COLOURS[colour], "Melanin Redness": 0.5, "Roughness": 0.3,
         "Radial Roughness": 0.3, "Coat": 0.0, "IOR": 1.55, "Random Color": 0.0,
         "Random Roughness": 0.0})
+    if MODEL == "HUANG":
+        for node in hair.node_tree.nodes:
+            if node.bl_idname == "ShaderNodeBsdfHairPrincipled":
+                node.model = "HUANG"
     skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
     sphere = helpers.make_particle_hair(scene, count=1500, children=8, location=(0.0, 0.0, 0.0),
                                         scale=1.0, hair_material=hair, skin_material=skin)
@@ -263,7 +275,7 @@ def main():
                "settings": {"resolution": list(RESOLUTION), "bounces": BOUNCES,
                             "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
                             "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
-                            "threads": 1, "probe": PROBE},
+                            "threads": 1, "probe": PROBE, "model": MODEL},
                "cases": cases}
     os.makedirs(OUT, exist_ok=True)
     suffix = "_probe" if PROBE else ""

@@ -285,8 +285,9 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             return found
         try:
             for index, material in data.hair_materials():
-                if material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES":
-                    continue  # Cycles' own Huang sampler needs no tables
+                if (material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES"
+                        and settings.integrator != "DUAL_SCATTERING"):
+                    continue  # Cycles' own Huang sampler needs no tables (Dual Scattering does)
                 node = tables.principled_struct(library, material.hair)
                 try:
                     fiber = library.fiber_principled(node)
@@ -295,7 +296,9 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                         from error
                 with fiber:
                     if material.source is not None:
-                        status = tables.check_material(library, material.source, fiber)
+                        status = tables.check_material(
+                            library, material.source, fiber,
+                            need_multiple=settings.integrator == "DUAL_SCATTERING")
                     else:
                         status = tables.TableStatus("MISSING", "material %r has no sampling "
                                                     "tables" % material.name)
@@ -327,7 +330,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         return found
 
     def _auto_bake(self, library, material, fiber, settings, status):
-        cached = tables.cached_tables(library, fiber)
+        cached = tables.cached_tables(library, fiber,
+                                      need_multiple=settings.integrator == "DUAL_SCATTERING")
         if cached is not None:
             self.report({"INFO"}, "%s: using tables auto-baked earlier in this session"
                         % status.message)

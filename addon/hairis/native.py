@@ -573,7 +573,8 @@ class Tables(_Handle):
     @property
     def info(self):
         """What the tables hold (strings): source, theta_r, theta_i, phi, n_h; for huang2022
-        tables source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi."""
+        tables source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi, and theta_r,
+        theta_i, n_h when they hold the multiple part (Dual Scattering needs it)."""
         return parse_options(_decode(self._library.raw.hairis_tables_info(self)))
 
     @property

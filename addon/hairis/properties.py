@@ -65,7 +65,8 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
         name="Huang Sampling",
         description="How Huang hair is sampled. Cycles (the default) renders what Cycles "
                     "renders, and at equal time with less noise than the strategy's tables "
-                    "(bench/results/bpy45/render_study_huang.md)",
+                    "(bench/results/bpy45/render_study_huang.md). Dual Scattering always uses "
+                    "the strategy: its MIS needs the sampler's density",
         items=(("STRATEGY", "Strategy",
                 "The strategy above, with its exact density (converges to Cycles' Huang eval, "
                 "about 1% from Cycles' image; noisier in renders: Cycles' eval, which weights "

@@ -98,8 +98,12 @@ def image_tables(library, image):
     return library.load_tables_file(path)
 
 
-def check_material(library, material, fiber):
-    """Full check (load, validate, match ``fiber``) of a material's tables: a TableStatus."""
+def check_material(library, material, fiber, need_multiple=False):
+    """Full check (load, validate, match ``fiber``) of a material's tables: a TableStatus.
+
+    ``need_multiple``: the tables must hold multiple-scattering tables (Dual Scattering), which
+    Huang tables baked before Dual Scattering covered Huang lack.
+    """
     image = material.hairis.table_image
     if image is None:
         return TableStatus("MISSING", "material %r has no sampling tables" % material.name)
@@ -112,6 +116,11 @@ def check_material(library, material, fiber):
         tables.close()
         return TableStatus("STALE", "material %r: its tables were baked for other hair "
                            "parameters" % material.name)
+    if need_multiple and not tables.n_h_values:
+        tables.close()
+        return TableStatus("STALE", "material %r: its tables have no multiple-scattering part, "
+                           "which Dual Scattering samples (baked by an earlier hairis); bake "
+                           "them again" % material.name)
     return TableStatus("OK", "material %r: tables are current" % material.name, tables)
 
 
@@ -191,8 +200,9 @@ def cache_path(parameters):
     return os.path.join(folder, "hairis_autobake_%s.exr" % digest)
 
 
-def cached_tables(library, fiber):
-    """Tables from the auto-bake cache when present and matching ``fiber``, else None."""
+def cached_tables(library, fiber, need_multiple=False):
+    """Tables from the auto-bake cache when present and matching ``fiber`` (and holding
+    multiple-scattering tables if ``need_multiple``), else None."""
     path = cache_path(fiber.parameters)
     if not os.path.isfile(path):
         return None
@@ -200,7 +210,7 @@ def cached_tables(library, fiber):
         tables = library.load_tables_file(path)
     except native.HairisError:
         return None
-    if tables.matches(fiber):
+    if tables.matches(fiber) and (tables.n_h_values or not need_multiple):
         return tables
     tables.close()
     return None

@@ -161,7 +161,10 @@ class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
         settings = context.scene.hairis
         column = layout.column()
         column.prop(settings, "strategy")
-        column.prop(settings, "huang_sampling")
+        sub = column.column()
+        # Dual Scattering samples Huang with the strategy (its MIS needs the sampler's density).
+        sub.active = settings.integrator != "DUAL_SCATTERING"
+        sub.prop(settings, "huang_sampling")
         sub = column.column()
         sub.active = settings.strategy in {"TABLE", "GAUSSIAN"}
         sub.prop(settings, "multiple_weight")

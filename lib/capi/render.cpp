@@ -8,6 +8,7 @@
 
 #include "capi_scene.h"
 #include "fiber/fiber_spec.h"
+#include "tables/huang_bake.h"
 #include "render/render.h"
 
 namespace hairis::capi {
@@ -73,18 +74,20 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     return std::move(shading).value();
 }
 
-// A fiber's dual-scattering averages (about a second of quadrature), kept for the process by
-// model and parameters: the add-on builds a new scene for every render. At most kDualCacheSize
-// fibers are kept; the oldest goes first.
+// A fiber's dual-scattering averages (about a second of quadrature for Chiang, several for
+// Huang: huang_dual_scattering), kept for the process by model and parameters: the add-on
+// builds a new scene for every render. At most kDualCacheSize fibers are kept; the oldest goes
+// first.
 constexpr std::size_t kDualCacheSize = 64;
-std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fiber, const std::string &name) {
+std::shared_ptr<const DualScattering> dual_scattering_of(const std::string &key,
+                                                         const std::function<Expected<DualScattering>()> &make,
+                                                         const std::string &name) {
     static std::mutex mutex;
     static std::deque<std::pair<std::string, std::shared_ptr<const DualScattering>>> cache;
-    const std::string key = fiber.name() + ":" + canonical_parameters(chiang_parameters(fiber.params()));
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto &entry : cache)
         if (entry.first == key) return entry.second;
-    Expected<DualScattering> made = DualScattering::create(fiber, DualScatteringParams{});
+    Expected<DualScattering> made = make();
     if (!made) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + made.error().message);
     auto dual = std::make_shared<const DualScattering>(std::move(made).value());
     if (cache.size() == kDualCacheSize) cache.pop_front();
@@ -93,22 +96,33 @@ std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fibe
 }
 
 // The dual-scattering data of hair material `index` (integrator=dual_scattering): its fiber's
-// averages, with the parameters the multiple tables were baked with, and those tables.
+// averages and the multiple tables baked for the same parameters.
 void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, size_t index) {
     const std::string name = "material " + std::to_string(index) + " (hair): ";
-    if (!hair.fiber)
-        invalid(name + "integrator=dual_scattering is for chiang2016 materials (this one is huang2022); render it "
-                       "with integrator=path");
     if (!hair.tables)
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "integrator=dual_scattering samples multiple scattering from the "
                                                   "material's baked multiple-scattering tables, but it was added "
                                                   "without tables; bake or load tables for it, or render with "
                                                   "integrator=path");
-    if (hair.tables->parameters != canonical_parameters(chiang_parameters(hair.fiber->params())) ||
-        hair.tables->model != hair.fiber->name() || !hair.tables->multiple)
+    const std::string model = hair.huang ? hair.huang->name() : hair.fiber->name();
+    const std::string parameters = canonical_parameters(hair.huang ? huang_parameters(hair.huang->params())
+                                                                   : chiang_parameters(hair.fiber->params()));
+    if (hair.tables->parameters != parameters || hair.tables->model != model)
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "the tables were baked for " + hair.tables->model + " \"" +
                                                hair.tables->parameters + "\", not for this fiber; bake tables for it");
-    material.dual = dual_scattering_of(*hair.fiber, name);
+    if (!hair.tables->multiple)
+        refuse(HAIRIS_ERROR_INVALID_TABLE, name + "these " + model + " tables have no multiple-scattering part "
+                                               "(baked with huang_multiple=0 or by hairis before dual scattering "
+                                               "covered Huang); bake them again, or render with integrator=path");
+    const std::string key = model + ":" + parameters;
+    if (hair.huang) {
+        const HuangFiber &fiber = *hair.huang;
+        material.dual = dual_scattering_of(key, [&] { return huang_dual_scattering(fiber); }, name);
+    } else {
+        const ChiangFiber &fiber = *hair.fiber;
+        material.dual = dual_scattering_of(key, [&] { return DualScattering::create(fiber, DualScatteringParams{}); },
+                                           name);
+    }
     material.multiple = hair.tables->multiple;
 }
 
@@ -141,9 +155,12 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {
+                // Dual scattering samples Huang with its tables: its MIS needs the sampler's
+                // density, which Cycles' own Huang sampler does not have.
+                const bool dual = o.render.integrator == int(Integrator::DualScattering);
                 HairMaterial material{hair_shading(*hair, m, o.sampler,
-                                                   o.render.huang_sampling == int(HuangSampling::Cycles))};
-                if (o.render.integrator == int(Integrator::DualScattering)) add_dual_scattering(material, *hair, m);
+                                                   o.render.huang_sampling == int(HuangSampling::Cycles) && !dual)};
+                if (dual) add_dual_scattering(material, *hair, m);
                 desc.materials.push_back(std::move(material));
             } else
                 desc.materials.push_back(std::get<SurfaceMaterial>(scene->materials[m]));

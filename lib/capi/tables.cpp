@@ -18,18 +18,25 @@ hairis_tables *make_tables(TableSet set) {
     if (!sampling) refuse(HAIRIS_ERROR_INVALID_TABLE, "hairis table: " + sampling.error().message);
     auto tables = std::make_unique<hairis_tables>();
     tables->parameters = canonical_parameters(set.parameters);
+    std::string n_h;
+    for (int v : set.n_h_values) n_h += (n_h.empty() ? "" : ",") + std::to_string(v);
     if (const HuangTableSet *h = set.huang.get()) {
-        tables->info = format_options({{"source", set.source},
-                                       {"huang_theta_o", std::to_string(h->theta_o_count())},
-                                       {"huang_phi_o", std::to_string(h->phi_o_count())},
-                                       {"huang_theta_i", std::to_string(h->theta_i_count)},
-                                       {"huang_phi", std::to_string(h->phi_count)}});
+        std::vector<std::pair<std::string, std::string>> info = {
+            {"source", set.source},
+            {"huang_theta_o", std::to_string(h->theta_o_count())},
+            {"huang_phi_o", std::to_string(h->phi_o_count())},
+            {"huang_theta_i", std::to_string(h->theta_i_count)},
+            {"huang_phi", std::to_string(h->phi_count)}};
+        if (set.has_multiple()) {  // the multiple part (dual scattering)
+            info.push_back({"theta_r", std::to_string(set.theta_r_count())});
+            info.push_back({"theta_i", std::to_string(set.theta_i_count)});
+            info.push_back({"n_h", n_h});
+        }
+        tables->info = format_options(info);
         tables->sampling = std::move(sampling).value();
         tables->set = std::move(set);
         return tables.release();
     }
-    std::string n_h;
-    for (int v : set.n_h_values) n_h += (n_h.empty() ? "" : ",") + std::to_string(v);
     tables->info = format_options({{"source", set.source},
                                    {"theta_r", std::to_string(set.theta_r_count())},
                                    {"theta_i", std::to_string(set.theta_i_count)},

@@ -316,7 +316,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         context.camera_ray = depth == 0;
         context.footprint = cr.footprint_at(hit->t);
         context.seed = vertex_seed(seeds, depth);
-        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles);
+        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles) && !dual;
         const HairInputValues *inputs = nullptr;
         if (sp.is_curve) {
             HairInputValues values;

@@ -81,6 +81,11 @@ Expected<SamplingTables> SamplingTables::from(const TableSet &t) {
         out.model = t.model;
         out.parameters = canonical_parameters(t.parameters);
         out.huang = std::make_shared<const HuangSamplingTable>(std::move(huang).value());
+        if (t.has_multiple()) {
+            Expected<MultipleTable> multiple = MultipleTable::create(t.theta_r_nodes, t.n_h_values, t.theta_i_count, t.multiple);
+            if (!multiple) return table_error("multiple table: " + multiple.error().message);
+            out.multiple = std::make_shared<const MultipleTable>(std::move(multiple).value());
+        }
         return out;
     }
     Expected<DirectTable> direct = DirectTable::create(t.theta_r_nodes, t.theta_i_count, t.phi_count, t.direct);

@@ -32,7 +32,8 @@ struct SamplingTables {
     std::string parameters;  ///< canonical_parameters(TableSet::parameters)
     /// The near-field part (Chiang), or null.
     std::shared_ptr<const NearFieldData> near_field;
-    /// The Huang table (huang2022 tables, which have no direct or multiple table), or null.
+    /// The Huang table (huang2022 tables, which have no direct table and a multiple table only
+    /// when baked for dual scattering), or null.
     std::shared_ptr<const HuangSamplingTable> huang;
 
     /// Builds the samplers' tables from a table set (validated here).

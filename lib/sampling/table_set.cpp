@@ -40,7 +40,23 @@ Status TableSet::validate() const {
                                check::count_in_range("n_h count", (long long)n_h_values.size(), 0,
                                                      std::min(phi_count, kMaxStrandCounts))))
         return file_error(s->message);
+    if (Status s = validate_axes()) return s;
     const long long cells = resolution().cells();
+    if (direct.size() != size_t(cells))
+        return file_error("direct table holds " + std::to_string(direct.size()) + " values; the grid needs " +
+                          std::to_string(cells));
+    for (size_t n = 0; n < direct.size(); ++n)
+        if (!std::isfinite(direct[n]) || direct[n] < 0.0f)
+            return file_error("direct table value " + std::to_string(n) + " is negative, NaN or infinite");
+    if (Status s = validate_multiple()) return s;
+    if (near_field) {
+        if (model != "chiang2016") return file_error("a near-field part is only for chiang2016 tables (got " + model + ")");
+        if (Status s = near_field->validate()) return file_error(s->message);
+    }
+    return std::nullopt;
+}
+
+Status TableSet::validate_axes() const {
     for (int r = 0; r < theta_r_count(); ++r) {
         const float t = theta_r_nodes[r];
         if (!std::isfinite(t) || std::fabs(t) > float(kHalfPi) + 1e-6f)
@@ -54,31 +70,37 @@ Status TableSet::validate() const {
         if (k > 0 && n_h_values[k] <= n_h_values[k - 1])
             return file_error("n_h values must be strictly increasing");
     }
-    if (direct.size() != size_t(cells))
-        return file_error("direct table holds " + std::to_string(direct.size()) + " values; the grid needs " +
-                          std::to_string(cells));
+    return std::nullopt;
+}
+
+Status TableSet::validate_multiple() const {
     const size_t multiple_size = size_t(theta_r_count()) * n_h_values.size() * theta_i_count;
     if (multiple.size() != multiple_size)
         return file_error("multiple table holds " + std::to_string(multiple.size()) +
                           " values; the grid needs " + std::to_string(multiple_size));
-    for (const std::vector<float> *v : {&direct, &multiple})
-        for (size_t n = 0; n < v->size(); ++n)
-            if (!std::isfinite((*v)[n]) || (*v)[n] < 0.0f)
-                return file_error(std::string(v == &direct ? "direct" : "multiple") + " table value " +
-                                  std::to_string(n) + " is negative, NaN or infinite");
-    if (near_field) {
-        if (model != "chiang2016") return file_error("a near-field part is only for chiang2016 tables (got " + model + ")");
-        if (Status s = near_field->validate()) return file_error(s->message);
-    }
+    for (size_t n = 0; n < multiple.size(); ++n)
+        if (!std::isfinite(multiple[n]) || multiple[n] < 0.0f)
+            return file_error("multiple table value " + std::to_string(n) + " is negative, NaN or infinite");
     return std::nullopt;
 }
 
 Status TableSet::validate_huang() const {
     if (!huang) return file_error("huang2022 tables need their Huang part (there is none)");
     if (source != "exact") return file_error("huang2022 tables have source \"exact\" (got \"" + source + "\")");
-    if (!theta_r_nodes.empty() || theta_i_count != 0 || phi_count != 0 || !n_h_values.empty() || !direct.empty() ||
-        !multiple.empty() || near_field)
-        return file_error("huang2022 tables hold only the Huang part (no far-field or near-field part)");
+    if (phi_count != 0 || !direct.empty() || near_field)
+        return file_error("huang2022 tables hold the Huang part and, optionally, a multiple-scattering part (no "
+                          "direct far-field or near-field part)");
+    if (has_multiple()) {
+        if (Status s = first_error(
+                check::count_in_range("theta_r_count", theta_r_count(), 1, kMaxThetaRNodes),
+                check::count_in_range("theta_i_count", theta_i_count, 2, kMaxTableAxisCells),
+                check::count_in_range("n_h count", (long long)n_h_values.size(), 1, kMaxStrandCounts)))
+            return file_error(s->message);
+        if (Status s = validate_axes()) return s;
+        if (Status s = validate_multiple()) return s;
+    } else if (theta_i_count != 0 || !n_h_values.empty() || !multiple.empty())
+        return file_error("a huang2022 multiple-scattering part needs its theta_r nodes, theta_i cells, n_h values "
+                          "and values (some are missing)");
     if (Status s = huang->validate()) return file_error(s->message);
     // Every parameter of a Huang fiber, by name and in order (the staleness check compares them).
     std::string names, expected;

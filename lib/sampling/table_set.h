@@ -17,8 +17,9 @@ namespace hairis {
 
 struct HuangTableSet;  // sampling/huang_table.h
 
-/// Everything a table file holds, as plain data. A huang2022 set holds only its Huang table
-/// (`huang`): no far-field part (every far-field member empty or 0) and no near-field part.
+/// Everything a table file holds, as plain data. A huang2022 set holds its Huang table (`huang`)
+/// and, when baked for dual scattering, the multiple table (theta_r_nodes, theta_i_count,
+/// n_h_values, multiple); never a direct table (phi_count 0, direct empty) or a near-field part.
 struct TableSet {
     std::string model;   ///< "chiang2016", "marschner2003" or "huang2022"
     std::string source;  ///< "exact" (our distributions) or "gaussian" (the seed's PDFs)
@@ -37,7 +38,10 @@ struct TableSet {
 
     int theta_r_count() const { return int(theta_r_nodes.size()); }
     /// True when the set has the far-field part (every model but huang2022).
-    bool has_far_field() const { return !theta_r_nodes.empty(); }
+    bool has_far_field() const { return !theta_r_nodes.empty() && !huang; }
+    /// True when the set has multiple-scattering tables (every far field; huang2022 sets baked
+    /// for dual scattering, TableSet::multiple over theta_r_nodes × n_h_values × theta_i_count).
+    bool has_multiple() const { return !theta_r_nodes.empty(); }
     TableResolution resolution() const { return {theta_r_count(), theta_i_count, phi_count}; }
     float direct_at(int r, int i, int j) const {
         return direct[(size_t(r) * theta_i_count + i) * phi_count + j];
@@ -51,6 +55,8 @@ struct TableSet {
 
   private:
     Status validate_huang() const;
+    Status validate_axes() const;      // θ_r nodes and n_h values
+    Status validate_multiple() const;  // the multiple table's size and values
 };
 
 /// "name=value;..." with values printed to 9 significant digits, in the order given.

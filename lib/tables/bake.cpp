@@ -63,6 +63,19 @@ std::vector<float> theta_r_nodes(int count) {
     return nodes;
 }
 
+Status bake_multiple_slice(const DualScattering &dual, double theta_r, const BakeOptions &options, float *out) {
+    ThetaGridSpec theta_spec;
+    theta_spec.theta_count = options.theta_i_count;
+    theta_spec.quadrature_points = std::max(options.quadrature_points, 2);
+    const size_t n_i = size_t(options.theta_i_count);
+    for (size_t k = 0; k < options.n_h_values.size(); ++k) {
+        Expected<Grid1D> m = multiple_distribution(dual, theta_r, options.n_h_values[k], theta_spec);
+        if (!m) return Error{"multiple distribution: " + m.error().message};
+        for (size_t i = 0; i < n_i; ++i) out[k * n_i + i] = float(m.value().values[i]);
+    }
+    return std::nullopt;
+}
+
 namespace {
 
 Expected<TableSet> bake_in_arena(const FiberModel &model,
@@ -106,14 +119,7 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
             Expected<Grid2D> grid = direct_distribution_relative(model, theta_r, spec);
             if (!grid) return Error{"direct distribution: " + grid.error().message};
             for (size_t c = 0; c < grid.value().values.size(); ++c) direct[c] = float(grid.value().values[c]);
-            ThetaGridSpec theta_spec;
-            theta_spec.theta_count = n_i;
-            theta_spec.quadrature_points = std::max(options.quadrature_points, 2);
-            for (int k = 0; k < n_k; ++k) {
-                Expected<Grid1D> m = multiple_distribution(*dual, theta_r, options.n_h_values[size_t(k)], theta_spec);
-                if (!m) return Error{"multiple distribution: " + m.error().message};
-                for (int i = 0; i < n_i; ++i) multiple[size_t(k) * n_i + i] = float(m.value().values[size_t(i)]);
-            }
+            if (Status s = bake_multiple_slice(*dual, theta_r, options, multiple)) return *s;
         } else {
             const SeedPdfParams &seed = options.seed;
             const int q = options.quadrature_points;

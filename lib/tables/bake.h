@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/expected.h"
+#include "fiber/dual_scattering.h"
 #include "fiber/fiber.h"
 #include "fiber/seed_pdfs.h"
 #include "sampling/huang_table.h"
@@ -34,8 +35,12 @@ struct BakeOptions {
     std::string source = "exact";  ///< "exact" (the model's distributions) or "gaussian"
     SeedPdfParams seed;            ///< the seed's PDFs, for source "gaussian"
     int threads = 0;               ///< 0: all cores
-    /// What a huang2022 fiber bakes instead of everything above but `threads`.
+    /// What a huang2022 fiber bakes instead of the direct tables: its Huang table at this
+    /// resolution (source must be "exact", phi and quadrature_points are unused).
     HuangResolution huang;
+    /// A huang2022 fiber's multiple part (theta_r × n_h × theta_i, for dual scattering); 0
+    /// bakes its Huang table alone (several seconds faster).
+    bool huang_multiple = true;
 
     /// Names the first option out of range.
     Status validate() const;
@@ -51,6 +56,7 @@ void describe(Fields &f, BakeOptions &o) {
     f.field("source", o.source);
     f.field("quadrature_points", o.quadrature_points, 1, 16);
     f.field("threads", o.threads, 0, 1024);
+    f.field("huang_multiple", o.huang_multiple);
     f.field("huang_theta_o", o.huang.theta_o, 1, kMaxThetaRNodes);
     f.field("huang_phi_o", o.huang.phi_o, 1, kMaxPhiONodes);
     f.field("huang_theta_i", o.huang.theta_i, 1, kMaxTableAxisCells);
@@ -64,6 +70,10 @@ std::vector<float> theta_r_nodes(int count);
 
 /// Called with progress in [0, 1]; return false to cancel.
 using ProgressFn = std::function<bool(float)>;
+
+/// The multiple tables of θ_r at `theta_r` for options.n_h_values over options.theta_i_count
+/// cells (TableSet::multiple's [k][i] of one θ_r node), from `dual`, into `out`.
+Status bake_multiple_slice(const DualScattering &dual, double theta_r, const BakeOptions &options, float *out);
 
 /// Bakes direct and multiple tables for `model` whose parameters are `parameters` (recorded
 /// in the metadata); for a huang2022 fiber its Huang table alone, at options.huang's resolution

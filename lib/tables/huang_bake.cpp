@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -138,6 +139,19 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
     return result;
 }
 
+Expected<DualScattering> huang_dual_scattering(const HuangFiber &fiber) {
+    HuangQuadrature rule;
+    rule.first_order = HuangBakeOptions{}.first_order;
+    rule.second_order = HuangBakeOptions{}.second_order;
+    Expected<HuangFiber> evaluated = HuangFiber::create(fiber.params(), rule);
+    if (!evaluated) return evaluated.error();
+    DualScatteringParams params;
+    params.theta_count = 16;
+    params.theta_panels = 8;
+    params.phi_panels = 4;
+    return DualScattering::create(evaluated.value(), params);
+}
+
 Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions &options, const ProgressFn &progress) {
     if (options.source != "exact")
         return Error{"source must be \"exact\" for a huang2022 fiber (got \"" + options.source +
@@ -151,17 +165,46 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
     if (Status s = o.validate()) return Error{"the Huang resolution (huang_theta_o, huang_phi_o, huang_theta_i, huang_phi): " + s->message};
     // The file's image: one row per (φ_o node, θ_o node, θ_i cell), refused before the bake.
     const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count * o.theta_i_count;
-    if (Status s = TableImageSize{o.phi_count, rows}.validate()) return *s;
+    const long long multiple_rows = options.huang_multiple ? (long long)options.theta_r_count * options.theta_i_count : 0;
+    if (Status s = TableImageSize{std::max<long long>(o.phi_count, (long long)options.n_h_values.size()),
+                                  rows + multiple_rows}.validate())
+        return *s;
+    if (options.huang_multiple && options.n_h_values.empty())
+        return Error{"huang_multiple needs at least one n_h value"};
     if (HuangTable::bytes_needed(o.theta_o_count, o.phi_o_count, o.theta_i_count, o.phi_count) > kMaxSamplingTableBytes)
         return Error{"the Huang table (huang_theta_o x huang_phi_o x huang_theta_i x huang_phi) would need more than " +
                      std::to_string(kMaxSamplingTableBytes) + " bytes; bake fewer cells"};
-    Expected<HuangTableSet> baked = bake_huang_table(fiber, o, progress);
+    // The Huang table takes progress to 0.8 when the multiple part follows.
+    const float table_share = options.huang_multiple ? 0.8f : 1.0f;
+    ProgressFn table_progress;
+    if (progress) table_progress = [&](float f) { return progress(f * table_share); };
+    Expected<HuangTableSet> baked = bake_huang_table(fiber, o, table_progress);
     if (!baked) return baked.error();
     TableSet t;
     t.model = fiber.name();
     t.source = "exact";
     t.parameters = baked.value().parameters;
     t.huang = std::make_shared<const HuangTableSet>(std::move(baked).value());
+    if (options.huang_multiple) {
+        tbb::task_arena arena(options.threads > 0 ? options.threads : int(tbb::task_arena::automatic));
+        Expected<DualScattering> dual = Error{"not run"};
+        arena.execute([&] { dual = huang_dual_scattering(fiber); });
+        if (!dual) return Error{"dual scattering: " + dual.error().message};
+        t.theta_r_nodes = theta_r_nodes(options.theta_r_count);
+        t.theta_i_count = options.theta_i_count;
+        t.n_h_values = options.n_h_values;
+        const size_t slice = options.n_h_values.size() * size_t(options.theta_i_count);
+        t.multiple.assign(size_t(options.theta_r_count) * slice, 0.0f);
+        for (int r = 0; r < options.theta_r_count; ++r) {
+            if (progress && !progress(0.9f + 0.1f * float(r) / float(options.theta_r_count)))
+                return Error{"cancelled", ErrorKind::Cancelled};
+            Status s;
+            arena.execute([&] { s = bake_multiple_slice(dual.value(), t.theta_r_nodes[size_t(r)], options,
+                                                        &t.multiple[size_t(r) * slice]); });
+            if (s) return *s;
+        }
+        if (progress && !progress(1.0f)) return Error{"cancelled", ErrorKind::Cancelled};
+    }
     if (Status s = t.validate()) return Error{"the baked Huang table is invalid (a bug): " + s->message};
     return t;
 }

@@ -220,6 +220,7 @@ TEST(HuangBake, BakeTablesOfAHuangFiberIsItsHuangTableSet) {
     const HuangFiber fiber = make_fiber(0.6f);
     BakeOptions o;
     o.huang = {4, 3, 8, 12};
+    o.huang_multiple = false;
     o.threads = 1;
     const Expected<TableSet> one = bake_tables(fiber, huang_parameters(fiber.params()), o);
     ASSERT_TRUE(one.ok()) << one.error().message;
@@ -228,6 +229,7 @@ TEST(HuangBake, BakeTablesOfAHuangFiberIsItsHuangTableSet) {
     const TableSet &t = one.value();
     EXPECT_EQ(t.model, "huang2022");
     EXPECT_FALSE(t.has_far_field());
+    EXPECT_FALSE(t.has_multiple());
     EXPECT_FALSE(t.near_field);
     ASSERT_TRUE(t.huang && two.huang);
     EXPECT_EQ(t.huang->theta_o_nodes.size(), 4u);
@@ -244,6 +246,64 @@ TEST(HuangBake, BakeTablesOfAHuangFiberIsItsHuangTableSet) {
         bake_tables(fiber, huang_parameters(fiber.params()), o, [&](float) { return ++calls < 2; });
     ASSERT_FALSE(cancelled.ok());
     EXPECT_EQ(cancelled.error().kind, ErrorKind::Cancelled);
+}
+
+// The multiple part (huang_multiple): per θ_r node and n_h a density over θ_i (per steradian,
+// unnormalised as for Chiang: MultipleTable normalises), of the shape of the Huang fiber's term
+// multiple_f_cos(θ_i, θ_r, n_h) (evaluated here at cell centres, not through the bake's grid),
+// at the θ_r nodes and n_h values the options give, in their order; the Huang table is the
+// same as without it, and the progress ends after the multiple part.
+TEST(HuangBake, TheMultiplePartIsTheFibersDualScatteringDensity) {
+    const HuangFiber fiber = make_fiber(1.0f);  // circular: one orientation, a quarter of the averages' cost
+    BakeOptions o;
+    o.huang = {4, 1, 8, 12};
+    o.theta_r_count = 5;
+    o.theta_i_count = 24;
+    o.n_h_values = {1, 4};
+    std::vector<float> reported;
+    const Expected<TableSet> baked = bake_tables(fiber, huang_parameters(fiber.params()), o, [&](float f) {
+        reported.push_back(f);
+        return true;
+    });
+    ASSERT_TRUE(baked.ok()) << baked.error().message;
+    const TableSet &t = baked.value();
+    ASSERT_TRUE(t.has_multiple());
+    EXPECT_FALSE(t.has_far_field());
+    EXPECT_EQ(t.theta_r_nodes, theta_r_nodes(5));
+    EXPECT_EQ(t.n_h_values, (std::vector<int>{1, 4}));
+    ASSERT_EQ(t.multiple.size(), 5u * 2u * 24u);
+    ASSERT_FALSE(reported.empty());
+    EXPECT_EQ(reported.back(), 1.0f);
+    for (size_t n = 1; n < reported.size(); ++n) EXPECT_GE(reported[n], reported[n - 1]);
+    BakeOptions alone = o;
+    alone.huang_multiple = false;
+    const TableSet table_only = bake_tables(fiber, huang_parameters(fiber.params()), alone).value();
+    ASSERT_EQ(table_only.huang->values.size(), t.huang->values.size());
+    EXPECT_EQ(std::memcmp(table_only.huang->values.data(), t.huang->values.data(),
+                          t.huang->values.size() * sizeof(float)), 0);
+
+    const DualScattering dual = huang_dual_scattering(fiber).value();
+    for (int r = 0; r < 5; ++r)
+        for (int k = 0; k < 2; ++k) {
+            // Marginal mass per cell: the density times the cell's solid angle 2π (sin θ₁ − sin θ₀).
+            double total = 0.0, reference_total = 0.0;
+            std::vector<double> mass(24), reference(24);
+            for (int i = 0; i < 24; ++i) {
+                const double th0 = -kHalfPi + kPi * i / 24, th1 = -kHalfPi + kPi * (i + 1) / 24;
+                mass[size_t(i)] = t.multiple_at(r, k, i) * kTwoPi * (std::sin(th1) - std::sin(th0));
+                const double mid = 0.5 * (th0 + th1);
+                reference[size_t(i)] = luminance(dual.multiple_f_cos(mid, t.theta_r_nodes[size_t(r)], t.n_h_values[size_t(k)])) *
+                                       kTwoPi * std::cos(mid) * (th1 - th0);
+                total += mass[size_t(i)];
+                reference_total += reference[size_t(i)];
+            }
+            ASSERT_GT(total, 0.0);
+            ASSERT_GT(reference_total, 0.0);
+            // Cell averages against midpoint values: they agree to the curvature inside a cell.
+            double l1 = 0.0;
+            for (int i = 0; i < 24; ++i) l1 += std::fabs(mass[size_t(i)] / total - reference[size_t(i)] / reference_total);
+            EXPECT_LT(l1, 0.03) << "theta_r node " << r << ", n_h " << t.n_h_values[size_t(k)];
+        }
 }
 
 TEST(HuangBake, BakeTablesRefusesWhatAHuangTableSetCannotHold) {

@@ -71,12 +71,15 @@ int band_of_column(int j, int phi_count, int bands) { return int((long long)j * 
 // near-field part's; the width is the widest part's, narrower rows padded with zeros.
 struct Layout {
     int far_rows = 0, near_rows = 0, near_cols = 0;
+    long long huang_rows = 0, multiple_rows = 0;  // huang2022: the Huang part, then the multiple part
     long long width = 0, height = 0;
     static Layout of(const TableSet &t) {
         Layout l;
         if (const HuangTableSet *h = t.huang.get()) {
-            l.width = h->phi_count;
-            l.height = (long long)h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
+            l.huang_rows = (long long)h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
+            l.multiple_rows = t.has_multiple() ? (long long)t.theta_r_count() * t.theta_i_count : 0;
+            l.width = std::max<long long>(h->phi_count, t.has_multiple() ? (long long)t.n_h_values.size() : 0);
+            l.height = l.huang_rows + l.multiple_rows;
             return l;
         }
         l.far_rows = t.theta_r_count() * t.theta_i_count;
@@ -92,17 +95,33 @@ struct Layout {
 
 // The Huang part: row (q·theta_o_count + r)·theta_i_count + i, column j holds R = the value of
 // φ_o node q, θ_o node r, cell (i, j); G = B = 0, A = 1. The values' order is exactly this.
-std::vector<float> huang_pixels_of(const HuangTableSet &h) {
-    std::vector<float> px(h.values.size() * kChannels, 0.0f);
+// The multiple part after it: row huang_rows + r·theta_i_count + i, column k holds G = the
+// multiple table at θ_r node r, n_h value k, θ_i cell i; R = B = 0, A = 1. Padding is 0.
+std::vector<float> huang_pixels_of(const TableSet &t) {
+    const HuangTableSet &h = *t.huang;
+    const Layout l = Layout::of(t);
+    const size_t width = size_t(l.width);
+    std::vector<float> px(width * size_t(l.height) * kChannels, 0.0f);
+    const size_t huang_width = size_t(h.phi_count);
     for (size_t n = 0; n < h.values.size(); ++n) {
-        px[n * kChannels] = h.values[n];
-        px[n * kChannels + 3] = 1.0f;
+        float *p = &px[((n / huang_width) * width + n % huang_width) * kChannels];
+        p[0] = h.values[n];
+        p[3] = 1.0f;
     }
+    const int bands = int(t.n_h_values.size());
+    for (int r = 0; r < (t.has_multiple() ? t.theta_r_count() : 0); ++r)
+        for (int i = 0; i < t.theta_i_count; ++i)
+            for (int k = 0; k < bands; ++k) {
+                const size_t row = size_t(l.huang_rows) + size_t(r) * size_t(t.theta_i_count) + size_t(i);
+                float *p = &px[(row * width + size_t(k)) * kChannels];
+                p[1] = t.multiple_at(r, k, i);
+                p[3] = 1.0f;
+            }
     return px;
 }
 
 std::vector<float> pixels_of(const TableSet &t) {
-    if (t.huang) return huang_pixels_of(*t.huang);
+    if (t.huang) return huang_pixels_of(t);
     const Layout l = Layout::of(t);
     const size_t width = size_t(l.width);
     const int bands = int(t.n_h_values.size());
@@ -291,15 +310,36 @@ Expected<std::vector<float>> float_array(const OIIO::ImageSpec &spec, const char
     return std::vector<float>(values, values + count);
 }
 
-// The Huang part (parts "huang"): the layout of huang_pixels_of, sizes checked before the
-// pixels are read.
-Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t) {
+// The n_h values attribute "1,2,..." (absent: none).
+Expected<std::vector<int>> n_h_values_of(const OIIO::ImageSpec &spec) {
+    std::vector<int> values;
+    const std::string text = spec.get_string_attribute("hairis:n_h_values");
+    if (text.empty()) return values;
+    std::stringstream in_text(text);
+    std::string entry;
+    while (std::getline(in_text, entry, ',')) {
+        char *end = nullptr;
+        const long v = std::strtol(entry.c_str(), &end, 10);
+        if (entry.empty() || *end != '\0' || v < 1 || v > 1024)
+            return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + text + "\")");
+        values.push_back(int(v));
+    }
+    return values;
+}
+
+// The Huang part (parts "huang") and the multiple part after it ("huang,multiple"): the
+// layout of huang_pixels_of, sizes checked before the pixels are read.
+Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple) {
     const OIIO::ImageSpec &spec = in.spec();
-    for (const char *far : {"hairis:theta_r_count", "hairis:theta_i_count", "hairis:phi_count", "hairis:theta_r_nodes",
-                            "hairis:n_h_values", "hairis:near"})
+    for (const char *far : {"hairis:theta_r_count", "hairis:theta_i_count", "hairis:phi_count", "hairis:near"})
         if (spec.find_attribute(far))
-            return file_error(std::string("hairis:parts is \"huang\", which has no far-field or near-field part, "
-                                          "but the file has ") + far);
+            return file_error(std::string("a huang2022 file has no direct far-field or near-field part, but it has ") +
+                              far);
+    if (!multiple)
+        for (const char *part : {"hairis:theta_r_nodes", "hairis:n_h_values", "hairis:multiple"})
+            if (spec.find_attribute(part))
+                return file_error(std::string("hairis:parts is \"huang\", which has no multiple part, but the file "
+                                              "has ") + part);
     const OIIO::ParamValue *attribute = spec.find_attribute("hairis:huang");
     if (!attribute || attribute->type() != TypeDesc::STRING)
         return file_error("hairis:parts is \"huang\" but there is no string attribute hairis:huang "
@@ -322,10 +362,38 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t) {
         return file_error("hairis:huang claims " + std::to_string(rows * h->phi_count) +
                           " cells; a Huang table has at most " + std::to_string(kMaxTableCells) + " cells and " +
                           std::to_string(kMaxSamplingTableBytes) + " bytes");
-    if (Status s = TableImageSize{h->phi_count, rows}.validate()) return file_error(s->message);
-    if (spec.width != h->phi_count || spec.height != rows || spec.depth != 1 || spec.x != 0 || spec.y != 0)
+    long long width = h->phi_count, height = rows;
+    if (multiple) {
+        const OIIO::ParamValue *m = spec.find_attribute("hairis:multiple");
+        if (!m || m->type() != TypeDesc::STRING)
+            return file_error("hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
+                              "(\"row=...;theta_r=...;theta_i=...\")");
+        Expected<OptionReader> mr = OptionReader::parse(spec.get_string_attribute("hairis:multiple"), "hairis:multiple");
+        if (!mr) return file_error(mr.error().message);
+        int multiple_row = -1, theta_r = 0;
+        mr.value().field("row", multiple_row, 0, kMaxTableCells);
+        mr.value().field("theta_r", theta_r, 1, kMaxThetaRNodes);
+        mr.value().field("theta_i", t.theta_i_count, 2, kMaxTableAxisCells);
+        if (Status e = mr.value().finish()) return file_error(e->message);
+        if (multiple_row != rows || theta_r == 0 || t.theta_i_count == 0)
+            return file_error("hairis:multiple must give theta_r and theta_i and start at row " + std::to_string(rows) +
+                              ", after the Huang part");
+        Expected<std::vector<float>> nodes = float_array(spec, "hairis:theta_r_nodes", theta_r);
+        if (!nodes) return nodes.error();
+        t.theta_r_nodes = std::move(nodes).value();
+        Expected<std::vector<int>> n_h = n_h_values_of(spec);
+        if (!n_h) return n_h.error();
+        t.n_h_values = std::move(n_h).value();
+        if (t.n_h_values.empty() || t.n_h_values.size() > size_t(kMaxStrandCounts))
+            return file_error("hairis:n_h_values must give 1 to " + std::to_string(kMaxStrandCounts) +
+                              " strand counts for the multiple part");
+        width = std::max<long long>(width, (long long)t.n_h_values.size());
+        height += (long long)theta_r * t.theta_i_count;
+    }
+    if (Status s = TableImageSize{width, height}.validate()) return file_error(s->message);
+    if (spec.width != width || spec.height != height || spec.depth != 1 || spec.x != 0 || spec.y != 0)
         return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                          " but hairis:huang needs " + std::to_string(h->phi_count) + "x" + std::to_string(rows));
+                          " but the metadata needs " + std::to_string(width) + "x" + std::to_string(height));
     Expected<std::vector<float>> theta_o_nodes = float_array(spec, "hairis:huang_theta_o_nodes", theta_o);
     if (!theta_o_nodes) return theta_o_nodes.error();
     Expected<std::vector<float>> phi_o_nodes = float_array(spec, "hairis:huang_phi_o_nodes", phi_o);
@@ -336,15 +404,30 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t) {
     Expected<std::vector<float>> px = read_pixels(in);
     in.close();
     if (!px) return px.error();
-    const size_t width = size_t(spec.width);
-    h->values.resize(px.value().size() / kChannels);
-    for (size_t n = 0; n < h->values.size(); ++n) {
-        const float *p = &px.value()[n * kChannels];
-        if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
-            return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
-                              pixel_name((long long)(n % width), (long long)(n / width)));
-        h->values[n] = p[0];
-    }
+    const size_t w = size_t(width), huang_width = size_t(h->phi_count), bands = t.n_h_values.size();
+    h->values.resize(size_t(rows) * huang_width);
+    t.multiple.assign(size_t(t.theta_r_count()) * bands * size_t(t.theta_i_count), 0.0f);
+    for (size_t y = 0; y < size_t(height); ++y)
+        for (size_t x = 0; x < w; ++x) {
+            const float *p = &px.value()[(y * w + x) * kChannels];
+            const bool in_huang = y < size_t(rows) && x < huang_width;
+            const bool in_multiple = y >= size_t(rows) && x < bands;
+            if (!in_huang && !in_multiple) {
+                if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
+                    return file_error(pixel_name((long long)x, (long long)y) + " lies outside every part and must be 0");
+            } else if (in_huang) {
+                if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
+                    return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
+                                      pixel_name((long long)x, (long long)y));
+                h->values[y * huang_width + x] = p[0];
+            } else {
+                if (p[0] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
+                    return file_error("R and B must be 0 and A must be 1 in the multiple part at " +
+                                      pixel_name((long long)x, (long long)y));
+                const size_t r = (y - size_t(rows)) / size_t(t.theta_i_count), i = (y - size_t(rows)) % size_t(t.theta_i_count);
+                t.multiple[(r * bands + x) * size_t(t.theta_i_count) + i] = p[1];
+            }
+        }
     h->parameters = t.parameters;
     t.huang = std::move(h);
     if (Status s = t.validate()) return *s;
@@ -373,7 +456,15 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.attribute("hairis:source", t.source);
     spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
     if (const HuangTableSet *h = t.huang.get()) {
-        spec.attribute("hairis:parts", "huang");
+        spec.attribute("hairis:parts", t.has_multiple() ? "huang,multiple" : "huang");
+        if (t.has_multiple()) {
+            spec.attribute("hairis:multiple", format_options({{"row", std::to_string(layout.huang_rows)},
+                                                              {"theta_r", std::to_string(t.theta_r_count())},
+                                                              {"theta_i", std::to_string(t.theta_i_count)}}));
+            spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
+                           t.theta_r_nodes.data());
+            spec.attribute("hairis:n_h_values", join_ints(t.n_h_values));
+        }
         spec.attribute("hairis:huang", format_options({{"row", "0"},
                                                        {"theta_o", std::to_string(h->theta_o_count())},
                                                        {"phi_o", std::to_string(h->phi_o_count())},
@@ -447,13 +538,13 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
         t.parameters.emplace_back(item.substr(0, eq), v);
     }
     const std::string parts = spec.get_string_attribute("hairis:parts");
-    if (parts == "huang") {
+    if (parts == "huang" || parts == "huang,multiple") {
         if (t.model != "huang2022")
-            return file_error("hairis:parts \"huang\" is for model huang2022 (got \"" + t.model + "\")");
-        return decode_huang(*in, std::move(t));
+            return file_error("hairis:parts \"" + parts + "\" is for model huang2022 (got \"" + t.model + "\")");
+        return decode_huang(*in, std::move(t), parts == "huang,multiple");
     }
     if (t.model == "huang2022")
-        return file_error("huang2022 tables have hairis:parts \"huang\" (got \"" + parts + "\")");
+        return file_error("huang2022 tables have hairis:parts \"huang\" or \"huang,multiple\" (got \"" + parts + "\")");
     const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
     t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
     t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
@@ -461,7 +552,8 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
         return file_error(s->message);
     if (parts != "far" && parts != "far,near")
-        return file_error("hairis:parts must be \"far\", \"far,near\" or \"huang\" (got \"" + parts + "\")");
+        return file_error("hairis:parts must be \"far\", \"far,near\", \"huang\" or \"huang,multiple\" (got \"" +
+                          parts + "\")");
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;
     if (parts == "far,near") {
@@ -495,18 +587,9 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     const float *node_values = static_cast<const float *>(nodes->data());
     t.theta_r_nodes.assign(node_values, node_values + theta_r_count);
 
-    const std::string n_h_text = spec.get_string_attribute("hairis:n_h_values");
-    if (!n_h_text.empty()) {
-        std::stringstream in_text(n_h_text);
-        std::string entry;
-        while (std::getline(in_text, entry, ',')) {
-            char *end = nullptr;
-            const long v = std::strtol(entry.c_str(), &end, 10);
-            if (entry.empty() || *end != '\0' || v < 1 || v > 1024)
-                return file_error("hairis:n_h_values must be integers in [1, 1024] (got \"" + n_h_text + "\")");
-            t.n_h_values.push_back(int(v));
-        }
-    }
+    Expected<std::vector<int>> n_h = n_h_values_of(spec);
+    if (!n_h) return n_h.error();
+    t.n_h_values = std::move(n_h).value();
 
     Expected<std::vector<float>> read = read_pixels(*in);
     in->close();

@@ -38,6 +38,7 @@ std::shared_ptr<const HuangFiber> huang_fiber(float aspect_ratio = 0.85f) {
 BakeOptions small_bake() {
     BakeOptions o;
     o.huang = {8, 3, 16, 24};
+    o.huang_multiple = false;  // the multiple part's files are tested with distinct values
     return o;
 }
 
@@ -66,6 +67,16 @@ TableSet distinct_tables(int theta_o = 3, int phi_o = 2, int theta_i = 4, int ph
     t.source = "exact";
     t.parameters = h->parameters;
     t.huang = std::move(h);
+    return t;
+}
+
+// distinct_tables() with a multiple part of distinct values: 3 θ_r nodes, 4 θ_i cells, n_h 1, 4.
+TableSet distinct_with_multiple(int theta_o = 3, int phi_o = 2, int theta_i = 4, int phi = 5) {
+    TableSet t = distinct_tables(theta_o, phi_o, theta_i, phi);
+    t.theta_r_nodes = {-1.0f, 0.25f, 1.1f};
+    t.theta_i_count = 4;
+    t.n_h_values = {1, 4};
+    for (int n = 0; n < 3 * 2 * 4; ++n) t.multiple.push_back(n == 3 ? 0.0f : 2.0f + 0.01f * float(n));
     return t;
 }
 
@@ -142,6 +153,12 @@ void expect_same_huang_part(const TableSet &b, const TableSet &t) {
     EXPECT_EQ(b.huang->phi_count, t.huang->phi_count);
     ASSERT_EQ(b.huang->values.size(), t.huang->values.size());
     EXPECT_EQ(0, std::memcmp(b.huang->values.data(), t.huang->values.data(), t.huang->values.size() * sizeof(float)));
+    EXPECT_EQ(b.has_multiple(), t.has_multiple());
+    EXPECT_EQ(b.theta_r_nodes, t.theta_r_nodes);
+    EXPECT_EQ(b.theta_i_count, t.theta_i_count);
+    EXPECT_EQ(b.n_h_values, t.n_h_values);
+    ASSERT_EQ(b.multiple.size(), t.multiple.size());
+    EXPECT_EQ(0, std::memcmp(b.multiple.data(), t.multiple.data(), t.multiple.size() * sizeof(float)));
 }
 
 TEST(HuangTableFile, RoundTripIsBitExact) {
@@ -175,6 +192,67 @@ TEST(HuangTableFile, TheImageHoldsThePartWhereTheFormatSays) {
                     EXPECT_EQ(image.at(j, y, 2), 0.0f);
                     EXPECT_EQ(image.at(j, y, 3), 1.0f);
                 }
+}
+
+// The multiple part (parts "huang,multiple"): round-trips bit for bit, lies after the Huang
+// part with G = the value of (θ_r node r, θ_i cell i) in column k of n_h_values[k], and the
+// sampling tables built from it have the multiple table (what dual scattering samples).
+TEST(HuangTableFile, TheMultiplePartRoundTripsWhereTheFormatSays) {
+    for (const TableSet &t : {distinct_with_multiple(), distinct_with_multiple(1, 1, 2, 1)}) {
+        const std::vector<unsigned char> bytes = encode(t);
+        const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
+        ASSERT_TRUE(back.ok()) << back.error().message;
+        expect_same_huang_part(back.value(), t);
+        const Expected<SamplingTables> sampling = SamplingTables::from(back.value());
+        ASSERT_TRUE(sampling.ok()) << sampling.error().message;
+        ASSERT_TRUE(sampling.value().multiple && sampling.value().huang);
+        EXPECT_EQ(sampling.value().multiple->n_h_values(), t.n_h_values);
+    }
+    const TableSet t = distinct_with_multiple();
+    Image image = read_image(encode(t));
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:parts"), "huang,multiple");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:multiple"), "row=24;theta_r=3;theta_i=4");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:n_h_values"), "1,4");
+    EXPECT_EQ(image.spec.find_attribute("hairis:theta_r_count"), nullptr);
+    ASSERT_EQ(image.spec.width, 5);
+    ASSERT_EQ(image.spec.height, 24 + 3 * 4);
+    for (int r = 0; r < 3; ++r)
+        for (int i = 0; i < 4; ++i)
+            for (int x = 0; x < 5; ++x) {
+                const int y = 24 + r * 4 + i;
+                const bool cell = x < 2;
+                EXPECT_EQ(image.at(x, y, 0), 0.0f);
+                EXPECT_EQ(image.at(x, y, 1), cell ? t.multiple[size_t((r * 2 + x) * 4 + i)] : 0.0f) << r << i << x;
+                EXPECT_EQ(image.at(x, y, 2), 0.0f);
+                EXPECT_EQ(image.at(x, y, 3), cell ? 1.0f : 0.0f);
+            }
+    // A Huang part wider than n_h: the multiple part is padded; narrower: the Huang part is.
+    Image narrow = read_image(encode(distinct_with_multiple(1, 1, 2, 1)));
+    ASSERT_EQ(narrow.spec.width, 2);
+    EXPECT_EQ(narrow.at(1, 0, 3), 0.0f);
+    EXPECT_EQ(narrow.at(1, 2, 3), 1.0f);
+}
+
+TEST(HuangTableFile, RefusesADamagedMultiplePart) {
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.at(1, 25, 0) = 0.5f; }),
+                   "R and B must be 0 and A must be 1 in the multiple part");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.at(3, 26, 1) = 0.5f; }),
+                   "pixel (3, 26) lies outside every part");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.at(0, 27, 1) = -1.0f; }), "multiple table value");
+    expect_refused(tamper(distinct_with_multiple(),
+                          [](Image &im) { im.spec.attribute("hairis:multiple", "row=23;theta_r=3;theta_i=4"); }),
+                   "start at row 24");
+    expect_refused(tamper(distinct_with_multiple(),
+                          [](Image &im) { im.spec.attribute("hairis:multiple", "row=24;theta_r=4;theta_i=4"); }),
+                   "hairis:theta_r_nodes must hold 4 floats");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.spec.erase_attribute("hairis:n_h_values"); }),
+                   "hairis:n_h_values must give 1 to");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.spec.erase_attribute("hairis:multiple"); }),
+                   "no string attribute hairis:multiple");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.spec.attribute("hairis:parts", "huang"); }),
+                   "which has no multiple part");
+    expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.spec.attribute("hairis:n_h_values", "4,1"); }),
+                   "n_h values must be strictly increasing");
 }
 
 TEST(HuangTableFile, EncodingIsDeterministic) { EXPECT_EQ(encode(baked()), encode(baked())); }
@@ -390,10 +468,22 @@ TEST(HuangTableFile, RefusesParametersThatAreNotAHuangFibers) {
 
 TEST(HuangTableFile, TheSetsRulesAreCheckedBeforeEncoding) {
     TableSet t = distinct_tables();
-    t.theta_r_nodes = {0.0f};
+    t.phi_count = 4;
+    t.direct.assign(4, 1.0f);
     auto far = encode_table_exr(t);
     ASSERT_FALSE(far.ok());
-    EXPECT_NE(far.error().message.find("only the Huang part"), std::string::npos) << far.error().message;
+    EXPECT_NE(far.error().message.find("no direct far-field or near-field part"), std::string::npos)
+        << far.error().message;
+    TableSet partial = distinct_tables();
+    partial.theta_r_nodes = {0.0f};
+    auto half = encode_table_exr(partial);
+    ASSERT_FALSE(half.ok());
+    EXPECT_NE(half.error().message.find("theta_i_count"), std::string::npos) << half.error().message;
+    TableSet counts = distinct_tables();
+    counts.n_h_values = {1};
+    auto no_nodes = encode_table_exr(counts);
+    ASSERT_FALSE(no_nodes.ok());
+    EXPECT_NE(no_nodes.error().message.find("some are missing"), std::string::npos) << no_nodes.error().message;
     TableSet other = distinct_tables();
     other.parameters[6].second = 0.5;  // aspect_ratio, not what the Huang part was baked for
     auto stale = encode_table_exr(other);

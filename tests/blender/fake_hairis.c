@@ -1432,19 +1432,13 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
     if (!s->has_camera)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                     "scene has no camera: call hairis_scene_set_camera before hairis_render");
+    /* Dual scattering samples Huang with the strategy's sampler whatever huang_sampling says. */
     for (int i = 0; i < s->material_count; ++i)
-        if (s->material_is_huang[i] && !r.huang_sampling && r.strategy == 1)
+        if (s->material_is_huang[i] && (!r.huang_sampling || r.integrator == 1) && r.strategy == 1)
             return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
                         "material %d (hair): strategy=analytic has no sampler with a known density "
                         "for a huang2022 fiber; render with strategy=table or uniform",
                         i);
-    if (r.integrator == 1)
-        for (int i = 0; i < s->material_count; ++i)
-            if (s->material_is_huang[i])
-                return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
-                            "material %d (hair): integrator=dual_scattering is for chiang2016 "
-                            "materials (this one is huang2022); render it with integrator=path",
-                            i);
     /* integrator=dual_scattering samples multiple scattering from every hair material's tables. */
     if (r.integrator == 1)
         for (int i = 0; i < s->material_count; ++i) {

@@ -1754,8 +1754,15 @@ static void test_huang(void)
     CHECK(huang_tables != NULL, "Huang tables bake: %s", hairis_last_error());
     CHECK(huang_tables && strcmp(hairis_tables_model(huang_tables), "huang2022") == 0, "model huang2022");
     CHECK(huang_tables && strcmp(hairis_tables_info(huang_tables),
-                                 "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24") == 0,
-          "info \"%s\"", huang_tables ? hairis_tables_info(huang_tables) : "");
+                                 "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;"
+                                 "theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
+          "info \"%s\" (with the multiple part)", huang_tables ? hairis_tables_info(huang_tables) : "");
+    char table_only_options[TEXT];
+    snprintf(table_only_options, TEXT, "%s;huang_multiple=0", small);
+    hairis_tables *table_only = hairis_tables_bake(huang, table_only_options, NULL, NULL);
+    CHECK(table_only && strcmp(hairis_tables_info(table_only),
+                               "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24") == 0,
+          "huang_multiple=0: the Huang table alone, \"%s\"", table_only ? hairis_tables_info(table_only) : "");
     CHECK(hairis_tables_match_fiber(huang_tables, huang) == 1, "they match their fiber");
     hairis_fiber *rounder = hairis_fiber_create("model=huang;aspect_ratio=0.6;transmission=0.5");
     hairis_fiber *dimmer = hairis_fiber_create("model=huang;aspect_ratio=0.5;transmission=0.4");
@@ -1834,12 +1841,41 @@ static void test_huang(void)
     CHECK(mean[0] > 0.0 && fabs(mean[0] - mean[1]) <= 4.0 * sqrt(error2),
           "TABLE and UNIFORM agree in the mean: %g and %g (standard error of the difference %g)", mean[0], mean[1],
           sqrt(error2));
-    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering"), rgba, NULL, NULL) ==
-              HAIRIS_ERROR_INVALID_ARGUMENT,
-          "dual scattering refused for Huang");
-    CHECK_ERROR_MENTIONS("material 0");
-    CHECK_ERROR_MENTIONS("chiang2016");
+    /* Dual scattering renders Huang hair with the tables' multiple part, sampling it with the
+     * Huang table whatever huang_sampling says (its MIS needs the sampler's density); tables
+     * without the multiple part are refused naming the material and what to do. */
+    static float dual[W * H * 4], path[W * H * 4];
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;seed=3"), dual, NULL, NULL) ==
+              HAIRIS_OK,
+          "dual scattering renders Huang: %s", hairis_last_error());
+    CHECK(pixels_ok(dual) && pixel_sum(dual, W * H) > 0.0, "dual Huang: a finite, non-black image");
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;seed=3;huang_sampling=cycles"),
+                        rgba, NULL, NULL) == HAIRIS_OK,
+          "dual scattering with huang_sampling=cycles: %s", hairis_last_error());
+    CHECK(memcmp(rgba, dual, sizeof rgba) == 0, "dual scattering samples Huang with its table either way");
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";seed=3"), path, NULL, NULL) == HAIRIS_OK,
+          "path tracing the same scene");
+    CHECK(memcmp(path, dual, sizeof path) != 0, "dual scattering is not the path tracer for Huang");
+    CHECK(hairis_render(tabled, tiny_settings(s, "analytic", ";integrator=dual_scattering;huang_sampling=cycles"),
+                        rgba, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
+          "dual scattering with analytic is refused for Huang, whatever huang_sampling says");
+    CHECK_ERROR_MENTIONS("strategy=analytic");
     hairis_scene_destroy(tabled);
+    hairis_scene *old = hairis_scene_create();
+    CHECK(hairis_scene_add_hair_material(old, huang, table_only) == 0, "Huang material with the table alone");
+    CHECK(add_oriented_strands(old, 0, up, "") == HAIRIS_OK && hairis_scene_set_camera(old, CAMERA) == HAIRIS_OK &&
+              hairis_scene_set_world(old, SKY) == HAIRIS_OK,
+          "its curves, camera and world");
+    CHECK(hairis_render(old, tiny_settings(s, "table", ""), rgba, NULL, NULL) == HAIRIS_OK,
+          "the table alone path-traces: %s", hairis_last_error());
+    CHECK(hairis_render(old, tiny_settings(s, "table", ";integrator=dual_scattering"), rgba, NULL, NULL) ==
+              HAIRIS_ERROR_INVALID_TABLE,
+          "dual scattering without the multiple part is refused");
+    CHECK_ERROR_MENTIONS("material 0");
+    CHECK_ERROR_MENTIONS("no multiple-scattering part");
+    CHECK_ERROR_MENTIONS("bake them again");
+    hairis_scene_destroy(old);
+    hairis_tables_destroy(table_only);
 
     /* Tables of other parameters, or of another model, are refused naming the material. */
     hairis_fiber *chiang = hairis_fiber_create("");
