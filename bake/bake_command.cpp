@@ -87,7 +87,10 @@ int run_bake(const BakeFlags &flags) {
         std::cerr << "hairis-bake bake: wrote " << flags.output << " (" << t.model << ", ";
         if (t.huang)
             std::cerr << t.huang->theta_o_count() << " theta_o x " << t.huang->phi_o_count() << " phi_o nodes, "
-                      << t.huang->theta_i_count << " x " << t.huang->phi_count << " cells";
+                      << t.huang->theta_i_count << " x " << t.huang->phi_count << " cells"
+                      << (t.has_multiple() ? ", multiple part " + std::to_string(t.theta_r_count()) + " x " +
+                                                 std::to_string(t.theta_i_count)
+                                           : std::string());
         else
             std::cerr << t.theta_r_count() << " x " << t.theta_i_count << " x " << t.phi_count;
         std::cerr << ", " << seconds << " s)\n";
@@ -122,6 +125,9 @@ void add_bake_command(CLI::App &app, int &exit_code) {
         ->check(CLI::Range(1, kMaxTableAxisCells))->capture_default_str();
     cmd->add_option("--huang-phi", b.huang.phi, "Huang fibers: phi_i - phi_o cells over [-180, 180] degrees")
         ->check(CLI::Range(1, kMaxTableAxisCells))->capture_default_str();
+    cmd->add_flag("!--no-huang-multiple", b.huang_multiple,
+                  "Huang fibers: bake the Huang table alone, without the multiple-scattering part that "
+                  "integrator=dual_scattering samples (it takes several seconds)");
     cmd->add_option("--threads", b.threads, "worker threads, 0 for all cores (the output does not depend on it)")
         ->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--output,-o", flags->output, "the EXR file to write (atomically)")->required();

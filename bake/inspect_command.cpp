@@ -40,9 +40,23 @@ int run_inspect(const std::string &path) {
         std::printf("  huang  rows 0-%d: %d phi_o nodes x %d theta_o nodes x %d theta_i cells, %d phi cells "
                     "(R cell value of luminance(f cos theta_i))\n",
                     rows - 1, h->phi_o_count(), h->theta_o_count(), h->theta_i_count, h->phi_count);
-        std::printf("cells:           %zu\n", h->values.size());
-        std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", h->phi_count, rows,
-                    double(h->phi_count) * rows * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
+        int width = h->phi_count, height = rows;
+        if (s.has_multiple()) {
+            const int multiple_rows = s.theta_r_count() * s.theta_i_count, bands = int(s.n_h_values.size());
+            std::printf("  multiple  rows %d-%d: %d theta_r nodes (%.2f .. %.2f deg) x %d theta_i cells, columns "
+                        "n_h =",
+                        rows, rows + multiple_rows - 1, s.theta_r_count(), degrees(s.theta_r_nodes.front()),
+                        degrees(s.theta_r_nodes.back()), s.theta_i_count);
+            for (int n : s.n_h_values) std::printf(" %d", n);
+            std::printf(" (G multiple-scattering density; integrator=dual_scattering samples it)\n");
+            width = std::max(width, bands);
+            height += multiple_rows;
+        } else {
+            std::printf("  (no multiple part: integrator=dual_scattering needs a bake without --no-huang-multiple)\n");
+        }
+        std::printf("cells:           %zu\n", h->values.size() + s.multiple.size());
+        std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", width, height,
+                    double(width) * height * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
         std::printf("sampling table:  %.1f MB\n",
                     double(HuangTable::bytes_needed(h->theta_o_count(), h->phi_o_count(), h->theta_i_count,
                                                     h->phi_count)) / 1e6);

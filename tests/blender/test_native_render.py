@@ -171,6 +171,40 @@ def test_dual_scattering_renders():
         assert 0.5 < ratio < 2.0, ratio
 
 
+def test_dual_scattering_renders_huang():
+    """Blender 4.0+: the Hair material switched to the Huang model (Blender's default since
+    4.0) renders with Dual Scattering under the default Huang Sampling (Cycles), auto-baking
+    Huang tables with their multiple part: finite, not black, and within a factor of two of
+    the path tracer's image mean."""
+    if bpy.app.version < (4, 0, 0):
+        print("skipped: Blender %s has no Huang model" % bpy.app.version_string)
+        return
+    node = next(n for n in bpy.data.materials["Hair"].node_tree.nodes
+                if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
+    node.model = "HUANG"
+    auto_bake = SCENE.hairis.auto_bake
+    SCENE.hairis.auto_bake = True
+    SCENE.hairis.huang_sampling = "CYCLES"
+    means = {}
+    try:
+        for integrator in ("PATH", "DUAL_SCATTERING"):
+            SCENE.hairis.integrator = integrator
+            SCENE.hairis.strategy = "TABLE"
+            SCENE.hairis.samples = 16
+            pixels = f12_pixels("huang_integrator_%s" % integrator)
+            assert np.all(np.isfinite(pixels)), integrator
+            means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
+    finally:
+        node.model = "CHIANG"
+        SCENE.hairis.integrator = "PATH"
+        SCENE.hairis.auto_bake = auto_bake
+    assert means["DUAL_SCATTERING"] > 1e-3, "dual scattering rendered Huang black"
+    if not FAKE:
+        ratio = means["DUAL_SCATTERING"] / means["PATH"]
+        print("Huang: dual scattering / path image mean: %.3f" % ratio)
+        assert 0.5 < ratio < 2.0, ratio
+
+
 def test_strategies_agree():
     """Every strategy's mean image agrees with ANALYTIC's within the per-tile noise bound.
 
@@ -314,6 +348,7 @@ helpers.run([
     test_bake_operator,
     test_each_strategy_renders,
     test_dual_scattering_renders,
+    test_dual_scattering_renders_huang,
     test_strategies_agree,
     test_convergence,
     test_cancel_within_one_second,

@@ -60,10 +60,13 @@ class HairisBakeTest(unittest.TestCase):
         out, again = self.path("h.exr"), self.path("h2.exr")
         small = ["--huang-theta-o", "6", "--huang-phi-o", "3", "--huang-theta-i", "12",
                  "--huang-phi", "16"]
-        r = run("bake", "--preset", "cycles-default-huang", *small, "--threads", "1", "-o", out)
+        r = run("bake", "--preset", "cycles-default-huang", *small, "--no-huang-multiple",
+                "--threads", "1", "-o", out)
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertIn("huang2022, 6 theta_o x 3 phi_o nodes, 12 x 16 cells", r.stderr)
-        r = run("bake", "--set", "model=huang", *small, "--threads", "2", "-q", "-o", again)
+        self.assertIn("huang2022, 6 theta_o x 3 phi_o nodes, 12 x 16 cells,", r.stderr)
+        self.assertNotIn("multiple part", r.stderr)
+        r = run("bake", "--set", "model=huang", *small, "--no-huang-multiple", "--threads", "2",
+                "-q", "-o", again)
         self.assertEqual(r.returncode, 0, r.stderr)
         with open(out, "rb") as fa, open(again, "rb") as fb:
             self.assertEqual(fa.read(), fb.read(), "the Huang bake depends on the thread count")
@@ -75,6 +78,19 @@ class HairisBakeTest(unittest.TestCase):
                      "cells:           3456", "image:           16 x 216", "valid:           yes"]:
             self.assertIn(text, r.stdout)
         self.assertNotIn("far    rows", r.stdout)
+        self.assertIn("(no multiple part", r.stdout)
+        # With the multiple part (the default): after the Huang part, one column per n_h.
+        multiple = self.path("hm.exr")
+        r = run("bake", "--set", "model=huang", *small, "--theta-r", "4", "--theta-i", "8",
+                "--n-h", "1,4", "--threads", "2", "-o", multiple)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("12 x 16 cells, multiple part 4 x 8", r.stderr)
+        r = run("inspect", multiple)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for text in ["multiple  rows 216-247: 4 theta_r nodes (-67.50 .. 67.50 deg) x 8 theta_i "
+                     "cells, columns n_h = 1 4", "cells:           3520",
+                     "image:           16 x 248", "valid:           yes"]:
+            self.assertIn(text, r.stdout)
         r = run("bake", "--set", "model=huang", "--source", "gaussian", "-q", "-o", again)
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("huang2022", r.stderr)
