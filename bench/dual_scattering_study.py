@@ -68,9 +68,16 @@ SEEDS = (1, 2)
 COLOURS = {"blonde": 0.1, "brunette": 0.5, "black": 0.9}
 LIGHTINGS = ("sun", "area")
 ALL_CASES = ["%s_%s" % (c, light) for light in LIGHTINGS for c in COLOURS]
+# Diagnostic lightings (not in the default cases): "world" and "sunonly", the sun case's two
+# emitters alone.
 CASES = os.environ.get("HAIRIS_DUAL_CASES", ",".join(ALL_CASES)).split(",")
 METHODS = ("DUAL", "PATH", "CYCLES")
 MODEL = os.environ.get("HAIRIS_DUAL_MODEL", "CHIANG")
+# Diagnostic: the Huang node's Aspect Ratio (HAIRIS_DUAL_HUANG_ASPECT; Blender's default 0.85).
+HUANG_ASPECT = (float(os.environ["HAIRIS_DUAL_HUANG_ASPECT"])
+                if "HAIRIS_DUAL_HUANG_ASPECT" in os.environ else None)
+# Diagnostic: the sphere's diffuse colour (HAIRIS_DUAL_SKIN=r,g,b; 0,0,0 removes its light).
+SKIN = tuple(float(v) for v in os.environ.get("HAIRIS_DUAL_SKIN", "0.7,0.5,0.4").split(","))
 if MODEL not in ("CHIANG", "HUANG"):
     raise SystemExit("HAIRIS_DUAL_MODEL must be CHIANG or HUANG (got %r)" % MODEL)
 if MODEL == "HUANG" and bpy.app.version < (4, 0, 0):
@@ -100,6 +107,12 @@ def make_case_scene(colour, lighting):
         helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
         helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(1.0),
                            rotation=(math.radians(40), 0.0, math.radians(35)))
+    elif lighting == "world":  # diagnostic: the sun case's world alone
+        helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+    elif lighting == "sunonly":  # diagnostic: the sun case's sun alone
+        helpers.make_world(scene, color=(0.0, 0.0, 0.0), strength=0.0)
+        helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(1.0),
+                           rotation=(math.radians(40), 0.0, math.radians(35)))
     else:
         helpers.make_world(scene, color=(0.0, 0.0, 0.0), strength=0.0)
         light = helpers.make_light(scene, "AREA", "Panel", location=(2.0, -2.2, 2.6),
@@ -113,7 +126,9 @@ def make_case_scene(colour, lighting):
         for node in hair.node_tree.nodes:
             if node.bl_idname == "ShaderNodeBsdfHairPrincipled":
                 node.model = "HUANG"
-    skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
+                if HUANG_ASPECT is not None:
+                    helpers.socket(node, "Aspect Ratio").default_value = HUANG_ASPECT
+    skin = helpers.make_diffuse_material("Skin", SKIN + (1.0,))
     sphere = helpers.make_particle_hair(scene, count=1500, children=8, location=(0.0, 0.0, 0.0),
                                         scale=1.0, hair_material=hair, skin_material=skin)
     settings = sphere.modifiers["Hair"].particle_system.settings
@@ -275,7 +290,8 @@ def main():
                "settings": {"resolution": list(RESOLUTION), "bounces": BOUNCES,
                             "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
                             "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
-                            "threads": 1, "probe": PROBE, "model": MODEL},
+                            "threads": 1, "probe": PROBE, "model": MODEL,
+                            "skin": list(SKIN)},
                "cases": cases}
     os.makedirs(OUT, exist_ok=True)
     suffix = "_probe" if PROBE else ""

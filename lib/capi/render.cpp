@@ -74,20 +74,18 @@ HairShading hair_shading(const SceneHairMaterial &hair, size_t index, const Samp
     return std::move(shading).value();
 }
 
-// A fiber's dual-scattering averages (about a second of quadrature for Chiang, several for
-// Huang: huang_dual_scattering), kept for the process by model and parameters: the add-on
-// builds a new scene for every render. At most kDualCacheSize fibers are kept; the oldest goes
-// first.
+// A Chiang fiber's dual-scattering averages (about a second of quadrature), kept for the
+// process by model and parameters: the add-on builds a new scene for every render. At most
+// kDualCacheSize fibers are kept; the oldest goes first. (Huang's: huang_dual_scattering.)
 constexpr std::size_t kDualCacheSize = 64;
-std::shared_ptr<const DualScattering> dual_scattering_of(const std::string &key,
-                                                         const std::function<Expected<DualScattering>()> &make,
-                                                         const std::string &name) {
+std::shared_ptr<const DualScattering> dual_scattering_of(const ChiangFiber &fiber, const std::string &name) {
     static std::mutex mutex;
     static std::deque<std::pair<std::string, std::shared_ptr<const DualScattering>>> cache;
+    const std::string key = fiber.name() + ":" + canonical_parameters(chiang_parameters(fiber.params()));
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto &entry : cache)
         if (entry.first == key) return entry.second;
-    Expected<DualScattering> made = make();
+    Expected<DualScattering> made = DualScattering::create(fiber, DualScatteringParams{});
     if (!made) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + made.error().message);
     auto dual = std::make_shared<const DualScattering>(std::move(made).value());
     if (cache.size() == kDualCacheSize) cache.pop_front();
@@ -114,14 +112,12 @@ void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, 
         refuse(HAIRIS_ERROR_INVALID_TABLE, name + "these " + model + " tables have no multiple-scattering part "
                                                "(baked with huang_multiple=0 or by hairis before dual scattering "
                                                "covered Huang); bake them again, or render with integrator=path");
-    const std::string key = model + ":" + parameters;
     if (hair.huang) {
-        const HuangFiber &fiber = *hair.huang;
-        material.dual = dual_scattering_of(key, [&] { return huang_dual_scattering(fiber); }, name);
+        Expected<std::shared_ptr<const DualScattering>> dual = huang_dual_scattering(*hair.huang);
+        if (!dual) refuse(HAIRIS_ERROR_INTERNAL, name + "dual scattering: " + dual.error().message);
+        material.dual = std::move(dual).value();
     } else {
-        const ChiangFiber &fiber = *hair.fiber;
-        material.dual = dual_scattering_of(key, [&] { return DualScattering::create(fiber, DualScatteringParams{}); },
-                                           name);
+        material.dual = dual_scattering_of(*hair.fiber, name);
     }
     material.multiple = hair.tables->multiple;
 }

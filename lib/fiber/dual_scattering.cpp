@@ -76,6 +76,7 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
     const std::size_t nk = std::size_t(K);
     const std::size_t nl = std::size_t(lobes);
     ds.a_f_lobe_.assign(nl * nk, {});
+    ds.pass_.assign(nk, 0.0);
     ds.a_b_lobe_.assign(nl * nk, {});
     ds.n_g_lobe_.assign(nl * nk, {});
 
@@ -117,14 +118,20 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             std::fill(af.begin(), af.end(), Rgbd{});
             std::fill(ab.begin(), ab.end(), Rgbd{});
             Moments *mk = &moments[std::size_t(k)];  // lobe p at mk[p * nk]
+            double pass = 0;  // the unscattered share of the light's crossings (projected_width)
             for (const double phi_l : orient) {
                 const std::unique_ptr<const FarFieldView> view = model.view(dir(theta_k, phi_l));
+                // f is per hit on the fiber; a crossing meets it on a fraction `width` of the
+                // curve's width and passes unscattered elsewhere.
+                const double width = std::clamp(model.projected_width(dir(theta_k, phi_l)), 0.0, 1.0);
+                pass += (1.0 - width) / double(orient.size());
+                const double lobe_scale = weight_scale * width;
                 if (view->separable()) {
                     // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
                     for (int p = 0; p < lobes; ++p) {
                         double longitudinal = 0;
                         for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
-                            lw[m] = theta_rule.w[m] * std::cos(theta_rule.x[m]) * weight_scale *
+                            lw[m] = theta_rule.w[m] * std::cos(theta_rule.x[m]) * lobe_scale *
                                     view->longitudinal(p, theta_rule.x[m]);
                             longitudinal += lw[m];
                         }
@@ -147,7 +154,7 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 }
                 for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
                     const double th = theta_rule.x[m];
-                    const double wm = theta_rule.w[m] * std::cos(th) * weight_scale;
+                    const double wm = theta_rule.w[m] * std::cos(th) * lobe_scale;
                     const double theta_h = 0.5 * (th + theta_k);
                     for (int half = 0; half < 2; ++half) {
                         const QuadratureRule &rule = half == 0 ? fwd : back;
@@ -170,6 +177,7 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 ds.a_f_lobe_[p * nk + std::size_t(k)] = af[p];
                 ds.a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
             }
+            ds.pass_[std::size_t(k)] = pass;
         }
     });
 
@@ -264,6 +272,8 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 mean_alpha += al / double(nl);
                 mean_beta2 += be2 / double(nl);
             }
+            // Light that passes a crossed fiber unscattered goes on forward, undeflected.
+            sf += ds.pass_[k];
             const double a_f = sf, a_b = sb;
             const double alpha_f = sf > 0 ? alf / sf : mean_alpha;
             const double alpha_b = sb > 0 ? alb / sb : mean_alpha;
@@ -328,6 +338,15 @@ Rgb DualScattering::lobe_forward_attenuation(int p, double theta) const {
 Rgb DualScattering::lobe_backward_attenuation(int p, double theta) const {
     if (p < 0 || p >= lobe_count_) return {};
     return to_rgb(lookup(a_b_lobe_, theta, std::size_t(p) * std::size_t(params_.theta_count)));
+}
+double DualScattering::pass_through(double theta) const {
+    const int K = params_.theta_count;
+    const double t = (theta + kHalfPi) * K / kPi - 0.5;  // fractional node index, as lookup()
+    if (!(t > 0)) return pass_.front();
+    if (t >= K - 1) return pass_.back();
+    const int i = int(t);
+    const double f = t - i;
+    return (1 - f) * pass_[std::size_t(i)] + f * pass_[std::size_t(i) + 1];
 }
 Rgb DualScattering::lobe_forward_azimuthal(int p, double theta_d) const {
     if (p < 0 || p >= lobe_count_) return {};

@@ -15,8 +15,14 @@
 //
 //   a_f,p(θ_L) = <∫_{|φ−φ_L|>π/2} f_p(ω, ω_L) |cos θ| dω>_{φ_L}   forward fraction of lobe p
 //   a_b,p(θ_L) = <∫_{|φ−φ_L|<π/2} f_p(ω, ω_L) |cos θ| dω>_{φ_L}   backward fraction of lobe p
-//   ā_f = Σ_p a_f,p,  ā_b = Σ_p a_b,p          (paper eqs. 6 and 11; <·>_{φ_L} averages the
+//   ā_f = Σ_p a_f,p + t,  ā_b = Σ_p a_b,p      (paper eqs. 6 and 11; <·>_{φ_L} averages the
 //                                               light's azimuth around an eccentric fiber)
+//         DECISION: a crossing meets a Huang fiber only on its projected ellipse, a fraction
+//         w(ω_L) = FiberModel::projected_width of the curve's width (Cycles makes hits outside
+//         it transparent), and f is per hit on the fiber. So each a_f,p and a_b,p carries the
+//         factor w(ω_L) inside the azimuthal average, and t = <1 − w(ω_L)>_{φ_L}, the light
+//         that goes on unscattered, joins ā_f with shift 0 and width 0 (it dilutes ᾱ_f and
+//         β̄_f² below). w = 1 (t = 0) for Chiang and Marschner.
 //         DECISION: light from ω_L scatters into ω with f(ω_L, ω); by reciprocity we integrate
 //         f(ω, ω_L) instead, i.e. lobe_f_cos(p, ω, ω_L) over ω with ω_L in the viewer's slot:
 //         the white-furnace integral the models are built to keep ≤ 1. Cycles/Chiang's f·cos θ_i
@@ -138,6 +144,9 @@ class DualScattering {
     // --- Per-lobe precomputed quantities (θ = light inclination θ_L unless noted) ---------
     Rgb lobe_forward_attenuation(int p, double theta) const;   ///< a_f,p
     Rgb lobe_backward_attenuation(int p, double theta) const;  ///< a_b,p
+    /// 1 − FiberModel::projected_width averaged over the light's azimuths: the share of a
+    /// crossing the light passes unscattered (0 for a fiber that fills its curve).
+    double pass_through(double theta) const;
     /// N_p^G at Marschner's difference angle θ_d (see the header comment).
     Rgb lobe_forward_azimuthal(int p, double theta_d) const;
     /// α_p, β_p: the model's, or measured (see "Measured lobe shapes" above).
@@ -212,6 +221,7 @@ class DualScattering {
     std::vector<LobeShape> shapes_;
     // Per lobe, per θ node (index p * theta_count + k).
     std::vector<Rgbd> a_f_lobe_, a_b_lobe_, n_g_lobe_;
+    std::vector<double> pass_;  // per θ node: the unscattered share of a crossing (1 − projected width)
     // Per θ node.
     std::vector<Rgbd> a_f_, a_b_, alpha_f_, alpha_b_, beta2_f_, beta2_b_;
     std::vector<Rgbd> big_a_b_, delta_b_, sigma2_b_;

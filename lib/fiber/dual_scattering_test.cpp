@@ -591,6 +591,42 @@ TEST(DualScatteringRealModels, HuangLobeShapesAreMeasured) {
     }
 }
 
+// A crossing meets an elliptic Huang fiber only on its projected ellipse: the share the light
+// passes, averaged over the light's azimuths φ_j around the fiber, is 1 − the ellipse's
+// support function √(sin²φ + a² cos²φ) (major axis 1 along y, minor a along z), and it is the
+// part of ā_f no lobe carries; a circular fiber passes nothing.
+TEST(DualScatteringRealModels, HuangCrossingsPassOutsideTheProjectedEllipse) {
+    HuangQuadrature rule;
+    rule.first_order = 3;
+    rule.second_order = 2;
+    DualScatteringParams params;
+    params.theta_count = 6;
+    params.theta_panels = 6;
+    params.phi_panels = 3;
+    params.orientation_count = 3;
+    for (const float aspect : {0.6f, 1.0f}) {
+        HuangParams p;
+        p.aspect_ratio = aspect;
+        const HuangFiber fiber = HuangFiber::create(p, rule).value();
+        const DualScattering ds = DualScattering::create(fiber, params).value();
+        for (int k = 0; k < params.theta_count; ++k) {
+            const double theta = ds.table_theta(k);
+            double expected = 0;
+            for (int j = 0; j < 3; ++j) {
+                const double phi = -kPi + (j + 0.5) * kTwoPi / 3;
+                expected += (1.0 - std::sqrt(sqr(std::sin(phi)) + sqr(double(aspect)) * sqr(std::cos(phi)))) / 3;
+            }
+            EXPECT_NEAR(ds.pass_through(theta), expected, 1e-6) << "aspect " << aspect << ", node " << k;
+            Rgb lobes;
+            for (int l = 0; l < ds.lobe_count(); ++l) lobes += ds.lobe_forward_attenuation(l, theta);
+            const Rgb a_f = ds.forward_attenuation(theta);
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(a_f[c] - lobes[c], expected, 1e-5) << "aspect " << aspect;
+        }
+        if (aspect == 1.0f) EXPECT_EQ(ds.pass_through(0.0), 0.0);
+        else EXPECT_GT(ds.pass_through(0.0), 0.05);
+    }
+}
+
 TEST(DualScatteringRealModels, MarschnerBlonde) {
     Expected<MarschnerFiber> fiber = MarschnerFiber::create(MarschnerParams::blonde());
     ASSERT_TRUE(fiber.ok()) << fiber.error().message;

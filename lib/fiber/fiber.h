@@ -75,6 +75,12 @@ class FiberModel {
     /// True when f depends on φ_i and φ_o only through φ_i − φ_o (false for an elliptical
     /// Marschner fiber, whose response also depends on the half angle).
     virtual bool rotationally_symmetric() const { return true; }
+
+    /// The fraction of the fiber's width (its curve's radius, offsets h ∈ [−1, 1]) that a ray
+    /// along ±w meets the fiber in, in [0, 1]; rays through the rest pass unscattered. 1 for a
+    /// fiber that fills its curve; Huang's ellipse seen along w (Cycles makes hits outside it
+    /// transparent). f is per hit inside that fraction.
+    virtual double projected_width(Vec3 /*w*/) const { return 1.0; }
 };
 
 }  // namespace hairis

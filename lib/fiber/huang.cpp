@@ -490,6 +490,13 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
     return out;
 }
 
+double HuangFiber::projected_width(Vec3 w) const {
+    const double e2 = 1.0 - aspect_ * aspect_;
+    const double y2 = double(w.y) * w.y, across = y2 + double(w.z) * w.z;
+    if (e2 == 0.0 || !(across > 0.0)) return 1.0;
+    return std::sqrt(std::max(0.0, 1.0 - e2 * y2 / across));
+}
+
 std::unique_ptr<const FarFieldView> HuangFiber::view(Vec3 wo) const {
     return std::make_unique<HuangFarField>(*this, wo, far_field_);
 }

@@ -226,6 +226,9 @@ class HuangFiber final : public FiberModel, public ShadingModel {
     bool lobe_shapes_analytic() const override { return false; }
     /// True only for aspect ratio 1.
     bool rotationally_symmetric() const override { return aspect_ == 1.0; }
+    /// √(1 − e² w_y² / (w_y² + w_z²)), e² = 1 − aspect²: the projected radius Cycles'
+    /// make_view compares |h| with (1 along the fiber's axis).
+    double projected_width(Vec3 w) const override;
 
     /// The point for the renderer (in scratch).
     bool reads_orientation() const override { return true; }

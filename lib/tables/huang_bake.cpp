@@ -7,6 +7,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -60,6 +65,9 @@ std::vector<float> huang_phi_o_nodes(int count) {
 }
 
 namespace {
+
+// huang_dual_scattering keeps the averages of this many fibers (the oldest goes first).
+constexpr std::size_t kHuangDualCacheSize = 16;
 
 Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOptions &o, const ProgressFn &progress) {
     HuangTableSet t;
@@ -139,7 +147,13 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
     return result;
 }
 
-Expected<DualScattering> huang_dual_scattering(const HuangFiber &fiber) {
+Expected<std::shared_ptr<const DualScattering>> huang_dual_scattering(const HuangFiber &fiber) {
+    static std::mutex mutex;
+    static std::deque<std::pair<std::string, std::shared_ptr<const DualScattering>>> cache;
+    const std::string key = canonical_parameters(huang_parameters(fiber.params()));
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto &entry : cache)
+        if (entry.first == key) return entry.second;
     HuangQuadrature rule;
     rule.first_order = HuangBakeOptions{}.first_order;
     rule.second_order = HuangBakeOptions{}.second_order;
@@ -149,7 +163,12 @@ Expected<DualScattering> huang_dual_scattering(const HuangFiber &fiber) {
     params.theta_count = 16;
     params.theta_panels = 8;
     params.phi_panels = 4;
-    return DualScattering::create(evaluated.value(), params);
+    Expected<DualScattering> made = DualScattering::create(evaluated.value(), params);
+    if (!made) return made.error();
+    auto dual = std::make_shared<const DualScattering>(std::move(made).value());
+    if (cache.size() == kHuangDualCacheSize) cache.pop_front();
+    cache.emplace_back(key, dual);
+    return dual;
 }
 
 Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions &options, const ProgressFn &progress) {
@@ -187,7 +206,7 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
     t.huang = std::make_shared<const HuangTableSet>(std::move(baked).value());
     if (options.huang_multiple) {
         tbb::task_arena arena(options.threads > 0 ? options.threads : int(tbb::task_arena::automatic));
-        Expected<DualScattering> dual = Error{"not run"};
+        Expected<std::shared_ptr<const DualScattering>> dual = Error{"not run"};
         arena.execute([&] { dual = huang_dual_scattering(fiber); });
         if (!dual) return Error{"dual scattering: " + dual.error().message};
         t.theta_r_nodes = theta_r_nodes(options.theta_r_count);
@@ -199,7 +218,7 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
             if (progress && !progress(0.9f + 0.1f * float(r) / float(options.theta_r_count)))
                 return Error{"cancelled", ErrorKind::Cancelled};
             Status s;
-            arena.execute([&] { s = bake_multiple_slice(dual.value(), t.theta_r_nodes[size_t(r)], options,
+            arena.execute([&] { s = bake_multiple_slice(*dual.value(), t.theta_r_nodes[size_t(r)], options,
                                                         &t.multiple[size_t(r) * slice]); });
             if (s) return *s;
         }

@@ -46,8 +46,10 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
 /// (4, 3) and a coarser quadrature than DualScatteringParams' default (16 θ nodes, 8 θ and 4 φ
 /// panels), which agrees with the default one to 0.1% in ā_f, ā_b and Ā_b on Blender's default
 /// node at a tenth of the cost (about 12 s on 2 cores for an elliptic fiber, a quarter of that
-/// for a circular one). Runs on the calling thread's arena.
-Expected<DualScattering> huang_dual_scattering(const HuangFiber &fiber);
+/// for a circular one). Runs on the calling thread's arena. Kept for the process by the
+/// fiber's parameters (the last 16 fibers), so that a bake and the renders after it in one
+/// process (the add-on's) compute them once.
+Expected<std::shared_ptr<const DualScattering>> huang_dual_scattering(const HuangFiber &fiber);
 
 /// The table set of a huang2022 fiber (table_set.h): its Huang table baked at options.huang's
 /// resolution with options.threads, the default evaluator, and the fiber's parameters; with

@@ -282,7 +282,7 @@ TEST(HuangBake, TheMultiplePartIsTheFibersDualScatteringDensity) {
     EXPECT_EQ(std::memcmp(table_only.huang->values.data(), t.huang->values.data(),
                           t.huang->values.size() * sizeof(float)), 0);
 
-    const DualScattering dual = huang_dual_scattering(fiber).value();
+    const DualScattering &dual = *huang_dual_scattering(fiber).value();
     for (int r = 0; r < 5; ++r)
         for (int k = 0; k < 2; ++k) {
             // Marginal mass per cell: the density times the cell's solid angle 2π (sin θ₁ − sin θ₀).
