@@ -76,6 +76,8 @@ MODEL = os.environ.get("HAIRIS_DUAL_MODEL", "CHIANG")
 # Diagnostic: the Huang node's Aspect Ratio (HAIRIS_DUAL_HUANG_ASPECT; Blender's default 0.85).
 HUANG_ASPECT = (float(os.environ["HAIRIS_DUAL_HUANG_ASPECT"])
                 if "HAIRIS_DUAL_HUANG_ASPECT" in os.environ else None)
+# Diagnostic: Hair Volume (HAIRIS_DUAL_VOLUME=LAYER, the default, or UNBOUNDED).
+VOLUME = os.environ.get("HAIRIS_DUAL_VOLUME", "LAYER")
 # Diagnostic: the sphere's diffuse colour (HAIRIS_DUAL_SKIN=r,g,b; 0,0,0 removes its light).
 SKIN = tuple(float(v) for v in os.environ.get("HAIRIS_DUAL_SKIN", "0.7,0.5,0.4").split(","))
 if MODEL not in ("CHIANG", "HUANG"):
@@ -145,6 +147,7 @@ def make_case_scene(colour, lighting):
     hairis = scene.hairis
     hairis.max_bounces = BOUNCES
     hairis.strategy = "TABLE"
+    hairis.dual_hair_volume = VOLUME
     hairis.auto_bake = True
     hairis.threads = 1
     bpy.context.view_layer.update()
@@ -291,7 +294,7 @@ def main():
                             "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
                             "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
                             "threads": 1, "probe": PROBE, "model": MODEL,
-                            "skin": list(SKIN)},
+                            "skin": list(SKIN), "volume": VOLUME},
                "cases": cases}
     os.makedirs(OUT, exist_ok=True)
     suffix = "_probe" if PROBE else ""

@@ -119,7 +119,16 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                                               work.probe);
         ++work.rays;
     }
-    // The strands behind the vertex, away from that light point: where Ā_b's series stop.
+    // Where Ā_b's series stop for light from ω_i (Layer): the strands behind the vertex along
+    // the light's travel, −ω_i, up to the first mesh (−1: unbounded).
+    auto depth_behind = [&](Vec3 wi) {
+        if (!v.layer) return -1;
+        const Vec3 dir = -wi;
+        scene.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {}, work.behind);
+        ++work.rays;
+        return int(work.behind.size());
+    };
+    // The continuation's (the caller's): behind the vertex away from the probe's light point.
     int depth = -1;
     if (v.layer) {
         const Vec3 dir = -(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
@@ -160,7 +169,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                     if (v.layer) pdf_bsdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
-                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth);
+                // The probe's depth is this sample's when both drew the same delta light.
+                const int light_depth = crossings == &work.probe ? depth : depth_behind(ls->wi);
+                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
             }
@@ -179,6 +190,12 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
         const float t_end = mesh ? mesh->t : INFINITY;
         const float inv_pdf = 1.0f / s.pdf;
+        // The strands behind along −ω_i, traced once, when light arrives (work.table stays).
+        int table_depth = -2;
+        auto sample_depth = [&] {
+            if (table_depth == -2) table_depth = depth_behind(wi);
+            return table_depth;
+        };
         // Lamps between crossings see the strands before them.
         ForwardScattering forward;
         float t_lo = 0.0f;
@@ -186,7 +203,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             const float t_hi = k < work.table.size() ? work.table[k].t : t_end;
             const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true, sp.position);
             if (!is_black(lamps))
-                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * lamps * inv_pdf;
+                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth()) * lamps * inv_pdf;
             if (k < work.table.size()) add_crossing(forward, scene, work.table[k], wi, dual);
             t_lo = t_hi;
         }
@@ -205,7 +222,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             }
         }
         if (!is_black(arriving))
-            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, depth) * arriving * inv_pdf;
+            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth()) * arriving * inv_pdf;
     }
     return out;
 }

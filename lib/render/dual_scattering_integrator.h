@@ -40,10 +40,12 @@
 // The hair volume (RenderSettings::dual_hair_volume). The paper's series for Ā_b, Δ̄_b and σ̄_b
 // sum light that goes on through ever more strands behind x and comes back: a semi-infinite
 // volume (Unbounded). Real hair is a layer over a head, and light that passes it reaches the
-// skin instead. Layer (the default) cuts Ā_b's two series at the strands a second probe finds
-// behind x, from x away from the probe's light point up to the first mesh
-// (DualScattering::backscatter_attenuation(θ, depth)); Δ̄_b and σ̄_b, ratios of the same series,
-// are kept. In exchange, the continuation lets hair through: where it reaches a mesh after
+// skin instead. Layer (the default) cuts Ā_b's two series at the strands behind x along the
+// light's travel, up to the first mesh (DualScattering::backscatter_attenuation(θ, depth)): for
+// each light or table sample that brings light from ω_i, a ray from x along −ω_i counts them
+// (the probe's when the light sample drew the probe's delta light); for the continuation's
+// global term, a second probe from x away from the probe's light point. Δ̄_b and σ̄_b, ratios
+// of the same series, are kept. In exchange, the continuation lets hair through: where it reaches a mesh after
 // n ≥ 1 strands, its weight is the global term of the sampled direction (T_f and σ_f² of the
 // strands it crossed, the vertex's depth) over the sampler's density instead of f_s over it,
 // and only light the mesh reflects counts (its emission, lamps crossed after the first strand
@@ -134,7 +136,7 @@ struct DualVertex {
 /// Per-thread buffers and counts of the estimator.
 struct DualWork {
     std::vector<StrandCrossing> light, probe, table, behind, continuation;
-    int last_depth = -1;          ///< the strands found behind the last vertex (−1: unbounded)
+    int last_depth = -1;          ///< the strands the second probe found behind the last vertex (−1: unbounded)
     std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
     int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
     int last_strand_index = -1;   ///< the index into the table's n_h values it chose

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -629,6 +630,83 @@ TEST(DualScatteringRender, ConstantWorldMultipleScatteringMatchesQuadrature) {
     for (int ch = 0; ch < 3; ++ch) {
         ASSERT_GT(want[ch], 0.0);
         EXPECT_NEAR(e.mean[ch], want[ch] * world[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "ch " << ch;
+    }
+}
+
+TEST(DualScatteringRender, ALayerCutsEachSamplesBackscatterAlongItsOwnLight) {
+    // A constant world over a hair lying on a sheet of parallel strands (two rows of seven,
+    // below it). Light from above finds the strands its travel crosses behind the hair; light
+    // from below crosses them first and finds none behind. M must integrate each direction's
+    // term at its own depth, ∫ M(ω; forward(ω), depth(−ω)) L dω: by quadrature over the
+    // sphere, with the crossings in closed form (the strands are parallel to the hair). One
+    // depth for all the light, from a uniform probe, gives another value.
+    const float r = 0.02f;
+    std::vector<Vec3> centres{{0, 0, 0}};
+    for (int row = 1; row <= 2; ++row)
+        for (int j = -3; j <= 3; ++j) centres.push_back({0, 0.05f * float(j), -0.06f * float(row)});
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r))};
+    const float radiance = 1.3f;
+    d.world = {Rgb(1.0f), radiance};
+    d.camera = looking_down(0.001f, 0.001f, 1, 1);  // the top of the hair, (0, 0, r)
+    const Scene scene = build(std::move(d));
+    const DualScattering &dual = *blonde().dual;
+    // The strands a ray from (0, 0, r) along (·, dy, dz) crosses: those ahead of it whose axis
+    // lies within r of it (not the hair itself).
+    auto crossed = [&](double dy, double dz) {
+        const double len = std::sqrt(dy * dy + dz * dz);
+        int n = 0;
+        for (std::size_t k = 1; k < centres.size(); ++k) {
+            const double py = centres[k].y, pz = centres[k].z - r;  // the axis from the origin
+            const double along = (py * dy + pz * dz) / len, off = std::fabs(py * dz - pz * dy) / len;
+            n += along > 0 && off < r;
+        }
+        return n;
+    };
+    // M·cos θ_i of light from ω at the given depth behind the hair (θ_o = 0).
+    auto term = [&](double u, double y, double z, int depth) {
+        const float theta_i = float(std::asin(u));
+        ForwardScattering forward;
+        forward.strands = crossed(y, z);
+        for (int k = 0; k < forward.strands; ++k) {
+            forward.attenuation *= dual.forward_attenuation(theta_i);
+            forward.spread_variance += dual.forward_spread_variance(theta_i, 1);
+        }
+        return dual_multiple_f_cos(dual, theta_i, 0.0f, forward, depth);
+    };
+    const QuadratureRule q = QuadratureRule::composite(-1.0, 1.0, 16, 8);
+    const int phis = 2048, most = int(centres.size());
+    double want[3] = {0, 0, 0};
+    std::vector<std::array<double, 3>> single(std::size_t(most), {0, 0, 0});
+    std::vector<double> share(std::size_t(most), 0.0);
+    for (std::size_t i = 0; i < q.x.size(); ++i)
+        for (int j = 0; j < phis; ++j) {
+            const double u = q.x[i], c = std::sqrt(1.0 - u * u), phi = kTwoPi * (j + 0.5) / phis;
+            const double y = c * std::cos(phi), z = c * std::sin(phi), w = q.w[i] * kTwoPi / phis;
+            const int behind = crossed(-y, -z);  // along the light's travel, −ω
+            const Rgb m = term(u, y, z, behind);
+            for (int ch = 0; ch < 3; ++ch) want[ch] += w * m[ch] * radiance;
+            share[std::size_t(behind)] += w / (4.0 * kPi);  // a uniform probe's chance of `behind`
+            if (i % 4 == 0 && j % 4 == 0)  // the probe's alternative on a coarser grid
+                for (int k = 0; k < most; ++k) {
+                    const Rgb mk = term(u, y, z, k);
+                    for (int ch = 0; ch < 3; ++ch) single[std::size_t(k)][ch] += 16.0 * w * mk[ch] * radiance;
+                }
+        }
+    RenderSettings path = dual_settings(0, DualHairVolume::Layer);
+    path.integrator = int(Integrator::Path);
+    const Estimate e = mean_difference(scene, dual_settings(0, DualHairVolume::Layer), scene, path, 40000);
+    for (int ch = 0; ch < 3; ++ch) {
+        double probe_depth = 0;
+        for (int k = 0; k < most; ++k) probe_depth += share[std::size_t(k)] * single[std::size_t(k)][ch];
+        ASSERT_GT(want[ch], 0.0);
+        EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 3e-3 * want[ch]) << "ch " << ch;
+        if (ch == 0) {
+            std::printf("per-sample depth %.5f, one probe's depth %.5f, estimate %.5f ± %.5f\n", want[ch],
+                        probe_depth, e.mean[ch], e.sigma[ch]);
+            EXPECT_GT(std::fabs(want[ch] - probe_depth), 8.0 * e.sigma[ch]) << "the test tells the two apart";
+        }
     }
 }
 
