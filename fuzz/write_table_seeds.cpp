@@ -1,6 +1,7 @@
 // Writes the seed corpus of the table_reader target (fuzz/corpus/table_reader/): valid table
 // files of format v2 (Chiang with a near part narrower and wider than the far part, with cone
-// lobes and with extreme values; far-only Gaussian-source and Marschner files) and, made from
+// lobes and with extreme values; far-only Gaussian-source and Marschner files; huang2022 files
+// of distinct values, with and without the multiple part) and, made from
 // them with the library's encoder and OpenImageIO (or by editing bytes, for what OpenImageIO
 // cannot write), one file per check of the reader, each named after what it breaks. Every
 // pixel-level change keeps the hash right unless the hash is what it breaks, so the file
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "fiber/fiber_spec.h"
+#include "sampling/huang_table.h"
 #include "sampling/near_field_table.h"
 #include "tables/bake.h"
 #include "tables/table_file.h"
@@ -192,6 +194,31 @@ Bytes rewrite_header(const Bytes &bytes, const std::vector<Attribute> &edits, si
 }
 
 // ---- The valid tables --------------------------------------------------------------------------
+
+// A huang2022 set of 2 φ_o × 3 θ_o nodes × 4 θ_i × 5 φ cells of distinct values (image rows
+// 0..23) and, with `multiple`, the multiple part: 3 θ_r nodes × 4 θ_i cells (rows 24..35), n_h
+// 1 and 4 (columns 0 and 1).
+TableSet huang_set(bool multiple) {
+    auto h = std::make_shared<HuangTableSet>();
+    h->parameters = huang_parameters(HuangParams{});
+    h->theta_o_nodes = {-1.0f, 0.1f, 1.2f};
+    h->phi_o_nodes = {0.0f, 1.5707964f};
+    h->theta_i_count = 4;
+    h->phi_count = 5;
+    for (int n = 0; n < 2 * 3 * 4 * 5; ++n) h->values.push_back(0.25f + 0.01f * float(n));
+    TableSet t;
+    t.model = "huang2022";
+    t.source = "exact";
+    t.parameters = h->parameters;
+    t.huang = std::move(h);
+    if (multiple) {
+        t.theta_r_nodes = {-1.0f, 0.25f, 1.1f};
+        t.theta_i_count = 4;
+        t.n_h_values = {1, 4};
+        for (int n = 0; n < 3 * 2 * 4; ++n) t.multiple.push_back(2.0f + 0.01f * float(n));
+    }
+    return t;
+}
 
 struct Chiang {
     std::shared_ptr<const ChiangFiber> fiber;
@@ -428,6 +455,24 @@ int main(int argc, char **argv) {
             for (int k = 0; k <= 6; ++k) i.at(k, kFarRows + 11, 2) = -i.at(k, kFarRows + 11, 2) - 1.0f;
         }));
     add("near_hash_mismatch.exr", tamper(chiang_file, [](Image &i) { i.at(5, kFarRows + 11, 1) *= 1.0001f; }, true));
+
+    // ---- Huang files: the Huang part alone and with the multiple part ----
+    const Bytes huang_file = encode(huang_set(false)), huang_multiple_file = encode(huang_set(true));
+    add("huang_2x3x4x5.exr", huang_file);
+    add("huang_multiple_3x4.exr", huang_multiple_file);
+    add("huang_g_nonzero.exr", tamper(huang_file, [](Image &i) { i.at(2, 5, 1) = 0.5f; }));
+    add("huang_part_value_negative.exr", tamper(huang_file, [](Image &i) { i.at(4, 7, 0) = -1.0f; }));
+    add("huang_multiple_r_nonzero.exr", tamper(huang_multiple_file, [](Image &i) { i.at(1, 25, 0) = 0.5f; }));
+    add("huang_multiple_padding_nonzero.exr", tamper(huang_multiple_file, [](Image &i) { i.at(3, 30, 3) = 1.0f; }));
+    add("huang_multiple_value_nan.exr", tamper(huang_multiple_file, [](Image &i) {
+            i.at(0, 33, 1) = std::numeric_limits<float>::quiet_NaN();
+        }));
+    add("huang_multiple_row_wrong.exr", with_attribute(huang_multiple_file, "hairis:multiple", "row=23;theta_r=3;theta_i=4"));
+    add("huang_multiple_counts_absurd.exr",
+        with_attribute(huang_multiple_file, "hairis:multiple", "row=24;theta_r=1024;theta_i=4096"));
+    add("huang_multiple_n_h_missing.exr", tamper(huang_multiple_file, [](Image &i) { i.spec.erase_attribute("hairis:n_h_values"); }));
+    add("huang_parts_without_multiple.exr", with_attribute(huang_multiple_file, "hairis:parts", "huang"));
+    add("huang_parts_multiple_missing.exr", with_attribute(huang_file, "hairis:parts", "huang,multiple"));
 
     for (const auto &[name, bytes] : seeds) {
         const std::string path = std::string(argv[1]) + "/" + name;
