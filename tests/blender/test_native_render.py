@@ -151,31 +151,37 @@ def test_each_strategy_renders():
         assert pixels.reshape(-1, 4)[:, :3].mean() > 1e-3, "%s rendered black" % strategy
 
 
-def test_dual_scattering_renders():
-    """F12 with the Dual Scattering integrator: finite, not black, and within a factor of two
-    of the path tracer's image mean (a sanity bound: dual scattering approximates multiple
-    scattering; its measured bias is in bench/results/dual_scattering.md)."""
+def check_dual_against_path(prefix, label):
+    """F12 with each integrator (TABLE, 16 spp): finite, dual scattering not black, and within
+    a factor of two of the path tracer's image mean (a sanity bound: dual scattering
+    approximates multiple scattering; its measured bias is in bench/results/)."""
     means = {}
-    for integrator in ("PATH", "DUAL_SCATTERING"):
-        SCENE.hairis.integrator = integrator
-        SCENE.hairis.strategy = "TABLE"
-        SCENE.hairis.samples = 16
-        pixels = f12_pixels("integrator_%s" % integrator)
-        assert np.all(np.isfinite(pixels)), integrator
-        means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
-    SCENE.hairis.integrator = "PATH"
-    assert means["DUAL_SCATTERING"] > 1e-3, "dual scattering rendered black"
+    try:
+        for integrator in ("PATH", "DUAL_SCATTERING"):
+            SCENE.hairis.integrator = integrator
+            SCENE.hairis.strategy = "TABLE"
+            SCENE.hairis.samples = 16
+            pixels = f12_pixels("%sintegrator_%s" % (prefix, integrator))
+            assert np.all(np.isfinite(pixels)), integrator
+            means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
+    finally:
+        SCENE.hairis.integrator = "PATH"
+    assert means["DUAL_SCATTERING"] > 1e-3, "dual scattering rendered %s black" % label
     if not FAKE:
         ratio = means["DUAL_SCATTERING"] / means["PATH"]
-        print("dual scattering / path image mean: %.3f" % ratio)
+        print("%s: dual scattering / path image mean: %.3f" % (label, ratio))
         assert 0.5 < ratio < 2.0, ratio
+
+
+def test_dual_scattering_renders():
+    """F12 with the Dual Scattering integrator against the path tracer (Chiang)."""
+    check_dual_against_path("", "Chiang")
 
 
 def test_dual_scattering_renders_huang():
     """Blender 4.0+: the Hair material switched to the Huang model (Blender's default since
     4.0) renders with Dual Scattering under the default Huang Sampling (Cycles), auto-baking
-    Huang tables with their multiple part: finite, not black, and within a factor of two of
-    the path tracer's image mean."""
+    Huang tables with their multiple part, as check_dual_against_path asks."""
     if bpy.app.version < (4, 0, 0):
         print("skipped: Blender %s has no Huang model" % bpy.app.version_string)
         return
@@ -185,24 +191,11 @@ def test_dual_scattering_renders_huang():
     auto_bake = SCENE.hairis.auto_bake
     SCENE.hairis.auto_bake = True
     SCENE.hairis.huang_sampling = "CYCLES"
-    means = {}
     try:
-        for integrator in ("PATH", "DUAL_SCATTERING"):
-            SCENE.hairis.integrator = integrator
-            SCENE.hairis.strategy = "TABLE"
-            SCENE.hairis.samples = 16
-            pixels = f12_pixels("huang_integrator_%s" % integrator)
-            assert np.all(np.isfinite(pixels)), integrator
-            means[integrator] = pixels.reshape(-1, 4)[:, :3].mean()
+        check_dual_against_path("huang_", "Huang")
     finally:
         node.model = "CHIANG"
-        SCENE.hairis.integrator = "PATH"
         SCENE.hairis.auto_bake = auto_bake
-    assert means["DUAL_SCATTERING"] > 1e-3, "dual scattering rendered Huang black"
-    if not FAKE:
-        ratio = means["DUAL_SCATTERING"] / means["PATH"]
-        print("Huang: dual scattering / path image mean: %.3f" % ratio)
-        assert 0.5 < ratio < 2.0, ratio
 
 
 def test_strategies_agree():
