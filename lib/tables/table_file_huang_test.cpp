@@ -6,6 +6,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include "same_bits.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -27,6 +29,7 @@ namespace {
 
 using testing::Chi2Options;
 using testing::Sample3;
+using testing::same_bits;
 
 std::shared_ptr<const HuangFiber> huang_fiber(float aspect_ratio = 0.85f) {
     HuangParams p;  // Blender's default node: its default colour mapped with Huang's roughness
@@ -152,13 +155,13 @@ void expect_same_huang_part(const TableSet &b, const TableSet &t) {
     EXPECT_EQ(b.huang->theta_i_count, t.huang->theta_i_count);
     EXPECT_EQ(b.huang->phi_count, t.huang->phi_count);
     ASSERT_EQ(b.huang->values.size(), t.huang->values.size());
-    EXPECT_EQ(0, std::memcmp(b.huang->values.data(), t.huang->values.data(), t.huang->values.size() * sizeof(float)));
+    EXPECT_TRUE(same_bits(b.huang->values, t.huang->values));
     EXPECT_EQ(b.has_multiple(), t.has_multiple());
     EXPECT_EQ(b.theta_r_nodes, t.theta_r_nodes);
     EXPECT_EQ(b.theta_i_count, t.theta_i_count);
     EXPECT_EQ(b.n_h_values, t.n_h_values);
     ASSERT_EQ(b.multiple.size(), t.multiple.size());
-    EXPECT_EQ(0, std::memcmp(b.multiple.data(), t.multiple.data(), t.multiple.size() * sizeof(float)));
+    EXPECT_TRUE(same_bits(b.multiple, t.multiple));
 }
 
 TEST(HuangTableFile, RoundTripIsBitExact) {

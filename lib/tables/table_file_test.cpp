@@ -8,6 +8,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include "same_bits.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -22,6 +24,8 @@
 
 namespace hairis {
 namespace {
+
+using testing::same_bits;
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -167,8 +171,8 @@ void expect_same_far_part(const TableSet &b, const TableSet &t) {
     EXPECT_EQ(b.n_h_values, t.n_h_values);
     ASSERT_EQ(b.direct.size(), t.direct.size());
     ASSERT_EQ(b.multiple.size(), t.multiple.size());
-    EXPECT_EQ(0, std::memcmp(b.direct.data(), t.direct.data(), t.direct.size() * sizeof(float)));
-    EXPECT_EQ(0, std::memcmp(b.multiple.data(), t.multiple.data(), t.multiple.size() * sizeof(float)));
+    EXPECT_TRUE(same_bits(b.direct, t.direct));
+    EXPECT_TRUE(same_bits(b.multiple, t.multiple));
 }
 
 void expect_same_near_part(const NearFieldData &b, const NearFieldData &t) {
@@ -177,9 +181,9 @@ void expect_same_near_part(const NearFieldData &b, const NearFieldData &t) {
     ASSERT_EQ(b.mass.size(), t.mass.size());
     ASSERT_EQ(b.edge.size(), t.edge.size());
     ASSERT_EQ(b.integral.size(), t.integral.size());
-    EXPECT_EQ(0, std::memcmp(b.mass.data(), t.mass.data(), t.mass.size() * sizeof(float)));
-    EXPECT_EQ(0, std::memcmp(b.edge.data(), t.edge.data(), t.edge.size() * sizeof(float)));
-    EXPECT_EQ(0, std::memcmp(b.integral.data(), t.integral.data(), t.integral.size() * sizeof(float)));
+    EXPECT_TRUE(same_bits(b.mass, t.mass));
+    EXPECT_TRUE(same_bits(b.edge, t.edge));
+    EXPECT_TRUE(same_bits(b.integral, t.integral));
     EXPECT_EQ(b.cone, t.cone);
 }
 
