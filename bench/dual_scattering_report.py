@@ -13,7 +13,10 @@ Per case (hair colour × lighting), over the hair pixels:
 - the crossover time: with MSE_path(t) = c_path/t (c_path fitted to PATH's and to Cycles'
   points) and MSE_dual(t) = b² + c_dual/t (b², the squared bias, is DUAL's MSE at its highest
   spp less its variance from the two seeds; c_dual = variance · time, averaged over its spps),
-  path tracing has the smaller error after t* = (c_path − c_dual)/b².
+  path tracing has the smaller error after t* = (c_path − c_dual)/b²;
+- where that bias is: its RMS per pixel and over 4×4 and 16×16 blocks (the study's
+  bias_by_block), and DUAL's error over the hair pixels in five groups by brightness (quintiles
+  of Cycles' reference, error_by_brightness).
 Images: per case the reference, DUAL, PATH and Cycles at 64 spp and DUAL − reference
 (dual_scattering_images.png), and the RMSE-time curves (dual_scattering_rmse.png).
 """
@@ -32,6 +35,7 @@ import numpy as np  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHANNELS = "RGB"
 LABELS = {"DUAL": "Hairis DUAL_SCATTERING", "PATH": "Hairis PATH", "CYCLES": "Cycles 3.4"}
+BRIGHTNESS_GROUPS = 5  # quintiles of the hair pixels by brightness
 COLOURS = {"DUAL": "tab:red", "PATH": "tab:blue", "CYCLES": "tab:gray"}
 
 
@@ -206,6 +210,37 @@ def write_markdown(results, numbers, path):
         lines.append("| %s | %.4f | %.3g | %.3g | %s | %.3g | %s |" % (
             name, math.sqrt(n["bias2"]) / n["scale"], n["c_dual"], cp["c"], seconds_text(cp["t"]),
             cc["c"], seconds_text(cc["t"])))
+    blocked = {name: max(case["renders"]["DUAL"], key=lambda e: e["spp"]).get("bias_by_block")
+               for name, case in results["cases"].items()}
+    if any(blocked.values()):
+        sizes = sorted({int(k) for b in blocked.values() if b for k in b})
+        lines += ["", "## Where DUAL's bias is: per pixel and over blocks", "",
+                  "DUAL's bias (relative RMS, noise-corrected: the two seeds' and the reference's "
+                  "own noise subtracted) of the mean difference from the reference over blocks of "
+                  "hair pixels. Per pixel it is the crossover table's; what survives averaging "
+                  "over large blocks is the light transport's error, what averages out is "
+                  "strand-scale (where one strand's light differs from the path tracer's, both "
+                  "ways).", "",
+                  "| case | " + " | ".join("%d×%d" % (k, k) for k in sizes) + " |",
+                  "| --- |" + " --- |" * len(sizes)]
+        for name, b in blocked.items():
+            if b:
+                lines.append("| %s | " % name + " | ".join(
+                    "%.4f" % b[str(k)] if str(k) in b else "" for k in sizes) + " |")
+    if any(n.get("by_brightness") for n in numbers.values()):
+        lines += ["", "## DUAL's error by pixel brightness", "",
+                  "The hair pixels in %d groups of equal count by their brightness in Cycles' "
+                  "reference (independent of both images' noise), dimmest first: DUAL's relative "
+                  "error of the group's mean luminance (its highest spp, seed 1), and the "
+                  "reference's group mean. A positive error in dim groups with a negative one in "
+                  "bright groups is light moved from where it arrives to where it does not: "
+                  "a flatter image than path tracing's." % BRIGHTNESS_GROUPS, "",
+                  "| case | " + " | ".join("group %d" % (k + 1) for k in range(BRIGHTNESS_GROUPS))
+                  + " |", "| --- |" + " --- |" * BRIGHTNESS_GROUPS]
+        for name, n in numbers.items():
+            if n.get("by_brightness"):
+                lines.append("| %s | " % name + " | ".join(
+                    "%+.1f%% (%.3f)" % (100 * e, r) for r, e in n["by_brightness"]) + " |")
     lines += ["", "## Renders (RMSE over hair pixels, relative; seconds)", ""]
     for name, case in results["cases"].items():
         lines.append("**%s**: " % name + "; ".join(
@@ -276,12 +311,31 @@ def write_images(results, images, numbers, out):
     plt.close(fig)
 
 
+def error_by_brightness(images, name, groups=BRIGHTNESS_GROUPS):
+    """DUAL's relative error (its highest spp, one seed) over the hair pixels grouped by their
+    brightness, dimmest first: quantiles of Cycles' reference, whose noise is independent of
+    both images (grouping by the PATH reference itself would put its negative noise in the dim
+    groups and show a spurious positive error there). None without Cycles' reference."""
+    keys = ["%s_%s" % (name, k) for k in ("cycles_reference", "reference", "dual", "mask")]
+    if not all(k in images for k in keys):
+        return None
+    cycles, reference, dual, mask = (images[k] for k in keys)
+    order = np.argsort(cycles[mask][:, :3].mean(axis=1))
+    ref, est = reference[mask][:, :3].mean(axis=1), dual[mask][:, :3].mean(axis=1)
+    out = []
+    for part in np.array_split(order, groups):
+        out.append((float(ref[part].mean()), float(est[part].mean() / ref[part].mean() - 1.0)))
+    return out
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "results")
     with open(os.path.join(out, "dual_scattering.json")) as handle:
         results = json.load(handle)
     images = np.load(os.path.join(out, "dual_scattering_images.npz"))
     numbers = {name: analyse(case) for name, case in results["cases"].items()}
+    for name in numbers:
+        numbers[name]["by_brightness"] = error_by_brightness(images, name)
     write_markdown(results, numbers, os.path.join(out, "dual_scattering.md"))
     write_images(results, images, numbers, out)
     print("wrote %s" % os.path.join(out, "dual_scattering.md"))

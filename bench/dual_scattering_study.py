@@ -21,7 +21,8 @@ world colour; an area light in a black world), 8 bounces. Per case, in one Blend
    computes the dual-scattering averages);
 4. per render: the per-channel mean error over the hair pixels against the reference, the
    noise-corrected RMSE over the hair pixels (the reference's own noise, estimated from its two
-   halves, subtracted), and the variance from the two seeds.
+   halves, subtracted), and the variance from the two seeds; for DUAL at its highest spp, its
+   bias per pixel and over 4×4 and 16×16 blocks (bias_by_scale).
 
 Writes bench/results/dual_scattering.json and dual_scattering_images.npz; the report (tables,
 the crossover times, difference images) is bench/dual_scattering_report.py's.
@@ -58,6 +59,7 @@ if not os.path.isfile(helpers.bundled_library(PACKAGE)):
 RESOLUTION = tuple(int(v) for v in os.environ.get("HAIRIS_DUAL_RESOLUTION", "64x64").split("x"))
 REF_SPP = int(os.environ.get("HAIRIS_DUAL_REF_SPP", "1024"))
 CYCLES_REF_SPP = int(os.environ.get("HAIRIS_DUAL_CYCLES_REF_SPP", "256"))
+BIAS_BLOCKS = (1, 4, 16)  # pixel, strand bundles, the ball's regions (64-pixel images)
 SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_SPPS", "1,4,16,64").split(",")]
 PATH_SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_PATH_SPPS", "4,16,64").split(",")]
 OUT = os.environ.get("HAIRIS_DUAL_OUT", os.path.join(HERE, "results"))
@@ -205,6 +207,38 @@ def errors(image, reference, mask, ref_mse_channel):
     }
 
 
+def block_means(field, mask, size):
+    """Means of field over the mask's pixels in size×size blocks, and their pixel counts."""
+    h, w = mask.shape
+    hb, wb = h // size, w // size
+    m = mask[:hb * size, :wb * size].reshape(hb, size, wb, size).astype(np.float64)
+    v = field[:hb * size, :wb * size].reshape(hb, size, wb, size, -1) * m[..., None]
+    counts = m.sum(axis=(1, 3))
+    sums = v.sum(axis=(1, 3))
+    keep = counts > 0
+    return sums[keep] / counts[keep][:, None], counts[keep]
+
+
+def bias_by_scale(images, reference, halves, mask, sizes=BIAS_BLOCKS):
+    """DUAL's bias at each block size: the RMS over blocks (weighted by their hair pixels) of the
+    mean difference from the reference, less the noise of both (from the two seeds' difference
+    and the reference's halves), relative to the reference's hair mean. Size 1 is per pixel;
+    larger blocks show how much of it is large-scale (the light transport) rather than
+    strand-scale."""
+    ref_mean = reference[mask].mean()
+    mean = 0.5 * (images[0] + images[1])
+    out = {}
+    for size in sizes:
+        d, n = block_means(mean - reference, mask, size)
+        spread, _ = block_means(images[0] - images[1], mask, size)
+        ref_spread, _ = block_means(halves[0] - halves[1], mask, size)
+        # E[d²] = b² + var(seed mean) + var(reference); spread²/4 and ref_spread²/4 estimate both.
+        excess = d ** 2 - spread ** 2 / 4.0 - ref_spread ** 2 / 4.0
+        b2 = (n[:, None] * excess).sum() / (excess.shape[1] * n.sum())
+        out[str(size)] = float(math.sqrt(max(b2, 0.0)) / ref_mean)
+    return out
+
+
 def study_case(name, keep):
     """Every render of one case; returns its record."""
     colour, lighting = name.split("_")
@@ -275,6 +309,11 @@ def study_case(name, keep):
                    math.sqrt(e["mse_corrected"]) / ref_mean.mean()))
             if samples == max(SPPS if method == "DUAL" else PATH_SPPS):
                 keep["%s_%s" % (name, method.lower())] = images[0].astype(np.float32)
+                if method == "DUAL":
+                    entry["bias_by_block"] = bias_by_scale(images, reference, (half_a, half_b),
+                                                           mask)
+                    log("%s DUAL bias (relative RMS) by block size %s"
+                        % (name, entry["bias_by_block"]))
     record["renders"] = renders
     return record
 
