@@ -29,7 +29,9 @@
 //  - the material's sampler draws the path's continuation as in the path tracer and collects
 //    D from the emitters it reaches unoccluded, MIS-weighted as there. It ends at hair: light
 //    reaching x from another strand is M's. It goes on from meshes (light that meshes reflect
-//    onto hair, single-scattered).
+//    onto hair: single-scattered with Unbounded; with Layer, F = f_s + d_b f_back^direct where
+//    no strand is in the way, Ā_b cut along that light's travel, and the global term through
+//    strands).
 // n_h estimate: the strands a probe ray crosses from x towards a point drawn from LightSet with
 // random numbers of its own (towards a direction uniform on the sphere when there is no lamp),
 // up to the first mesh; that count (at least 1) is rounded in log2 to the nearest strand count
@@ -57,8 +59,9 @@
 // reaches hair directly or through other strands. What is still traced: everything that
 // arrives at meshes (hair is opaque to their shadow rays, as in the path tracer, and the light
 // hair sends them — the head under the hair — is what their continuation rays find at hair
-// vertices, each shaded as above), and light meshes reflect onto hair (single scattering of
-// it where no strand is in the way; with Layer, the global term through strands). Not covered
+// vertices, each shaded as above), and light meshes reflect onto hair (with Layer F as for a
+// lamp: f_s + d_b f_back^direct where no strand is in the way, the global term through strands;
+// with Unbounded single scattering where no strand is in the way). Not covered
 // with Unbounded: light that meshes reflect and that then crosses strands before reaching x.
 #pragma once
 

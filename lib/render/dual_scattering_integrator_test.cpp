@@ -530,6 +530,88 @@ TEST(DualScatteringRender, ALayersMeshLightThroughStrandsIsTheGlobalTerm) {
     }
 }
 
+TEST(DualScatteringRender, ALayersUnoccludedMeshLightAlsoCarriesTheLocalBackscatter) {
+    // A hair over a sunlit white floor with nothing between them, under a mat of strands with a
+    // gap the camera looks through. The floor's light reaches the hair as a lamp's would:
+    // F = f_s + d_b f_back^direct, Ā_b cut at the mat's strands behind the hair along the
+    // light's travel (up). One bounce (camera → hair → floor → sun). The floor's light in dual
+    // scattering less the path tracer's (each the render with the floor less the render
+    // without it, same random numbers) is the local term alone, against an estimate over
+    // uniform directions from the hair's hits.
+    const float strength = 3.0f, r = 0.02f;
+    const Vec3 to_sun{0, 0, 1};
+    std::vector<Vec3> centres{{0, 0, 0}};
+    for (int k = 1; k <= 4; ++k) {
+        centres.push_back({0, float(k) * 2.0f * r, 0.05f});
+        centres.push_back({0, -float(k) * 2.0f * r, 0.05f});
+    }
+    auto scene_with = [&](bool floor) {
+        SceneDesc d;
+        d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(0.8f)}};
+        d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
+        if (floor) d.meshes = {quad_at(1.0f, -0.3f, 1)};
+        SunLight sun;
+        sun.to_sun = to_sun;
+        sun.strength = strength;
+        d.suns = {sun};
+        d.camera = looking_down(0.005f, 0.005f, 1, 1);
+        return build(std::move(d));
+    };
+    const Scene with = scene_with(true), without = scene_with(false);
+    RenderSettings path = dual_settings(1, DualHairVolume::Layer);
+    path.integrator = int(Integrator::Path);
+    const RenderSettings dual = dual_settings(1, DualHairVolume::Layer);
+    const int n = 40000;
+    const Estimate dual_floor = mean_difference(with, dual, without, dual, n);
+    const Estimate path_floor = mean_difference(with, path, without, path, n);
+    const DualScattering &averages = *blonde().dual;
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    double ind[3] = {0, 0, 0}, ind2[3] = {0, 0, 0};
+    const int m = 100000;
+    std::vector<StrandCrossing> strands, behind;
+    int cut = 0;
+    for (int i = 0; i < m; ++i) {
+        const CameraRay cr = with.camera().generate_ray(0, 0, uniform(rng), uniform(rng));
+        const auto hit = with.intersect(cr.origin, cr.direction, cr.tmin, cr.tmax);
+        ASSERT_TRUE(hit.has_value());
+        const SurfacePoint sp = with.surface_point(cr.origin, cr.direction, *hit);
+        ASSERT_NEAR(sp.position.z, 0.0f, 1.01f * r) << "the camera sees the lower hair through the gap";
+        const Vec3 wo = -cr.direction;
+        const FiberFrame frame = FiberFrame::from_tangent_and_view(sp.tangent, wo);
+        const float z = 1.0f - 2.0f * uniform(rng), phi = float(kTwoPi) * uniform(rng);
+        const float rho = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        const Vec3 w{rho * std::cos(phi), rho * std::sin(phi), z};
+        const auto floor = with.trace_through_hair(sp.spawn_point(w), w, 0.0f, INFINITY, sp.self, {}, strands);
+        Rgb value;
+        if (floor && floor->prim.geometry != PrimRef::kNone) {
+            EXPECT_TRUE(strands.empty()) << "nothing lies between the hair and the floor";
+            with.trace_through_hair(sp.spawn_point(-w), -w, 0.0f, INFINITY, sp.self, {}, behind);
+            cut += behind.empty() ? 0 : 1;
+            const SurfacePoint fp = with.surface_point(sp.spawn_point(w), w, *floor);
+            const bool lit = !with.occluded(fp.spawn_point(to_sun), to_sun, 0.0f, INFINITY, fp.self);
+            const float theta_i = std::asin(std::clamp(frame.to_local(w).x, -1.0f, 1.0f));
+            const float theta_o = std::asin(std::clamp(frame.to_local(wo).x, -1.0f, 1.0f));
+            const Rgb floor_radiance = Rgb(0.8f * strength / float(kPi)) * (lit ? 1.0f : 0.0f);
+            value = averages.local_f_cos(theta_i, theta_o, int(behind.size())) * floor_radiance *
+                    float(4.0 * kPi);
+        }
+        for (int ch = 0; ch < 3; ++ch) {
+            ind[ch] += value[ch];
+            ind2[ch] += double(value[ch]) * value[ch];
+        }
+    }
+    EXPECT_GT(cut, m / 10) << "the mat lies behind the hair for part of the floor's light";
+    for (int ch = 0; ch < 3; ++ch) {
+        const double got = dual_floor.mean[ch] - path_floor.mean[ch];
+        const double sigma2 = dual_floor.sigma[ch] * dual_floor.sigma[ch] + path_floor.sigma[ch] * path_floor.sigma[ch];
+        const double want = ind[ch] / m, var_ind = std::max(0.0, ind2[ch] / m - want * want) / m;
+        ASSERT_GT(want, 0.0);
+        EXPECT_NEAR(got, want, 5.0 * std::sqrt(sigma2 + var_ind)) << "ch " << ch;
+        EXPECT_GT(want, 8.0 * std::sqrt(sigma2 + var_ind)) << "the test tells the term from none, ch " << ch;
+    }
+}
+
 TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter) {
     // No strand under the hair: F = f_s + d_b f_back^direct. Over the hair's width (h uniform,
     // samples that miss it left out) f_s averages to the far field f_cos.

@@ -236,6 +236,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         float theta_o = 0;
         int depth = -1;
         Rgb beta;  // the path's throughput at that vertex
+        Vec3 behind_origin;  // the vertex's spawn point along −ω_i (ω_i: the continuation)
+        PrimRef self;
     } dual_from;
     alpha = 1.0f;
 
@@ -305,6 +307,21 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                 w = power_heuristic(bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
             }
             add(beta * emission * w);
+        }
+        // A mesh a layer vertex sees with no strand in the way sends it light like a lamp does,
+        // F = f_s + d_b f_back^direct: what the mesh reflects also carries the local multiple
+        // term, over the continuation's density (its emission above is f_s's alone: emitters'
+        // M is the light and table samples').
+        // Its Ā_b is cut at the strands behind the vertex along this light's travel, −ω_i.
+        if (dual_from.dual && dual_layer && !through_hair) {
+            std::vector<StrandCrossing> &behind = counters.dual.behind;
+            scene.trace_through_hair(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self, {}, behind);
+            ++counters.rays;
+            const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+            const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, ForwardScattering{},
+                                              int(behind.size()));
+            beta += dual_from.beta * m / bsdf_pdf;
+            if (!finite(beta)) break;
         }
 
         // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
@@ -415,6 +432,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             dual_from.theta_o = std::asin(std::clamp(bsdf.frame().to_local(wo).x, -1.0f, 1.0f));
             dual_from.depth = counters.dual.last_depth;
             dual_from.beta = beta;
+            dual_from.behind_origin = sp.spawn_point(-wi);
+            dual_from.self = sp.self;
         }
         if (bsdf.is_hair())
             last_segment = ++transmission_bounces > settings.max_transmission_bounces;
