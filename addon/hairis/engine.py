@@ -252,8 +252,9 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         hair_tables = self._resolve_tables(library, data, settings)
         if settings.integrator == "DUAL_SCATTERING":
             self.report({"WARNING"}, "Dual Scattering is experimental and biased: on the "
-                        "study's hair up to about 6% darker than path tracing with Chiang, "
-                        "15% with blonde Huang (README, Dual scattering)")
+                        "study's hair its mean is within 6% of path tracing with Chiang and "
+                        "15% with blonde Huang, and its shading is flatter: shaded regions "
+                        "brighter, lit ones darker (README, Dual scattering)")
         try:
             with build_native_scene(library, data, hair_tables) as native_scene:
                 self.update_stats("", "Rendering %d samples (%s%s)"
