@@ -308,21 +308,6 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             }
             add(beta * emission * w);
         }
-        // A mesh a layer vertex sees with no strand in the way sends it light like a lamp does,
-        // F = f_s + d_b f_back^direct: what the mesh reflects also carries the local multiple
-        // term, over the continuation's density (its emission above is f_s's alone: emitters'
-        // M is the light and table samples').
-        // Its Ā_b is cut at the strands behind the vertex along this light's travel, −ω_i.
-        if (dual_from.dual && dual_layer && !through_hair) {
-            std::vector<StrandCrossing> &behind = counters.dual.behind;
-            scene.trace_through_hair(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self, {}, behind);
-            ++counters.rays;
-            const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
-            const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, ForwardScattering{},
-                                              int(behind.size()));
-            beta += dual_from.beta * m / bsdf_pdf;
-            if (!finite(beta)) break;
-        }
 
         // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
         // transparency does not apply either).
@@ -348,6 +333,21 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             continue;
         }
         if (bsdf.black()) break;
+
+        // A mesh a layer vertex sees with no strand in the way sends it light as a lamp does,
+        // F = f_s + d_b f_back^direct: what the mesh reflects also carries the local multiple
+        // term over the continuation's density, Ā_b cut at the strands behind the vertex along
+        // this light's travel, −ω_i (the mesh's emission above is f_s's alone: emitters' M is
+        // the light and table samples').
+        if (dual_from.dual && dual_layer && !through_hair) {
+            std::vector<StrandCrossing> &behind = counters.dual.behind;
+            scene.trace_through_hair(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self, {}, behind);
+            ++counters.rays;
+            const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+            const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, int(behind.size()));
+            beta += dual_from.beta * m / bsdf_pdf;
+            if (!finite(beta)) break;
+        }
 
         // Russian roulette.
         if (depth >= settings.rr_start_bounce) {
