@@ -461,72 +461,96 @@ Estimate mean_difference(const Scene &a, const RenderSettings &sa, const Scene &
     return e;
 }
 
+// Straight hairs of radius r over a white floor (albedo 0.8) at floor_z, lit by a sun straight
+// above, seen straight down through a square window of half-width `window`.
+constexpr Vec3 kSunAbove{0, 0, 1};
+constexpr float kFloorAlbedo = 0.8f;
+Scene sunlit_floor(const std::vector<Vec3> &centres, float r, float floor_z, float window, float strength,
+                   bool floor) {
+    SceneDesc d;
+    d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(kFloorAlbedo)}};
+    d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
+    if (floor) d.meshes = {quad_at(1.0f, floor_z, 1)};
+    SunLight sun;
+    sun.to_sun = kSunAbove;
+    sun.strength = strength;
+    d.suns = {sun};
+    d.camera = looking_down(window, window, 1, 1);
+    return build(std::move(d));
+}
+
+// The floor's light at the hair the camera sees, ∫ f_cos(ω) L_floor(ω) dω over the directions
+// that reach the floor, estimated independently of the renderer: ω uniform on the sphere from
+// camera-ray hits on the hair. f_cos(hit, θ_i, θ_o, ω, strands crossed to the floor) is the term
+// under test; mean and standard error per channel.
+template <typename FCos>
+Estimate floor_light_by_uniform_directions(const Scene &scene, float strength, int m, unsigned seed,
+                                           FCos f_cos) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+    std::vector<StrandCrossing> strands;
+    for (int i = 0; i < m; ++i) {
+        const CameraRay cr = scene.camera().generate_ray(0, 0, uniform(rng), uniform(rng));
+        const auto hit = scene.intersect(cr.origin, cr.direction, cr.tmin, cr.tmax);
+        EXPECT_TRUE(hit.has_value());
+        if (!hit) continue;
+        const SurfacePoint sp = scene.surface_point(cr.origin, cr.direction, *hit);
+        const Vec3 wo = -cr.direction;
+        const FiberFrame frame = FiberFrame::from_tangent_and_view(sp.tangent, wo);
+        const float z = 1.0f - 2.0f * uniform(rng), phi = float(kTwoPi) * uniform(rng);
+        const float rho = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        const Vec3 w{rho * std::cos(phi), rho * std::sin(phi), z};
+        const auto floor = scene.trace_through_hair(sp.spawn_point(w), w, 0.0f, INFINITY, sp.self, {}, strands);
+        Rgb value;
+        if (floor && floor->prim.geometry != PrimRef::kNone) {
+            const SurfacePoint fp = scene.surface_point(sp.spawn_point(w), w, *floor);
+            const bool lit = !scene.occluded(fp.spawn_point(kSunAbove), kSunAbove, 0.0f, INFINITY, fp.self);
+            const float theta_i = std::asin(std::clamp(frame.to_local(w).x, -1.0f, 1.0f));
+            const float theta_o = std::asin(std::clamp(frame.to_local(wo).x, -1.0f, 1.0f));
+            const Rgb floor_radiance = Rgb(kFloorAlbedo * strength / float(kPi)) * (lit ? 1.0f : 0.0f);
+            value = f_cos(sp, theta_i, theta_o, w, strands) * floor_radiance * float(4.0 * kPi);
+        }
+        for (int ch = 0; ch < 3; ++ch) {
+            sum[ch] += value[ch];
+            sum2[ch] += double(value[ch]) * value[ch];
+        }
+    }
+    Estimate e;
+    for (int ch = 0; ch < 3; ++ch) {
+        e.mean[ch] = sum[ch] / m;
+        e.sigma[ch] = std::sqrt(std::max(0.0, sum2[ch] / m - e.mean[ch] * e.mean[ch]) / m);
+    }
+    return e;
+}
+
 TEST(DualScatteringRender, ALayersMeshLightThroughStrandsIsTheGlobalTerm) {
     // A hair above a mat of touching strands above a sunlit white floor: every direction from
     // the hair to the floor crosses the mat. With Layer, the floor's light is the global term
     // M(n) of the strands crossed: the render with the floor less the render without it (the
     // same random numbers) against an estimate over uniform directions from the hair's hits.
     const float strength = 3.0f, r = 0.02f;
-    const Vec3 to_sun{0, 0, 1};
     std::vector<Vec3> centres{{0, 0, 0}};
     for (int k = -3; k <= 3; ++k) centres.push_back({0, float(k) * 2.0f * r, -0.05f});
-    auto scene_with = [&](bool floor) {
-        SceneDesc d;
-        d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(0.8f)}};
-        d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
-        if (floor) d.meshes = {quad_at(1.0f, -1.0f, 1)};
-        SunLight sun;
-        sun.to_sun = to_sun;
-        sun.strength = strength;
-        d.suns = {sun};
-        d.camera = looking_down(0.01f, 0.01f, 1, 1);
-        return build(std::move(d));
-    };
-    const Scene with = scene_with(true), without = scene_with(false);
+    const Scene with = sunlit_floor(centres, r, -1.0f, 0.01f, strength, true);
+    const Scene without = sunlit_floor(centres, r, -1.0f, 0.01f, strength, false);
     const RenderSettings s = dual_settings(1, DualHairVolume::Layer);
     const Estimate floor_light = mean_difference(with, s, without, s, 20000);
-    // Independent: ω uniform on the sphere from a camera ray's hit on the hair.
     const DualScattering &dual = *blonde().dual;
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-    double ind[3] = {0, 0, 0}, ind2[3] = {0, 0, 0};
-    const int m = 100000;
-    std::vector<StrandCrossing> strands, behind;
-    for (int i = 0; i < m; ++i) {
-        const CameraRay cr = with.camera().generate_ray(0, 0, uniform(rng), uniform(rng));
-        const auto hit = with.intersect(cr.origin, cr.direction, cr.tmin, cr.tmax);
-        ASSERT_TRUE(hit.has_value());
-        const SurfacePoint sp = with.surface_point(cr.origin, cr.direction, *hit);
-        const Vec3 wo = -cr.direction;
-        const FiberFrame frame = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-        with.trace_through_hair(sp.spawn_point(-to_sun), -to_sun, 0.0f, INFINITY, sp.self, {}, behind);
-        const float z = 1.0f - 2.0f * uniform(rng), phi = float(kTwoPi) * uniform(rng);
-        const float rho = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const Vec3 w{rho * std::cos(phi), rho * std::sin(phi), z};
-        const auto floor = with.trace_through_hair(sp.spawn_point(w), w, 0.0f, INFINITY, sp.self, {}, strands);
-        Rgb value;
-        if (floor && floor->prim.geometry != PrimRef::kNone) {
+    std::vector<StrandCrossing> behind;
+    const Estimate want = floor_light_by_uniform_directions(
+        with, strength, 100000, 11,
+        [&](const SurfacePoint &sp, float theta_i, float theta_o, Vec3 w, const std::vector<StrandCrossing> &strands) {
             EXPECT_FALSE(strands.empty()) << "the mat covers the floor";
-            const SurfacePoint fp = with.surface_point(sp.spawn_point(w), w, *floor);
-            const bool lit = !with.occluded(fp.spawn_point(to_sun), to_sun, 0.0f, INFINITY, fp.self);
-            const ForwardScattering forward =
-                gather_forward_scattering(with, strands.data(), strands.size(), w, dual);
-            const float theta_i = std::asin(std::clamp(frame.to_local(w).x, -1.0f, 1.0f));
-            const float theta_o = std::asin(std::clamp(frame.to_local(wo).x, -1.0f, 1.0f));
-            const Rgb floor_radiance = Rgb(0.8f * strength / float(kPi)) * (lit ? 1.0f : 0.0f);
-            value = dual_multiple_f_cos(dual, theta_i, theta_o, forward, int(behind.size())) *
-                    floor_radiance * float(4.0 * kPi);
-        }
-        for (int ch = 0; ch < 3; ++ch) {
-            ind[ch] += value[ch];
-            ind2[ch] += double(value[ch]) * value[ch];
-        }
-    }
+            // The vertex's depth: the strands behind it away from the probe's light, the sun.
+            with.trace_through_hair(sp.spawn_point(-kSunAbove), -kSunAbove, 0.0f, INFINITY, sp.self, {}, behind);
+            const ForwardScattering forward = gather_forward_scattering(with, strands.data(), strands.size(), w, dual);
+            return dual_multiple_f_cos(dual, theta_i, theta_o, forward, int(behind.size()));
+        });
     for (int ch = 0; ch < 3; ++ch) {
-        const double sigma = floor_light.sigma[ch];
-        const double want = ind[ch] / m, var_ind = std::max(0.0, ind2[ch] / m - want * want) / m;
-        ASSERT_GT(want, 0.0);
-        EXPECT_NEAR(floor_light.mean[ch], want, 5.0 * std::sqrt(sigma * sigma + var_ind)) << "ch " << ch;
+        ASSERT_GT(want.mean[ch], 0.0);
+        EXPECT_NEAR(floor_light.mean[ch], want.mean[ch],
+                    5.0 * std::hypot(floor_light.sigma[ch], want.sigma[ch])) << "ch " << ch;
     }
 }
 
@@ -539,76 +563,39 @@ TEST(DualScatteringRender, ALayersUnoccludedMeshLightAlsoCarriesTheLocalBackscat
     // without it, same random numbers) is the local term alone, against an estimate over
     // uniform directions from the hair's hits.
     const float strength = 3.0f, r = 0.02f;
-    const Vec3 to_sun{0, 0, 1};
     std::vector<Vec3> centres{{0, 0, 0}};
     for (int k = 1; k <= 4; ++k) {
         centres.push_back({0, float(k) * 2.0f * r, 0.05f});
         centres.push_back({0, -float(k) * 2.0f * r, 0.05f});
     }
-    auto scene_with = [&](bool floor) {
-        SceneDesc d;
-        d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(0.8f)}};
-        d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
-        if (floor) d.meshes = {quad_at(1.0f, -0.3f, 1)};
-        SunLight sun;
-        sun.to_sun = to_sun;
-        sun.strength = strength;
-        d.suns = {sun};
-        d.camera = looking_down(0.005f, 0.005f, 1, 1);
-        return build(std::move(d));
-    };
-    const Scene with = scene_with(true), without = scene_with(false);
+    const Scene with = sunlit_floor(centres, r, -0.3f, 0.005f, strength, true);
+    const Scene without = sunlit_floor(centres, r, -0.3f, 0.005f, strength, false);
     RenderSettings path = dual_settings(1, DualHairVolume::Layer);
     path.integrator = int(Integrator::Path);
     const RenderSettings dual = dual_settings(1, DualHairVolume::Layer);
-    const int n = 40000;
+    const int n = 40000, m = 100000;
     const Estimate dual_floor = mean_difference(with, dual, without, dual, n);
     const Estimate path_floor = mean_difference(with, path, without, path, n);
     const DualScattering &averages = *blonde().dual;
-    std::mt19937 rng(12);
-    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-    double ind[3] = {0, 0, 0}, ind2[3] = {0, 0, 0};
-    const int m = 100000;
-    std::vector<StrandCrossing> strands, behind;
+    std::vector<StrandCrossing> behind;
     int cut = 0;
-    for (int i = 0; i < m; ++i) {
-        const CameraRay cr = with.camera().generate_ray(0, 0, uniform(rng), uniform(rng));
-        const auto hit = with.intersect(cr.origin, cr.direction, cr.tmin, cr.tmax);
-        ASSERT_TRUE(hit.has_value());
-        const SurfacePoint sp = with.surface_point(cr.origin, cr.direction, *hit);
-        ASSERT_NEAR(sp.position.z, 0.0f, 1.01f * r) << "the camera sees the lower hair through the gap";
-        const Vec3 wo = -cr.direction;
-        const FiberFrame frame = FiberFrame::from_tangent_and_view(sp.tangent, wo);
-        const float z = 1.0f - 2.0f * uniform(rng), phi = float(kTwoPi) * uniform(rng);
-        const float rho = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const Vec3 w{rho * std::cos(phi), rho * std::sin(phi), z};
-        const auto floor = with.trace_through_hair(sp.spawn_point(w), w, 0.0f, INFINITY, sp.self, {}, strands);
-        Rgb value;
-        if (floor && floor->prim.geometry != PrimRef::kNone) {
+    const Estimate want = floor_light_by_uniform_directions(
+        with, strength, m, 12,
+        [&](const SurfacePoint &sp, float theta_i, float theta_o, Vec3 w, const std::vector<StrandCrossing> &strands) {
+            EXPECT_NEAR(sp.position.z, 0.0f, 1.01f * r) << "the camera sees the lower hair through the gap";
             EXPECT_TRUE(strands.empty()) << "nothing lies between the hair and the floor";
             with.trace_through_hair(sp.spawn_point(-w), -w, 0.0f, INFINITY, sp.self, {}, behind);
             cut += behind.empty() ? 0 : 1;
-            const SurfacePoint fp = with.surface_point(sp.spawn_point(w), w, *floor);
-            const bool lit = !with.occluded(fp.spawn_point(to_sun), to_sun, 0.0f, INFINITY, fp.self);
-            const float theta_i = std::asin(std::clamp(frame.to_local(w).x, -1.0f, 1.0f));
-            const float theta_o = std::asin(std::clamp(frame.to_local(wo).x, -1.0f, 1.0f));
-            const Rgb floor_radiance = Rgb(0.8f * strength / float(kPi)) * (lit ? 1.0f : 0.0f);
-            value = averages.local_f_cos(theta_i, theta_o, int(behind.size())) * floor_radiance *
-                    float(4.0 * kPi);
-        }
-        for (int ch = 0; ch < 3; ++ch) {
-            ind[ch] += value[ch];
-            ind2[ch] += double(value[ch]) * value[ch];
-        }
-    }
+            return averages.local_f_cos(theta_i, theta_o, int(behind.size()));
+        });
     EXPECT_GT(cut, m / 10) << "the mat lies behind the hair for part of the floor's light";
     for (int ch = 0; ch < 3; ++ch) {
         const double got = dual_floor.mean[ch] - path_floor.mean[ch];
-        const double sigma2 = dual_floor.sigma[ch] * dual_floor.sigma[ch] + path_floor.sigma[ch] * path_floor.sigma[ch];
-        const double want = ind[ch] / m, var_ind = std::max(0.0, ind2[ch] / m - want * want) / m;
-        ASSERT_GT(want, 0.0);
-        EXPECT_NEAR(got, want, 5.0 * std::sqrt(sigma2 + var_ind)) << "ch " << ch;
-        EXPECT_GT(want, 8.0 * std::sqrt(sigma2 + var_ind)) << "the test tells the term from none, ch " << ch;
+        const double sigma = std::sqrt(dual_floor.sigma[ch] * dual_floor.sigma[ch] +
+                                       path_floor.sigma[ch] * path_floor.sigma[ch] + want.sigma[ch] * want.sigma[ch]);
+        ASSERT_GT(want.mean[ch], 0.0);
+        EXPECT_NEAR(got, want.mean[ch], 5.0 * sigma) << "ch " << ch;
+        EXPECT_GT(want.mean[ch], 8.0 * sigma) << "the test tells the term from none, ch " << ch;
     }
 }
 
