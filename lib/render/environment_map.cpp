@@ -203,8 +203,8 @@ Expected<EnvironmentMap> EnvironmentMap::create(EnvironmentDesc desc) {
     // The map's resolution.
     int W = desc.map_width, H = desc.map_height;
     if (W == 0 && H == 0) {
-        W = std::min(image.width(), kMaxAutoMapWidth);
-        H = std::min(image.height(), kMaxAutoMapHeight);
+        W = std::min(std::max(image.width(), kMinAutoMapWidth), kMaxAutoMapWidth);
+        H = std::min(std::max(image.height(), kMinAutoMapHeight), kMaxAutoMapHeight);
     } else {
         if (H == 0) H = std::max(1, W / 2);
         if (Status s = first_error(check::count_in_range("map_width", W, 1, kMaxMapWidth),

@@ -84,7 +84,11 @@ struct EnvironmentDesc {
     float strength = 1.0f;
     Rgb color{1.0f};
     /// Importance-map resolution, like Cycles' World > Settings > Sampling. 0 (Auto): the
-    /// image's own, at most kMaxAutoMapWidth × kMaxAutoMapHeight. Otherwise Manual: width
+    /// image's own but at least kMinAutoMapWidth × kMinAutoMapHeight, as Cycles' Auto for a
+    /// world without a single Nishita sun (cycles@v3.4.0…v5.0.0 scene/light.cpp,
+    /// device_update_background), and at most kMaxAutoMapWidth × kMaxAutoMapHeight: finer
+    /// cells follow the bilinear radiance within a texel (a small HDRI's 2 × 2 sun: 5× less
+    /// variance on a diffuse floor at 32 spp). Otherwise Manual: width
     /// map_width in [1, kMaxMapWidth] and height map_height in [1, kMaxMapHeight], or
     /// map_width / 2 (at least 1) when map_height is 0, as Cycles' Map Resolution.
     int map_width = 0;
@@ -103,6 +107,8 @@ class EnvironmentMap {
   public:
     static constexpr int kMaxMapWidth = 8192;
     static constexpr int kMaxMapHeight = 4096;
+    static constexpr int kMinAutoMapWidth = 4096;
+    static constexpr int kMinAutoMapHeight = 2048;
     static constexpr int kMaxAutoMapWidth = kMaxMapWidth;
     static constexpr int kMaxAutoMapHeight = kMaxMapHeight;
 

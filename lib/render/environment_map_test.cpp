@@ -96,13 +96,14 @@ EnvironmentImage make_image(int w, int h, const std::function<Rgb(int, int)> &te
     return std::move(image).value();
 }
 
+// map_width = −1: a map at the image's resolution (the cells the χ² tests align to); 0: Auto.
 EnvironmentMap make_map(EnvironmentImage image, const Mat4 &world_to_texture = Mat4{},
-                        int map_width = 0, int map_height = 0) {
+                        int map_width = -1, int map_height = 0) {
     EnvironmentDesc desc;
+    desc.map_width = map_width < 0 ? image.width() : map_width;
+    desc.map_height = map_width < 0 ? image.height() : map_height;
     desc.image = std::move(image);
     desc.world_to_texture = world_to_texture;
-    desc.map_width = map_width;
-    desc.map_height = map_height;
     auto map = EnvironmentMap::create(std::move(desc));
     EXPECT_TRUE(map.ok()) << (map.ok() ? "" : map.error().message);
     return std::move(map).value();
@@ -348,8 +349,23 @@ TEST(EnvironmentChi2, RotatedAndScaledMapping) {
     EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
 }
 
-TEST(EnvironmentChi2, LargeImageAutoResolution) {
-    // A map at the image's own resolution of 512 × 256 cells, much finer than the χ² cells.
+TEST(EnvironmentMap, AutoResolutionIsCyclesOwn) {
+    // Cycles' Auto for an Environment Texture world: the image's size, but at least 4096 × 2048
+    // in each axis (the fallback for a world without a single Nishita sun).
+    const auto flat = [](int, int) { return Rgb{1.0f}; };
+    const EnvironmentMap small = make_map(make_image(64, 32, flat), Mat4{}, 0);
+    EXPECT_EQ(small.map_width(), 4096);
+    EXPECT_EQ(small.map_height(), 2048);
+    const EnvironmentMap wide = make_map(make_image(5000, 3, flat), Mat4{}, 0);
+    EXPECT_EQ(wide.map_width(), 5000);
+    EXPECT_EQ(wide.map_height(), 2048);
+    const EnvironmentMap manual = make_map(make_image(64, 32, flat), Mat4{}, 64, 32);
+    EXPECT_EQ(manual.map_width(), 64);
+    EXPECT_EQ(manual.map_height(), 32);
+}
+
+TEST(EnvironmentChi2, FineMapOfALargeImage) {
+    // A map at the image's resolution of 512 × 256 cells, much finer than the χ² cells.
     const EnvironmentMap map = make_map(make_image(512, 256, [](int x, int y) {
         const float s = std::sin(0.05f * float(x)) * std::cos(0.11f * float(y));
         return Rgb{1.0f + 0.9f * s, 0.5f, (x / 16 + y / 16) % 3 == 0 ? 5.0f : 0.0f};

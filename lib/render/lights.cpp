@@ -447,10 +447,14 @@ std::optional<LightSample> LightSet::sample(Vec3 p, float u_select, float u0, fl
 
 float LightSet::importance_at(const Lamp &lamp, Vec3 p) {
     switch (lamp.type) {
-        case LampType::Point:
-        case LampType::Spot: {
+        case LampType::Point: {
             const Vec3 d = p - lamp.position;
             return lamp.importance / std::max({dot(d, d), lamp.radius * lamp.radius, 1e-12f});
+        }
+        case LampType::Spot: {
+            const Vec3 d = p - lamp.position;
+            const float d2 = dot(d, d), r2 = lamp.radius * lamp.radius;
+            return lamp.importance * spot_reach(lamp, d, d2) / std::max({d2, r2, 1e-12f});
         }
         case LampType::Area: {
             const Vec3 d = p - lamp.position;
@@ -570,13 +574,28 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
 
 float LightSet::spot_factor(const Lamp &lamp, Vec3 n) {
     if (lamp.type != LampType::Spot) return 1.0f;
-    if (lamp.cycles == CyclesVersion::V3_4)
-        return cycles_light::spot_attenuation(dot(lamp.direction, n), lamp.cos_half, lamp.smooth);
+    const float c = spot_axis_cosine(lamp, n);
+    if (lamp.cycles == CyclesVersion::V3_4) return cycles_light::spot_attenuation(c, lamp.cos_half, lamp.smooth);
+    return cycles_light::spot_attenuation_cycles45(c, lamp.cos_half, lamp.smooth);
+}
+
+float LightSet::spot_reach(const Lamp &lamp, Vec3 d, float d2) {
+    const float r2 = lamp.radius * lamp.radius;
+    if (!(d2 > r2)) return 1.0f;  // within the light's radius: any direction may reach p
+    // The axis angle of p, less the disk's angular radius seen from p (the light may leave
+    // from any point of it), against the cone's half angle.
+    const float c = spot_axis_cosine(lamp, d * (1.0f / std::sqrt(d2)));
+    const float angle = std::acos(std::clamp(c, -1.0f, 1.0f)) - std::asin(std::sqrt(r2 / d2));
+    return angle <= std::acos(std::clamp(lamp.cos_half, -1.0f, 1.0f)) ? 1.0f : 0.0f;
+}
+
+float LightSet::spot_axis_cosine(const Lamp &lamp, Vec3 n) {
+    if (lamp.cycles == CyclesVersion::V3_4) return dot(lamp.direction, n);
     const float(&m)[3][3] = lamp.world_to_light;
     const Vec3 local = safe_normalize(Vec3{m[0][0] * n.x + m[0][1] * n.y + m[0][2] * n.z,
                                            m[1][0] * n.x + m[1][1] * n.y + m[1][2] * n.z,
                                            m[2][0] * n.x + m[2][1] * n.y + m[2][2] * n.z});
-    return cycles_light::spot_attenuation_cycles45(-local.z, lamp.cos_half, lamp.smooth);
+    return -local.z;
 }
 
 float LightSet::sphere_pdf(float d2, float r2) {

@@ -334,6 +334,12 @@ class LightSet {
 
     // The spot's attenuation for light leaving it in unit direction n (towards the receiver).
     static float spot_factor(const Lamp &lamp, Vec3 n);
+    // The cosine spot_factor compares with the cone: of n and the axis (3.4), of the light's
+    // own frame (4.5).
+    static float spot_axis_cosine(const Lamp &lamp, Vec3 n);
+    // 1 where light from some point of the spot's disk can leave inside its cone towards p
+    // (d = p − centre, d2 = |d|²), else 0.
+    static float spot_reach(const Lamp &lamp, Vec3 d, float d2);
     // Point and spot: the sphere's light-sampling density (without selection) seen from a
     // point at squared distance d2 from its centre.
     static float sphere_pdf(float d2, float r2);
@@ -351,7 +357,7 @@ class LightSet {
     std::optional<LightSample> sample_point_like(const Lamp &lamp, Vec3 p, float u0, float u1,
                                                  float pick) const;
     // Selection by importance: a lamp's estimate of the irradiance it brings to p, unshadowed
-    // (sun: E; point, spot: I/max(d², r²); area: L·A·max(cos, 0)/d², or L where p is within
+    // (sun: E; point: I/max(d², r²); spot: the same where its cone can reach p, else 0; area: L·A·max(cos, 0)/d², or L where p is within
     // √area of it; environment: πL̄ = ∫L dω/4), their sum over the lamps, and a lamp's share of
     // the lamps' probability from its importance: kUniformShare uniform, the rest by importance.
     static float importance_at(const Lamp &lamp, Vec3 p);

@@ -462,6 +462,37 @@ TEST(LightSet, SpotIrradianceClosedForms) {
     }
 }
 
+TEST(LightSet, ASpotIsChosenOnlyWhereItsConeCanReach) {
+    // A disk spot straight down (half angle 0.4; lamp 1, after the sun) beside a sun: where no point of the disk can
+    // light p inside the cone the spot keeps only its uniform share; where the disk's edge can
+    // (p just outside the bare cone) it keeps its importance. Either way the irradiance is the
+    // sum of the two lamps' own (each alone in its set, so picked with probability 1).
+    const float h = 2.0f, r = 0.3f, size = 0.8f;
+    SunLight sun;
+    sun.to_sun = safe_normalize(Vec3{0.3f, 0.0f, 1.0f});
+    sun.strength = 1.0f;
+    for (const CyclesVersion v : {CyclesVersion::V3_4, CyclesVersion::V4_5}) {
+        LightsDesc both, spot_only, sun_only;
+        both.spots = spot_only.spots = {spot_at({0, 0, h}, 2000.0f, r, size, 0.2f, v)};
+        both.suns = sun_only.suns = {sun};
+        const LightSet set = build_lights(both), spot = build_lights(spot_only), sun_set = build_lights(sun_only);
+        const float bare = h * std::tan(0.5f * size);  // the bare cone's radius on the floor
+        const float edge = bare + 0.5f * r;             // outside it, within the disk's reach
+        const float far = bare + 3.0f * r;              // out of reach
+        EXPECT_GT(set.lamp_selection_probability({0.5f * bare, 0, 0}, 1), 0.9f) << int(v);
+        EXPECT_GT(set.lamp_selection_probability({edge, 0, 0}, 1), 0.9f) << int(v);
+        EXPECT_NEAR(set.lamp_selection_probability({far, 0, 0}, 1), 0.05f, 1e-6f) << int(v);
+        for (const float x : {0.5f * bare, edge, far}) {
+            const Vec3 p{x, 0, 0}, n{0, 0, 1};
+            const auto [e, se] = irradiance(set, p, n, 40000);
+            const auto [e_spot, se_spot] = irradiance(spot, p, n, 40000);
+            const auto [e_sun, se_sun] = irradiance(sun_set, p, n, 40000);
+            EXPECT_NEAR(e, e_spot + e_sun, 4.0 * std::sqrt(se * se + se_spot * se_spot + se_sun * se_sun))
+                << int(v) << " x " << x;
+        }
+    }
+}
+
 TEST(LightSet, SpotConeFollowsTheObjectScaleInCycles45) {
     // Cycles 4.5 measures the cone in the light's frame: with the object scaled 2× along X, a
     // direction at angle β from the axis in the XZ plane has local z = cos β / √(cos²β +
