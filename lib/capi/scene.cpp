@@ -283,7 +283,7 @@ OptionReader read_world_options(const char *options, WorldOptions &o, bool pixel
                         " needs an environment (image=<path> or hairis_scene_set_world_pixels)");
     if (o.map_resolution != d.map_resolution && o.sampling != 1)
         invalid("world: map_resolution needs sampling=manual (auto follows the image's "
-                "resolution)");
+                "resolution, at least 4096 x 2048)");
     return reader;
 }
 

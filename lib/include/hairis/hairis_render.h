@@ -155,7 +155,7 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options);
  * object's inverse matrix, without translation), then the Mapping node: mapping = point |
  * texture | vector | normal, rotation (XYZ Euler, radians), scale (its Location must be 0 and
  * is not taken). sampling = auto (default: light-sampled with an importance map at the
- * image's resolution, at most 8192 x 4096) | manual (map_resolution x map_resolution/2,
+ * image's resolution but at least 4096 x 2048 and at most 8192 x 4096, as Cycles' Auto) | manual (map_resolution x map_resolution/2,
  * map_resolution in [1, 8192], default 1024) | none (not light-sampled: found by BSDF rays
  * alone), as World > Settings > Sampling. Environment options other than their defaults are
  * refused without an environment. The image is read and its importance map built here.
