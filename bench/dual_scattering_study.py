@@ -33,7 +33,8 @@ HAIRIS_DUAL_PATH_SPPS (4,16,64), HAIRIS_DUAL_CASES (all: blonde_sun, brunette_su
 blonde_area, brunette_area, black_area), HAIRIS_DUAL_OUT (bench/results), HAIRIS_DUAL_PROBE=1
 (one render of each method at 4 spp per case, timings only), HAIRIS_DUAL_MODEL (CHIANG, or
 HUANG: the node's Huang model, Blender 4.0 or newer, e.g. the bpy 4.5 wheel through
-run_test.py --bpy-python; Coat and Radial Roughness are Chiang's alone).
+run_test.py --bpy-python; Coat and Radial Roughness are Chiang's alone), HAIRIS_DUAL_EXACT
+(Exact Bounces; unset: the add-on's default).
 """
 
 import json
@@ -80,6 +81,8 @@ HUANG_ASPECT = (float(os.environ["HAIRIS_DUAL_HUANG_ASPECT"])
                 if "HAIRIS_DUAL_HUANG_ASPECT" in os.environ else None)
 # Diagnostic: Hair Volume (HAIRIS_DUAL_VOLUME=LAYER, the default, or UNBOUNDED).
 VOLUME = os.environ.get("HAIRIS_DUAL_VOLUME", "LAYER")
+# Exact Bounces (HAIRIS_DUAL_EXACT; unset: the add-on's default).
+EXACT = int(os.environ["HAIRIS_DUAL_EXACT"]) if "HAIRIS_DUAL_EXACT" in os.environ else None
 # Diagnostic: the sphere's diffuse colour (HAIRIS_DUAL_SKIN=r,g,b; 0,0,0 removes its light).
 SKIN = tuple(float(v) for v in os.environ.get("HAIRIS_DUAL_SKIN", "0.7,0.5,0.4").split(","))
 if MODEL not in ("CHIANG", "HUANG"):
@@ -150,6 +153,8 @@ def make_case_scene(colour, lighting):
     hairis.max_bounces = BOUNCES
     hairis.strategy = "TABLE"
     hairis.dual_hair_volume = VOLUME
+    if EXACT is not None:
+        hairis.dual_exact_bounces = EXACT
     hairis.auto_bake = True
     hairis.threads = 1
     bpy.context.view_layer.update()
@@ -333,7 +338,9 @@ def main():
                             "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
                             "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
                             "threads": 1, "probe": PROBE, "model": MODEL,
-                            "skin": list(SKIN), "volume": VOLUME},
+                            "skin": list(SKIN), "volume": VOLUME,
+                            "exact_bounces": (EXACT if EXACT is not None else
+                                              bpy.context.scene.hairis.dual_exact_bounces)},
                "cases": cases}
     os.makedirs(OUT, exist_ok=True)
     suffix = "_probe" if PROBE else ""

@@ -90,6 +90,7 @@ def render_settings(settings):
             "strategy": settings.strategy.lower(),
             "huang_sampling": settings.huang_sampling.lower(),
             "dual_hair_volume": settings.dual_hair_volume.lower(),
+            "dual_exact_bounces": int(settings.dual_exact_bounces),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces()}

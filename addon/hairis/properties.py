@@ -53,6 +53,12 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
                 "Zinke et al.'s semi-infinite hair volume (too bright and too red on light hair "
                 "over a head)", 1)),
         default="LAYER")
+    dual_exact_bounces: IntProperty(
+        name="Exact Bounces",
+        description="Bounces path-traced before Dual Scattering closes the path: 0 shades the "
+                    "first hair hit by dual scattering alone (flattest, least noise); each one "
+                    "more leaves less of the light to the approximation (less bias, more noise)",
+        default=3, min=0, max=1024, soft_max=8)
     max_transparent_bounces: IntProperty(
         name="Transparent Max Bounces",
         description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "

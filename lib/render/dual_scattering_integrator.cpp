@@ -45,6 +45,13 @@ bool same_ray(const LightSample &a, const LightSample &b) {
 
 }  // namespace
 
+int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
+                   std::vector<StrandCrossing> &scratch) {
+    const Vec3 dir = -wi;
+    return scene.strands_before_mesh(point.spawn_point(dir), dir, 0.0f, INFINITY, point.self,
+                                     kMaxStrandsBehind, scratch);
+}
+
 ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
                                             std::size_t count, Vec3 dir,
                                             const DualScattering &fallback) {
@@ -123,19 +130,11 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
     // the light's travel, −ω_i, up to the first mesh (−1: unbounded).
     auto depth_behind = [&](Vec3 wi) {
         if (!v.layer) return -1;
-        const Vec3 dir = -wi;
-        scene.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {}, work.behind);
         ++work.rays;
-        return int(work.behind.size());
+        return strands_behind(scene, sp, wi, work.behind);
     };
     // The continuation's (the caller's): behind the vertex away from the probe's light point.
-    int depth = -1;
-    if (v.layer) {
-        const Vec3 dir = -(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
-        scene.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {}, work.behind);
-        ++work.rays;
-        depth = int(work.behind.size());
-    }
+    const int depth = depth_behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
     work.last_depth = depth;
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;

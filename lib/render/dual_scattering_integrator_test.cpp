@@ -110,10 +110,12 @@ Scene build(SceneDesc d) {
     return std::move(s).value();
 }
 
-// The paper's unbounded hair volume, whose closed forms most tests here check.
+// The paper's unbounded hair volume and its dual scattering at the first hair hit (no exact
+// bounces), whose closed forms most tests here check.
 RenderSettings dual_settings(int max_bounces = 0, DualHairVolume volume = DualHairVolume::Unbounded) {
     RenderSettings s;
     s.integrator = int(Integrator::DualScattering);
+    s.dual_exact_bounces = 0;
     s.dual_hair_volume = int(volume);
     s.max_bounces = max_bounces;
     s.film_transparent = true;
@@ -845,6 +847,37 @@ HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
         c.first.push_back(std::uint32_t(c.points.size()));
     }
     return c;
+}
+
+TEST(TraceThroughHair, StrandsBeforeMeshIsTheCappedCountOfTheFullTrace) {
+    // Random rays through a dense tuft cut by a floor half-way up: the capped count equals the
+    // full trace's count, capped, for every cap (the traversal stops early only once it knows).
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
+    d.curves = {tuft(1500, 6, 0.008f)};
+    d.curves[0].material = 1;
+    d.meshes = {quad_at(0.2f, 0.45f, 0)};
+    d.camera = looking_down(1, 1, 4, 4);
+    const Scene scene = build(std::move(d));
+    std::vector<StrandCrossing> full, scratch;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+    auto u = [&] { return uniform(rng); };
+    int crossed_many = 0, stopped_by_mesh = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 origin{0.3f * u(), 0.3f * u(), 0.5f + 0.5f * u()};
+        const Vec3 dir = safe_normalize(Vec3{u(), u(), 0.5f * u()});
+        if (!(dot(dir, dir) > 0.0f)) continue;
+        const auto mesh = scene.trace_through_hair(origin, dir, 0.0f, INFINITY, {}, {}, full);
+        const int n = int(full.size());
+        crossed_many += n > 16;
+        stopped_by_mesh += mesh.has_value() && n > 0;
+        for (const int cap : {1, 3, 16, 64})
+            ASSERT_EQ(scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, {}, cap, scratch), std::min(n, cap))
+                << "ray " << i << " cap " << cap;
+    }
+    EXPECT_GT(crossed_many, 100);  // the caps were exercised
+    EXPECT_GT(stopped_by_mesh, 100);
 }
 
 TEST(DualScatteringRender, AUniformMultipleTableGivesTheSameMeanWithMoreNoise) {

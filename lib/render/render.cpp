@@ -340,11 +340,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // this light's travel, −ω_i (the mesh's emission above is f_s's alone: emitters' M is
         // the light and table samples').
         if (dual_from.dual && dual_layer && !through_hair) {
-            std::vector<StrandCrossing> &behind = counters.dual.behind;
-            scene.trace_through_hair(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self, {}, behind);
+            const int behind = scene.strands_before_mesh(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self,
+                                                         kMaxStrandsBehind, counters.dual.behind);
             ++counters.rays;
             const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
-            const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, int(behind.size()));
+            const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, behind);
             beta += dual_from.beta * m / bsdf_pdf;
             if (!finite(beta)) break;
         }
@@ -359,7 +359,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // Next-event estimation.
         // render() refuses hair without dual-scattering data; render_sample() path-traces it.
         const auto *hair = dual ? std::get_if<HairMaterial>(&material) : nullptr;
-        const bool dual_vertex = hair && hair->dual && hair->multiple && bsdf.hair();
+        const bool dual_vertex = hair && hair->dual && hair->multiple && bsdf.hair() &&
+                                 depth >= settings.dual_exact_bounces;
         if (dual_vertex) {
             DualVertex v;
             v.point = &sp;
@@ -477,7 +478,8 @@ Status validate(const RenderSettings &s) {
                        check::count_in_range("tile_size", s.tile_size, 1, 4096),
                        check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024),
                        check::count_in_range("huang_sampling", s.huang_sampling, 0, 1),
-                       check::count_in_range("dual_hair_volume", s.dual_hair_volume, 0, 1));
+                       check::count_in_range("dual_hair_volume", s.dual_hair_volume, 0, 1),
+                       check::count_in_range("dual_exact_bounces", s.dual_exact_bounces, 0, 1024));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.

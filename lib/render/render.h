@@ -160,6 +160,13 @@ struct RenderSettings {
     int huang_sampling = int(HuangSampling::Strategy);
     /// A DualHairVolume for integrator=dual_scattering: "layer" or "unbounded".
     int dual_hair_volume = int(DualHairVolume::Layer);
+    /// integrator=dual_scattering: the path's first scattering vertices (depth < this, the
+    /// camera's hit is depth 0) are path-traced as integrator=path traces them, and the first
+    /// hair vertex at a depth >= this is shaded by dual scattering, which closes the path there
+    /// (its light from other strands is the dual estimate's). In [0, 1024]; 0 is Zinke et al.'s
+    /// dual scattering at the first hair hit. Each exact bounce leaves less of the light to the
+    /// approximation: less bias, more noise (bench/results/dual_scattering.md measures both).
+    int dual_exact_bounces = 3;
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -180,6 +187,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("film_transparent", s.film_transparent);
     f.choice("huang_sampling", s.huang_sampling, {"strategy", "cycles"});
     f.choice("dual_hair_volume", s.dual_hair_volume, {"layer", "unbounded"});
+    f.field("dual_exact_bounces", s.dual_exact_bounces, 0, 1024);
 }
 
 /// What a render did.

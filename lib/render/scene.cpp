@@ -61,6 +61,9 @@ struct TraceContext {
     PrimRef skip_a, skip_b;
     bool hit_curve_backfaces = false;
     std::vector<StrandCrossing> *strands = nullptr;
+    // With strands: once it holds this many records, curve hits are accepted (the ray's tfar
+    // shrinks to them) instead of let through, which ends the traversal early.
+    std::size_t accept_after = std::numeric_limits<std::size_t>::max();
 };
 
 bool skipped(const TraceContext *ctx, unsigned geom, unsigned prim) {
@@ -111,7 +114,7 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
                     break;
                 }
             if (!repeat) out.push_back(c);
-            args->valid[i] = 0;
+            if (out.size() < ctx->accept_after) args->valid[i] = 0;
         }
     }
 }
@@ -649,21 +652,35 @@ bool Scene::occluded(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip
 std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                              PrimRef skip_a, PrimRef skip_b,
                                              std::vector<StrandCrossing> &strands) const {
+    bool stopped = false;
+    return trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands,
+                              std::numeric_limits<std::size_t>::max(), stopped);
+}
+
+std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                             PrimRef skip_a, PrimRef skip_b,
+                                             std::vector<StrandCrossing> &strands,
+                                             std::size_t accept_after, bool &stopped) const {
     strands.clear();
+    stopped = false;
     if (!traceable(origin, dir, tmin, tmax)) return Hit{tmin, PrimRef{}, 0.0f, 0.0f};  // blocked
     TraceContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.skip_a = skip_a;
     ctx.skip_b = skip_b;
     ctx.strands = &strands;
+    ctx.accept_after = accept_after;
     RTCRayHit rh = ray_hit(origin, dir, tmin, tmax);
     rtcIntersect1(impl_->rtc_scene, &ctx.rtc, &rh);
     std::optional<Hit> mesh;
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
-        mesh = Hit{rh.ray.tfar, {rh.hit.geomID, rh.hit.primID}, rh.hit.u, rh.hit.v};
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+        // An accepted curve hit: the traversal stopped there, with no mesh before it.
+        stopped = impl_->geometries[rh.hit.geomID].is_curve;
+        if (!stopped) mesh = Hit{rh.ray.tfar, {rh.hit.geomID, rh.hit.primID}, rh.hit.u, rh.hit.v};
+    }
 
-    // Hair hits recorded before a nearer triangle was found lie behind it.
-    const float t_end = mesh ? mesh->t : tmax;
+    // Hair hits recorded before a nearer triangle (or accepted curve) was found lie behind it.
+    const float t_end = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar : tmax;
     strands.erase(std::remove_if(strands.begin(), strands.end(),
                                  [&](const StrandCrossing &c) { return !(c.t < t_end); }),
                   strands.end());
@@ -702,6 +719,18 @@ std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, 
     }
     strands.resize(kept);
     return mesh;
+}
+
+int Scene::strands_before_mesh(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip, int cap,
+                               std::vector<StrandCrossing> &scratch) const {
+    cap = std::max(cap, 1);
+    // A crossing may leave two records (a joint of two segments): 2·cap records hold at least
+    // cap crossings but for repeats, which the fallback below covers.
+    bool stopped = false;
+    trace_through_hair(origin, dir, tmin, tmax, skip, {}, scratch, 2 * std::size_t(cap), stopped);
+    if (!stopped || int(scratch.size()) >= cap) return std::min(int(scratch.size()), cap);
+    trace_through_hair(origin, dir, tmin, tmax, skip, {}, scratch);  // too few before the stop
+    return std::min(int(scratch.size()), cap);
 }
 
 Vec3 Scene::curve_point(PrimRef segment, float u, Vec3 *derivative, float *radius) const {

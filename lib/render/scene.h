@@ -271,6 +271,18 @@ class Scene {
     std::optional<Hit> trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                           PrimRef skip_a, PrimRef skip_b,
                                           std::vector<StrandCrossing> &strands) const;
+    /// min(cap, the strands trace_through_hair reports along the ray), cap >= 1: the traversal
+    /// stops once cap crossings are known to lie before any mesh (so a long ray through dense
+    /// hair costs about what its first cap crossings cost). `scratch` is overwritten.
+    int strands_before_mesh(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip, int cap,
+                            std::vector<StrandCrossing> &scratch) const;
+    /// trace_through_hair, with curve hits accepted once `accept_after` hits are recorded;
+    /// `stopped`: the traversal ended at such a hit (no mesh before it; the strands reported
+    /// are those before it).
+    std::optional<Hit> trace_through_hair(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                          PrimRef skip_a, PrimRef skip_b,
+                                          std::vector<StrandCrossing> &strands,
+                                          std::size_t accept_after, bool &stopped) const;
     /// Shading data of a hit of the ray (origin, dir).
     SurfacePoint surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const;
     /// The node inputs a curve hit's curve set gives (HairCurves::inputs) at the hit, in

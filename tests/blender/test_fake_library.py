@@ -247,7 +247,11 @@ def test_dual_scattering_needs_tables_whatever_the_strategy():
     _pixels, summary = render(scene)
     assert summary_value(summary, "integrator") == "1"
     assert summary_value(summary, "strategy") == "1"
+    assert summary_value(summary, "dual_exact_bounces") == "3"
     assert summary.count("tables=1") == 2, summary
+    scene.hairis.dual_exact_bounces = 0
+    _pixels, summary = render(scene)
+    assert summary_value(summary, "dual_exact_bounces") == "0"
     scene.hairis.integrator = "PATH"
     _pixels, summary = render(scene)
     assert summary_value(summary, "integrator") == "0"

@@ -313,6 +313,7 @@ static void test_defaults(void)
     expect_default("sampler", "multiple_weight", "0");
     expect_default("sampler", "n_h", "2");
     expect_default("render", "integrator", "path");
+    expect_default("render", "dual_exact_bounces", "3");
     expect_default("render", "samples", "64");
     expect_default("render", "max_bounces", "12");
     expect_default("render", "max_diffuse_bounces", "4");
@@ -1431,7 +1432,7 @@ static void test_render(void)
               "path reference");
         const char *direct[2] = {"table", "analytic"};
         for (int k = 0; k < 2; ++k) {
-            CHECK(hairis_render(scene, tiny_settings(s, direct[k], ";integrator=dual_scattering;seed=7;threads=2"),
+            CHECK(hairis_render(scene, tiny_settings(s, direct[k], ";integrator=dual_scattering;dual_exact_bounces=0;seed=7;threads=2"),
                                 rgba, NULL, NULL) == HAIRIS_OK,
                   "dual scattering with strategy %s", direct[k]);
             CHECK_NO_ERROR();
@@ -1441,7 +1442,7 @@ static void test_render(void)
                   hairis_last_render_stats());
         }
         CHECK(memcmp(rgba, path, sizeof rgba) != 0, "dual scattering is not the path tracer");
-        CHECK(hairis_render(scene, tiny_settings(s, "analytic", ";integrator=dual_scattering;seed=7;threads=1"),
+        CHECK(hairis_render(scene, tiny_settings(s, "analytic", ";integrator=dual_scattering;dual_exact_bounces=0;seed=7;threads=1"),
                             again, NULL, NULL) == HAIRIS_OK,
               "dual scattering, 1 thread");
         CHECK(memcmp(rgba, again, sizeof rgba) == 0, "dual: bit-identical with 1 and 2 threads");
@@ -1449,6 +1450,11 @@ static void test_render(void)
                             again, NULL, NULL) == HAIRIS_OK,
               "integrator=path");
         CHECK(memcmp(path, again, sizeof again) == 0, "integrator=path is the default");
+        CHECK(hairis_render(scene, tiny_settings(s, "table", ";integrator=dual_scattering;dual_exact_bounces=1024;seed=7;threads=2"),
+                            again, NULL, NULL) == HAIRIS_OK,
+              "dual scattering with every bounce exact");
+        CHECK(memcmp(path, again, sizeof again) == 0,
+              "dual scattering with every bounce exact is the path tracer, bit for bit");
     }
 
     /* Same seed, same image, whatever the thread count or tile size; another seed differs. */
@@ -1547,6 +1553,8 @@ static void test_render(void)
                                 {"tile_size=4097", "tile_size"},
                                 {"threads=-1", "threads"},
                                 {"rr_start_bounce=0", "rr_start_bounce"},
+                                {"dual_exact_bounces=-1", "dual_exact_bounces"},
+                                {"dual_exact_bounces=1025", "dual_exact_bounces"},
                                 {"samples=16777217", "samples"},
                                 {"film_transparent=maybe", "film_transparent"},
                                 {"curve_backfaces=yes", "curve_backfaces"}};
@@ -1845,11 +1853,11 @@ static void test_huang(void)
      * Huang table whatever huang_sampling says (its MIS needs the sampler's density); tables
      * without the multiple part are refused naming the material and what to do. */
     static float dual[W * H * 4], path[W * H * 4];
-    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;seed=3"), dual, NULL, NULL) ==
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;dual_exact_bounces=0;seed=3"), dual, NULL, NULL) ==
               HAIRIS_OK,
           "dual scattering renders Huang: %s", hairis_last_error());
     CHECK(pixels_ok(dual) && pixel_sum(dual, W * H) > 0.0, "dual Huang: a finite, non-black image");
-    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;seed=3;huang_sampling=cycles"),
+    CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;dual_exact_bounces=0;seed=3;huang_sampling=cycles"),
                         rgba, NULL, NULL) == HAIRIS_OK,
           "dual scattering with huang_sampling=cycles: %s", hairis_last_error());
     CHECK(memcmp(rgba, dual, sizeof rgba) == 0, "dual scattering samples Huang with its table either way");

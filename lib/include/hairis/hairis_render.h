@@ -193,7 +193,10 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * (lib/render/dual_scattering_integrator.h) and needs every hair material's tables
  * (HAIRIS_ERROR_INVALID_TABLE naming the material otherwise); its dual_hair_volume = layer
  * (default: the hair is a layer over what is under it, whose light reaches hair through the
- * strands) | unbounded (Zinke et al.'s semi-infinite hair volume). A scene without camera or
+ * strands) | unbounded (Zinke et al.'s semi-infinite hair volume), and dual_exact_bounces (in
+ * [0, 1024], default 3) the path's first scattering vertices that are path-traced before the
+ * first hair vertex at that depth or deeper closes the path by dual scattering (0: at the
+ * first hair hit, the paper's). A scene without camera or
  * geometry is refused. Each call builds the scene anew, so
  * a scene can be rendered again with other settings, also from several threads at once.
  */
