@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "same_bits.h"
 #include "core/quadrature.h"
 #include "fiber/chiang.h"
 #include "fiber/distributions.h"
@@ -878,6 +879,46 @@ TEST(TraceThroughHair, StrandsBeforeMeshIsTheCappedCountOfTheFullTrace) {
     }
     EXPECT_GT(crossed_many, 100);  // the caps were exercised
     EXPECT_GT(stopped_by_mesh, 100);
+}
+
+TEST(DualScatteringRender, ExactBouncesArePathTracedAndTheClosureMovesWithThem) {
+    // A blonde tuft over a floor under a sun and a world: with every bounce exact the dual
+    // render is the path tracer's image bit for bit; with fewer, each exact bounce moves the
+    // image, since the vertex that closes the path by dual scattering moves deeper.
+    SceneDesc d;
+    d.materials = {dual_hair(blonde()), DiffuseMaterial{}};
+    d.curves = {tuft(300, 6, 0.006f)};
+    d.meshes = {quad_at(1.0f, 0.0f, 1)};
+    SunLight sun;
+    sun.to_sun = safe_normalize(Vec3{0.3f, -0.5f, 1.0f});
+    sun.strength = 2.0f;
+    d.suns = {sun};
+    d.world = {Rgb(0.3f), 1.0f};
+    d.camera = looking_down(0.4f, 0.4f, 12, 12);
+    const Scene scene = build(std::move(d));
+    RenderSettings path;
+    path.samples = 4;
+    path.max_bounces = 6;
+    path.threads = 1;
+    const std::size_t n = 12 * 12 * 4;
+    std::vector<float> reference(n), image(n), previous(n);
+    ASSERT_FALSE(render(scene, path, reference.data(), {}, nullptr));
+    RenderSettings dual = path;
+    dual.integrator = int(Integrator::DualScattering);
+    for (const int exact : {7, 1024}) {
+        dual.dual_exact_bounces = exact;
+        ASSERT_FALSE(render(scene, dual, image.data(), {}, nullptr));
+        EXPECT_TRUE(testing::same_bits(image, reference)) << "exact bounces " << exact;
+    }
+    for (const int exact : {0, 1, 2}) {
+        dual.dual_exact_bounces = exact;
+        ASSERT_FALSE(render(scene, dual, image.data(), {}, nullptr));
+        EXPECT_FALSE(testing::same_bits(image, reference)) << "exact bounces " << exact;
+        if (exact > 0) {
+            EXPECT_FALSE(testing::same_bits(image, previous)) << "exact bounces " << exact;
+        }
+        previous = image;
+    }
 }
 
 TEST(DualScatteringRender, AUniformMultipleTableGivesTheSameMeanWithMoreNoise) {
