@@ -152,13 +152,16 @@ def write_markdown(results, numbers, path):
              "Roughness%s 0.3) under a 1° sun with a world colour (`sun`) or a "
              "1.2 m square area light in a black world (`area`), %dx%d pixels, %d bounces, one "
              "thread for Hairis and for Cycles. Hairis uses the TABLE strategy for its direct "
-             "term in both integrators. Errors are over the %s hair pixels (a Cycles alpha render "
-             "without the sphere), relative to the reference's channel means." % (
+             "term in both integrators; DUAL path-traces its first %s bounces (Exact Bounces) "
+             "and closes the path by dual scattering at the next hair vertex. Errors are over "
+             "the %s hair pixels (a Cycles alpha render without the sphere), relative to the "
+             "reference's channel means." % (
                  " with the Huang model (its defaults: Aspect Ratio 0.85, Offset 2°; Hairis "
                  "samples Huang with its tables in DUAL, with Cycles' sampler in PATH)"
                  if s.get("model") == "HUANG" else "",
                  "" if s.get("model") == "HUANG" else " and Radial Roughness",
                  s["resolution"][0], s["resolution"][1], s["bounces"],
+                 s.get("exact_bounces", 0),
                  "/".join(str(c["hair_pixels"]) for c in results["cases"].values())), "",
              "Reference: Hairis PATH at %d spp (two halves, seeds 1000 and 1001; their difference "
              "gives the reference's own noise, which is subtracted from every MSE). Cycles at %d "
