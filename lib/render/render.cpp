@@ -318,7 +318,10 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         context.camera_ray = depth == 0;
         context.footprint = cr.footprint_at(hit->t);
         context.seed = vertex_seed(seeds, depth);
-        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles) && !dual;
+        // A dual vertex needs the strategy's sampler (its MIS needs a density); the exact
+        // bounces before it are path-traced as integrator=path traces them.
+        context.cycles_huang = settings.huang_sampling == int(HuangSampling::Cycles) &&
+                               !(dual && depth >= settings.dual_exact_bounces);
         const HairInputValues *inputs = nullptr;
         if (sp.is_curve) {
             HairInputValues values;

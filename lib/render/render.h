@@ -155,8 +155,9 @@ struct RenderSettings {
     /// Blender's Film > Transparent: camera rays that miss everything add neither the world
     /// nor alpha (suns seen directly still add their disc, as in Cycles). Alpha is otherwise 1.
     bool film_transparent = false;
-    /// A HuangSampling: how Huang hair samples directions (integrator=dual_scattering always
-    /// uses the strategy's sampler: its MIS needs a density, which Cycles' sampler lacks).
+    /// A HuangSampling: how Huang hair samples directions (integrator=dual_scattering uses
+    /// the strategy's sampler at the vertex that closes the path, whose MIS needs a density,
+    /// which Cycles' sampler lacks; its exact bounces follow this setting).
     int huang_sampling = int(HuangSampling::Strategy);
     /// A DualHairVolume for integrator=dual_scattering: "layer" or "unbounded".
     int dual_hair_volume = int(DualHairVolume::Layer);

@@ -1849,8 +1849,9 @@ static void test_huang(void)
     CHECK(mean[0] > 0.0 && fabs(mean[0] - mean[1]) <= 4.0 * sqrt(error2),
           "TABLE and UNIFORM agree in the mean: %g and %g (standard error of the difference %g)", mean[0], mean[1],
           sqrt(error2));
-    /* Dual scattering renders Huang hair with the tables' multiple part, sampling it with the
-     * Huang table whatever huang_sampling says (its MIS needs the sampler's density); tables
+    /* Dual scattering renders Huang hair with the tables' multiple part, sampling the vertex
+     * that closes the path with the Huang table whatever huang_sampling says (its MIS needs the
+     * sampler's density); tables
      * without the multiple part are refused naming the material and what to do. */
     static float dual[W * H * 4], path[W * H * 4];
     CHECK(hairis_render(tabled, tiny_settings(s, "table", ";integrator=dual_scattering;dual_exact_bounces=0;seed=3"), dual, NULL, NULL) ==
@@ -1864,6 +1865,22 @@ static void test_huang(void)
     CHECK(hairis_render(tabled, tiny_settings(s, "table", ";seed=3"), path, NULL, NULL) == HAIRIS_OK,
           "path tracing the same scene");
     CHECK(memcmp(path, dual, sizeof path) != 0, "dual scattering is not the path tracer for Huang");
+    /* Its exact bounces are path-traced as huang_sampling says: with every bounce exact, the
+     * path tracer's image bit for bit under either sampler. */
+    static float exact[W * H * 4];
+    const char *samplings[2] = {"strategy", "cycles"};
+    for (int k = 0; k < 2; ++k) {
+        char extra[128];
+        snprintf(extra, sizeof extra, ";seed=3;huang_sampling=%s", samplings[k]);
+        CHECK(hairis_render(tabled, tiny_settings(s, "table", extra), path, NULL, NULL) == HAIRIS_OK,
+              "path tracing Huang with huang_sampling=%s", samplings[k]);
+        snprintf(extra, sizeof extra, ";integrator=dual_scattering;dual_exact_bounces=1024;seed=3;huang_sampling=%s",
+                 samplings[k]);
+        CHECK(hairis_render(tabled, tiny_settings(s, "table", extra), exact, NULL, NULL) == HAIRIS_OK,
+              "dual scattering with every bounce exact, huang_sampling=%s", samplings[k]);
+        CHECK(memcmp(path, exact, sizeof path) == 0,
+              "dual scattering with every bounce exact is the path tracer for Huang, huang_sampling=%s", samplings[k]);
+    }
     CHECK(hairis_render(tabled, tiny_settings(s, "analytic", ";integrator=dual_scattering;huang_sampling=cycles"),
                         rgba, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "dual scattering with analytic is refused for Huang, whatever huang_sampling says");
