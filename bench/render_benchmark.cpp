@@ -1,5 +1,6 @@
 // Google Benchmark: time per sample of the path tracer on a scene like bench/render_versions'
-// "sphere" (1000 strands of particle-like hair on a diffuse sphere, a sun and a dim world,
+// "sphere" (1000 strands of particle-like hair on a diffuse sphere, and 12000 as dense as
+// bench/dual_scattering_study's, under a sun and a dim world,
 // 8 bounces, 96 × 96, one thread), per strategy and integrator (path, dual_scattering),
 // without Blender. Each iteration renders
 // kSamples samples per pixel; the counter ms_per_spp is its CPU time per sample per pixel
@@ -15,6 +16,7 @@
 
 #include "fiber/fiber_spec.h"
 #include "fiber/principled_hair.h"
+#include "render/dual_scattering_integrator.h"
 #include "render/render.h"
 #include "render/scene.h"
 #include "sampling/strategy.h"
@@ -69,7 +71,7 @@ TriangleMesh sphere_mesh(int rings, int segments) {
     return m;
 }
 
-Expected<Scene> sphere_scene(StrategyKind kind, Integrator integrator) {
+Expected<Scene> sphere_scene(StrategyKind kind, Integrator integrator, std::size_t strands = 1000) {
     PrincipledHairNode node;
     node.parametrization = HairParametrization::Melanin;
     node.melanin = 0.25f;
@@ -108,7 +110,7 @@ Expected<Scene> sphere_scene(StrategyKind kind, Integrator integrator) {
     DiffuseMaterial skin;
     skin.albedo = {0.6f, 0.5f, 0.45f};
     desc.materials.push_back(skin);
-    desc.curves.push_back(sphere_strands(1000));
+    desc.curves.push_back(sphere_strands(strands));
     desc.meshes.push_back(sphere_mesh(24, 48));
     SunLight sun;
     sun.to_sun = safe_normalize(Vec3{0.5f, -0.6f, 0.6f});
@@ -129,7 +131,8 @@ Expected<Scene> sphere_scene(StrategyKind kind, Integrator integrator) {
 void render_sphere(benchmark::State &state) {
     const auto kind = StrategyKind(state.range(0));
     const auto integrator = Integrator(state.range(1));
-    auto scene = sphere_scene(kind, integrator);
+    const auto strands = std::size_t(state.range(2));
+    auto scene = sphere_scene(kind, integrator, strands);
     if (!scene) {
         state.SkipWithError(scene.error().message.c_str());
         return;
@@ -159,12 +162,72 @@ void render_sphere(benchmark::State &state) {
     state.counters["ms_per_spp"] = 1e3 * cpu_seconds / double(state.iterations()) / kSamples;
     state.counters["rays_per_sample"] = double(stats.rays) / samples;
     state.counters["shadow_rays_per_sample"] = double(stats.shadow_rays) / samples;
-    state.SetLabel(std::string(strategy_name(kind)) + (integrator == Integrator::DualScattering ? ", dual" : ", path"));
+    state.SetLabel(std::string(strategy_name(kind)) +
+                   (integrator == Integrator::DualScattering ? ", dual" : ", path") + ", " +
+                   std::to_string(strands) + " strands");
 }
+// Time per ray of each query from hair points in a dense ball (12000 strands, as
+// bench/dual_scattering_study's), in directions uniform on the sphere: 0 intersect (closest
+// hit), 1 occluded, 2 trace_through_hair (every crossing), 3 strands_before_mesh (capped at
+// kMaxStrandsBehind). The counter crossings is the mean strand count per ray.
+void hair_rays(benchmark::State &state) {
+    const int query = int(state.range(0));
+    auto scene = sphere_scene(StrategyKind::Analytic, Integrator::Path, 12000);
+    if (!scene) {
+        state.SkipWithError(scene.error().message.c_str());
+        return;
+    }
+    const Scene &s = scene.value();
+    // Ray origins: where rays from outside the ball towards its centre first hit hair.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    auto sphere_dir = [&] {
+        const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng);
+        const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        return Vec3{r * std::cos(phi), r * std::sin(phi), z};
+    };
+    std::vector<SurfacePoint> points;
+    while (points.size() < 4096) {
+        const Vec3 from = 3.0f * sphere_dir(), dir = safe_normalize(0.3f * sphere_dir() - from);
+        const auto hit = s.intersect(from, dir, 0.0f, INFINITY, {});
+        if (!hit) continue;
+        const SurfacePoint sp = s.surface_point(from, dir, *hit);
+        if (sp.is_curve) points.push_back(sp);
+    }
+    std::vector<Vec3> dirs(points.size());
+    for (Vec3 &d : dirs) d = sphere_dir();
+    std::vector<StrandCrossing> crossings;
+    std::size_t k = 0, rays = 0, strands = 0;
+    for (auto _ : state) {
+        const SurfacePoint &sp = points[k % points.size()];
+        const Vec3 dir = dirs[k % dirs.size()];
+        ++k;
+        switch (query) {
+        case 0: benchmark::DoNotOptimize(s.intersect(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self)); break;
+        case 1: benchmark::DoNotOptimize(s.occluded(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {})); break;
+        case 2:
+            benchmark::DoNotOptimize(
+                s.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self, {}, crossings));
+            strands += crossings.size();
+            break;
+        default:
+            strands += std::size_t(s.strands_before_mesh(sp.spawn_point(dir), dir, 0.0f, INFINITY, sp.self,
+                                                         kMaxStrandsBehind, crossings));
+        }
+        ++rays;
+    }
+    state.counters["crossings"] = double(strands) / double(std::max<std::size_t>(rays, 1));
+    static const char *names[] = {"intersect", "occluded", "trace_through_hair", "strands_before_mesh"};
+    state.SetLabel(names[query]);
+}
+BENCHMARK(hair_rays)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+
 BENCHMARK(render_sphere)
-    ->Args({int(StrategyKind::Analytic), int(Integrator::Path)})
-    ->Args({int(StrategyKind::Table), int(Integrator::Path)})
-    ->Args({int(StrategyKind::Table), int(Integrator::DualScattering)})
+    ->Args({int(StrategyKind::Analytic), int(Integrator::Path), 1000})
+    ->Args({int(StrategyKind::Table), int(Integrator::Path), 1000})
+    ->Args({int(StrategyKind::Table), int(Integrator::DualScattering), 1000})
+    ->Args({int(StrategyKind::Table), int(Integrator::Path), 12000})
+    ->Args({int(StrategyKind::Table), int(Integrator::DualScattering), 12000})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
