@@ -147,7 +147,7 @@ def write_markdown(results, numbers, path):
                  m["blender_version"], m["git_commit"], m["nproc"], m["cpu_model"],
                  m["load_average_start"][0], m.get("load_average_end", [float("nan")])[0],
                  m.get("total_seconds", float("nan"))), "",
-             "Scene: particle hair (1500 parents × 8 interpolated children) on a diffuse sphere, "
+             "Scene: %s, "
              "Principled Hair%s (Melanin 0.1 blonde, 0.5 brunette, 0.9 black; Melanin Redness 0.5; "
              "Roughness%s 0.3) under a 1° sun with a world colour (`sun`) or a "
              "1.2 m square area light in a black world (`area`), %dx%d pixels, %d bounces, one "
@@ -155,14 +155,25 @@ def write_markdown(results, numbers, path):
              "term in both integrators; DUAL path-traces its first %s bounces (Exact Bounces) "
              "and closes the path by dual scattering at the next hair vertex. Errors are over "
              "the %s hair pixels (a Cycles alpha render without the sphere), relative to the "
-             "reference's channel means." % (
+             "reference's channel means.%s" % (
+                 "the demo head's particle hair (1500 parents × 10 interpolated children, 0.52 m "
+                 "long, 26 mm thick at the root: scripts/render_demo.py's) on a diffuse sphere of "
+                 "1.3 m, `backsun` the sun case with the sun behind the hair"
+                 if s.get("scene") == "head" else
+                 "particle hair (1500 parents × 8 interpolated children) on a diffuse sphere",
                  " with the Huang model (its defaults: Aspect Ratio 0.85, Offset 2°; Hairis "
                  "samples Huang with its tables in DUAL, with Cycles' sampler in PATH)"
                  if s.get("model") == "HUANG" else "",
                  "" if s.get("model") == "HUANG" else " and Radial Roughness",
                  s["resolution"][0], s["resolution"][1], s["bounces"],
                  s.get("exact_bounces", 0),
-                 "/".join(str(c["hair_pixels"]) for c in results["cases"].values())), "",
+                 "/".join(str(c["hair_pixels"]) for c in results["cases"].values()),
+                 " The closing vertex adds %s." % (
+                     "every order of scattering, as the paper (dual_bounce_limit none)"
+                     if s.get("bounce_limit") == "none" else
+                     "only the orders of scattering the path tracer reaches within the bounce "
+                     "limits (dual_bounce_limit bounces)" if s.get("bounce_limit") == "bounces"
+                     else "every order of scattering (before dual_bounce_limit)")), "",
              "Reference: Hairis PATH at %d spp (two halves, seeds 1000 and 1001; their difference "
              "gives the reference's own noise, which is subtracted from every MSE). Cycles at %d "
              "spp checks it (below). Every other render is done with seeds 1 and 2; times are the "

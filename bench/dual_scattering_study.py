@@ -34,7 +34,11 @@ blonde_area, brunette_area, black_area), HAIRIS_DUAL_OUT (bench/results), HAIRIS
 (one render of each method at 4 spp per case, timings only), HAIRIS_DUAL_MODEL (CHIANG, or
 HUANG: the node's Huang model, Blender 4.0 or newer, e.g. the bpy 4.5 wheel through
 run_test.py --bpy-python; Coat and Radial Roughness are Chiang's alone), HAIRIS_DUAL_EXACT
-(Exact Bounces; unset: the add-on's default).
+(Exact Bounces; unset: the add-on's default), HAIRIS_DUAL_SCENE (sphere, or head: the demo
+head's thicker hair, 96x72 by default), HAIRIS_DUAL_RANDOM_COLOR and HAIRIS_DUAL_RANDOM_ROUGHNESS
+(the node's per-strand inputs, 0), HAIRIS_DUAL_SKIN (the skin's colour, 0.7,0.5,0.4),
+HAIRIS_DUAL_BOUNCES (Max Bounces of every method, 8), HAIRIS_DUAL_BOUNCE_LIMIT (BOUNCES, or
+NONE: DUAL adds every order of scattering).
 """
 
 import json
@@ -57,7 +61,14 @@ if not os.path.isfile(helpers.bundled_library(PACKAGE)):
     helpers.skip("libhairis.so is not built yet (looked for %s)"
                  % helpers.bundled_library(PACKAGE))
 
-RESOLUTION = tuple(int(v) for v in os.environ.get("HAIRIS_DUAL_RESOLUTION", "64x64").split("x"))
+# The hair: "sphere" (the study's ball, the default) or "head" (the demo head of
+# scripts/render_demo.py in the case's colour and lighting: longer, thicker hair on a larger
+# head, a scene the integrator was not tuned on).
+SCENE = os.environ.get("HAIRIS_DUAL_SCENE", "sphere")
+if SCENE not in ("sphere", "head"):
+    raise SystemExit("HAIRIS_DUAL_SCENE must be sphere or head (got %r)" % SCENE)
+RESOLUTION = tuple(int(v) for v in os.environ.get(
+    "HAIRIS_DUAL_RESOLUTION", "64x64" if SCENE == "sphere" else "96x72").split("x"))
 REF_SPP = int(os.environ.get("HAIRIS_DUAL_REF_SPP", "1024"))
 CYCLES_REF_SPP = int(os.environ.get("HAIRIS_DUAL_CYCLES_REF_SPP", "256"))
 BIAS_BLOCKS = (1, 4, 16)  # pixel, strand bundles, the ball's regions (64-pixel images)
@@ -65,14 +76,14 @@ SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_SPPS", "1,4,16,64").split(",
 PATH_SPPS = [int(v) for v in os.environ.get("HAIRIS_DUAL_PATH_SPPS", "4,16,64").split(",")]
 OUT = os.environ.get("HAIRIS_DUAL_OUT", os.path.join(HERE, "results"))
 PROBE = os.environ.get("HAIRIS_DUAL_PROBE", "0") == "1"
-BOUNCES = 8
+BOUNCES = int(os.environ.get("HAIRIS_DUAL_BOUNCES", "8"))
 REF_SEED = 1000
 SEEDS = (1, 2)
 COLOURS = {"blonde": 0.1, "brunette": 0.5, "black": 0.9}
 LIGHTINGS = ("sun", "area")
 ALL_CASES = ["%s_%s" % (c, light) for light in LIGHTINGS for c in COLOURS]
-# Diagnostic lightings (not in the default cases): "world" and "sunonly", the sun case's two
-# emitters alone.
+# Other lightings (not in the default cases): "world" and "sunonly", the sun case's two
+# emitters alone; "backsun", the sun case with the sun behind the hair.
 CASES = os.environ.get("HAIRIS_DUAL_CASES", ",".join(ALL_CASES)).split(",")
 METHODS = ("DUAL", "PATH", "CYCLES")
 MODEL = os.environ.get("HAIRIS_DUAL_MODEL", "CHIANG")
@@ -81,8 +92,13 @@ HUANG_ASPECT = (float(os.environ["HAIRIS_DUAL_HUANG_ASPECT"])
                 if "HAIRIS_DUAL_HUANG_ASPECT" in os.environ else None)
 # Diagnostic: Hair Volume (HAIRIS_DUAL_VOLUME=LAYER, the default, or UNBOUNDED).
 VOLUME = os.environ.get("HAIRIS_DUAL_VOLUME", "LAYER")
+# Bounce Limit (HAIRIS_DUAL_BOUNCE_LIMIT=BOUNCES, the default, or NONE: every order).
+BOUNCE_LIMIT = os.environ.get("HAIRIS_DUAL_BOUNCE_LIMIT", "BOUNCES")
 # Exact Bounces (HAIRIS_DUAL_EXACT; unset: the add-on's default).
 EXACT = int(os.environ["HAIRIS_DUAL_EXACT"]) if "HAIRIS_DUAL_EXACT" in os.environ else None
+# The node's Random Color and Random Roughness (per-strand variation; 0 by default).
+RANDOM_COLOR = float(os.environ.get("HAIRIS_DUAL_RANDOM_COLOR", "0"))
+RANDOM_ROUGHNESS = float(os.environ.get("HAIRIS_DUAL_RANDOM_ROUGHNESS", "0"))
 # Diagnostic: the sphere's diffuse colour (HAIRIS_DUAL_SKIN=r,g,b; 0,0,0 removes its light).
 SKIN = tuple(float(v) for v in os.environ.get("HAIRIS_DUAL_SKIN", "0.7,0.5,0.4").split(","))
 if MODEL not in ("CHIANG", "HUANG"):
@@ -105,15 +121,21 @@ def look_at(obj, target):
 
 
 def make_case_scene(colour, lighting):
-    """Particle hair of ``colour`` on a diffuse sphere under ``lighting``, both engines alike."""
+    """Particle hair of ``colour`` on a diffuse sphere (SCENE) under ``lighting``, both engines
+    alike."""
     scene = helpers.reset()
-    camera = helpers.make_camera(scene, location=(0.0, -4.6, 1.2), resolution=RESOLUTION,
-                                 percentage=100)
-    look_at(camera, (0.0, 0.0, 0.55))
-    if lighting == "sun":
+    if SCENE == "head":
+        camera = helpers.make_camera(scene, location=(0.0, -7.5, 0.3), resolution=RESOLUTION,
+                                     percentage=100)
+    else:
+        camera = helpers.make_camera(scene, location=(0.0, -4.6, 1.2), resolution=RESOLUTION,
+                                     percentage=100)
+        look_at(camera, (0.0, 0.0, 0.55))
+    if lighting in ("sun", "backsun"):
         helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
         helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(1.0),
-                           rotation=(math.radians(40), 0.0, math.radians(35)))
+                           rotation=(math.radians(40), 0.0,
+                                     math.radians(35 if lighting == "sun" else 215)))
     elif lighting == "world":  # diagnostic: the sun case's world alone
         helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
     elif lighting == "sunonly":  # diagnostic: the sun case's sun alone
@@ -127,8 +149,8 @@ def make_case_scene(colour, lighting):
         look_at(light, (0.0, 0.0, 0.6))
     hair = helpers.make_hair_material("Hair", "MELANIN", **{
         "Melanin": COLOURS[colour], "Melanin Redness": 0.5, "Roughness": 0.3,
-        "Radial Roughness": 0.3, "Coat": 0.0, "IOR": 1.55, "Random Color": 0.0,
-        "Random Roughness": 0.0})
+        "Radial Roughness": 0.3, "Coat": 0.0, "IOR": 1.55, "Random Color": RANDOM_COLOR,
+        "Random Roughness": RANDOM_ROUGHNESS})
     if MODEL == "HUANG":
         for node in hair.node_tree.nodes:
             if node.bl_idname == "ShaderNodeBsdfHairPrincipled":
@@ -136,15 +158,21 @@ def make_case_scene(colour, lighting):
                 if HUANG_ASPECT is not None:
                     helpers.socket(node, "Aspect Ratio").default_value = HUANG_ASPECT
     skin = helpers.make_diffuse_material("Skin", SKIN + (1.0,))
-    sphere = helpers.make_particle_hair(scene, count=1500, children=8, location=(0.0, 0.0, 0.0),
-                                        scale=1.0, hair_material=hair, skin_material=skin)
-    settings = sphere.modifiers["Hair"].particle_system.settings
-    settings.hair_length = 0.5
-    settings.radius_scale = 0.006
-    settings.root_radius = 1.0
-    settings.tip_radius = 0.5
-    settings.child_radius = 0.08
-    settings.render_step = 3
+    if SCENE == "head":  # helpers.make_demo_head's hair
+        sphere = helpers.make_particle_hair(scene, count=1500, children=10,
+                                            location=(0.0, 0.0, 0.3), scale=1.3,
+                                            hair_material=hair, skin_material=skin)
+    else:
+        sphere = helpers.make_particle_hair(scene, count=1500, children=8,
+                                            location=(0.0, 0.0, 0.0), scale=1.0,
+                                            hair_material=hair, skin_material=skin)
+        settings = sphere.modifiers["Hair"].particle_system.settings
+        settings.hair_length = 0.5
+        settings.radius_scale = 0.006
+        settings.root_radius = 1.0
+        settings.tip_radius = 0.5
+        settings.child_radius = 0.08
+        settings.render_step = 3
     helpers.match_cycles(scene, 4, BOUNCES)
     scene.cycles.diffuse_bounces = 4  # Hairis' max_diffuse_bounces default
     scene.render.threads_mode = "FIXED"
@@ -153,6 +181,7 @@ def make_case_scene(colour, lighting):
     hairis.max_bounces = BOUNCES
     hairis.strategy = "TABLE"
     hairis.dual_hair_volume = VOLUME
+    hairis.dual_bounce_limit = BOUNCE_LIMIT
     if EXACT is not None:
         hairis.dual_exact_bounces = EXACT
     hairis.auto_bake = True
@@ -338,7 +367,10 @@ def main():
                             "ref_spp": REF_SPP, "cycles_ref_spp": CYCLES_REF_SPP,
                             "spps": SPPS, "path_spps": PATH_SPPS, "seeds": list(SEEDS),
                             "threads": 1, "probe": PROBE, "model": MODEL,
-                            "skin": list(SKIN), "volume": VOLUME,
+                            "skin": list(SKIN), "volume": VOLUME, "scene": SCENE,
+                            "bounce_limit": BOUNCE_LIMIT.lower(),
+                            "random_color": RANDOM_COLOR,
+                            "random_roughness": RANDOM_ROUGHNESS,
                             "exact_bounces": (EXACT if EXACT is not None else
                                               bpy.context.scene.hairis.dual_exact_bounces)},
                "cases": cases}

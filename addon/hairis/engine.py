@@ -91,6 +91,7 @@ def render_settings(settings):
             "huang_sampling": settings.huang_sampling.lower(),
             "dual_hair_volume": settings.dual_hair_volume.lower(),
             "dual_exact_bounces": int(settings.dual_exact_bounces),
+            "dual_bounce_limit": settings.dual_bounce_limit.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces()}

@@ -60,6 +60,16 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
                     "first hair hit by dual scattering alone (flattest, least noise); each one "
                     "more leaves less of the light to the approximation (less bias, more noise)",
         default=3, min=0, max=1024, soft_max=8)
+    dual_bounce_limit: EnumProperty(
+        name="Bounce Limit",
+        description="Which orders of scattering Dual Scattering adds where it closes a path",
+        items=(("BOUNCES", "Max Bounces",
+                "Only those path tracing reaches within Max Bounces, as Cycles renders the "
+                "scene", 0),
+               ("NONE", "None",
+                "Every order, as Zinke et al. (light hair comes out brighter than Cycles "
+                "renders it with a low Max Bounces)", 1)),
+        default="BOUNCES")
     max_transparent_bounces: IntProperty(
         name="Transparent Max Bounces",
         description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "

@@ -141,6 +141,7 @@ class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
         sub.active = settings.integrator == "DUAL_SCATTERING"
         sub.prop(settings, "dual_hair_volume")
         sub.prop(settings, "dual_exact_bounces")
+        sub.prop(settings, "dual_bounce_limit")
         column.prop(settings, "samples")
         column.prop(settings, "seed")
         column.prop(settings, "max_bounces")

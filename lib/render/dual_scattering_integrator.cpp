@@ -60,11 +60,19 @@ ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCros
     return forward;
 }
 
+int backscatter_depth(int depth, int strands, int bounces_left) {
+    if (bounces_left < 0) return depth;
+    const int limit = bounces_left > strands ? (bounces_left - strands) / 2 : 0;
+    return depth < 0 ? limit : std::min(depth, limit);
+}
+
 Rgb dual_multiple_f_cos(const DualScattering &dual, float theta_i, float theta_o,
-                        const ForwardScattering &forward, int depth) {
-    if (forward.strands == 0) return dual.local_f_cos(theta_i, theta_o, depth);
+                        const ForwardScattering &forward, int depth, int bounces_left) {
+    if (bounces_left >= 0 && forward.strands > bounces_left) return Rgb(0.0f);
+    const int cut = backscatter_depth(depth, forward.strands, bounces_left);
+    if (forward.strands == 0) return dual.local_f_cos(theta_i, theta_o, cut);
     return dual.scattered_f_cos(theta_i, theta_o, forward.attenuation * dual.params().d_f,
-                                forward.spread_variance, depth);
+                                forward.spread_variance, cut);
 }
 
 int nearest_strand_index(const MultipleTable &table, int strands) {
@@ -168,9 +176,13 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                     if (v.layer) pdf_bsdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
-                // The probe's depth is this sample's when both drew the same delta light.
-                const int light_depth = crossings == &work.probe ? depth : depth_behind(ls->wi);
-                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth);
+                // The probe's depth is this sample's when both drew the same delta light; none
+                // is needed where the bounces left allow no strand behind.
+                const int light_depth =
+                    backscatter_depth(-1, forward.strands, v.bounces_left) == 0 ? 0
+                    : crossings == &work.probe                                ? depth
+                                                                              : depth_behind(ls->wi);
+                const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth, v.bounces_left);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
             }
@@ -191,7 +203,8 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         const float inv_pdf = 1.0f / s.pdf;
         // The strands behind along −ω_i, traced once, when light arrives (work.table stays).
         int table_depth = -2;
-        auto sample_depth = [&] {
+        auto sample_depth = [&](int strands) {
+            if (backscatter_depth(-1, strands, v.bounces_left) == 0) return 0;
             if (table_depth == -2) table_depth = depth_behind(wi);
             return table_depth;
         };
@@ -202,7 +215,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             const float t_hi = k < work.table.size() ? work.table[k].t : t_end;
             const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true, sp.position);
             if (!is_black(lamps))
-                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth()) * lamps * inv_pdf;
+                out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth(forward.strands),
+                                           v.bounces_left) *
+                       lamps * inv_pdf;
             if (k < work.table.size()) add_crossing(forward, scene, work.table[k], wi, dual);
             t_lo = t_hi;
         }
@@ -221,7 +236,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             }
         }
         if (!is_black(arriving))
-            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth()) * arriving * inv_pdf;
+            out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth(forward.strands),
+                                       v.bounces_left) *
+                   arriving * inv_pdf;
     }
     return out;
 }

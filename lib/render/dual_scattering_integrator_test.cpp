@@ -118,6 +118,7 @@ RenderSettings dual_settings(int max_bounces = 0, DualHairVolume volume = DualHa
     s.integrator = int(Integrator::DualScattering);
     s.dual_exact_bounces = 0;
     s.dual_hair_volume = int(volume);
+    s.dual_bounce_limit = int(DualBounceLimit::None);  // every order, as the paper's closed forms
     s.max_bounces = max_bounces;
     s.film_transparent = true;
     s.threads = 1;
@@ -369,6 +370,39 @@ TEST(DualScatteringRender, SunThroughKStrandsIsTheClosedForm) {
         RenderSettings path = dual_settings(0);
         path.integrator = int(Integrator::Path);
         EXPECT_EQ(render_sample(scene, path, 3, 1, 0).g, 0.0f);
+    }
+}
+
+TEST(DualScatteringRender, TheBounceLimitKeepsTheOrdersThePathTracerReaches) {
+    // sun_through_strands(k) with Max Bounces B: the sun's light crosses k strands (k events)
+    // and a backscatter term through i strands behind adds 2i, so the vertex at depth 0 keeps
+    // the global term for k <= B with Ā_b's series cut at (B − k)/2 strands behind, nothing for
+    // k > B. Max Transmission Bounces limits alike.
+    const float strength = 2.0f;
+    const DualScattering &dual = *blonde().dual;
+    for (int k : {1, 3, 6}) {
+        const Scene scene = sun_through_strands(k, strength);
+        for (int limit : {2, 5, 8}) {
+            const Rgb t_f = dual.forward_transmittance(0.4, k);
+            const Rgb s_f2 = dual.forward_spread_variance(0.4, k);
+            const Rgb want = k > limit ? Rgb(0.0f) : dual.scattered_f_cos(0.4f, 0.0f, t_f, s_f2, (limit - k) / 2) * strength;
+            for (const bool by_transmission : {false, true}) {
+                RenderSettings s = dual_settings(by_transmission ? 12 : limit);
+                if (by_transmission) s.max_transmission_bounces = limit;
+                s.dual_bounce_limit = int(DualBounceLimit::Bounces);
+                for (std::uint64_t i = 0; i < 8; ++i) {
+                    const Rgb got = render_sample(scene, s, 3, 1, i);
+                    for (int ch = 0; ch < 3; ++ch)
+                        EXPECT_NEAR(got[ch], want[ch], 2e-4 * want[ch] + 1e-9)
+                            << "k " << k << " limit " << limit << " transmission " << by_transmission << " ch " << ch;
+                }
+            }
+        }
+        // The cut moves the value: the series through 0 strands behind is not the unbounded one.
+        const Rgb unbounded = dual.multiple_f_cos(0.4f, 0.0f, k) * strength;
+        const Rgb cut = dual.scattered_f_cos(0.4f, 0.0f, dual.forward_transmittance(0.4, k),
+                                             dual.forward_spread_variance(0.4, k), 0) * strength;
+        EXPECT_GT(unbounded.r, 1.01f * cut.r) << "k " << k;
     }
 }
 
@@ -980,6 +1014,39 @@ TEST(DualScatteringRender, AUniformMultipleTableGivesTheSameMeanWithMoreNoise) {
     EXPECT_GT(mean_baked, 0.05);
     EXPECT_LT(std::fabs(diff_mean), 4.0 * diff_sigma);
     EXPECT_GT(var_uniform, 1.5 * var_baked);
+}
+
+TEST(DualScatteringRender, WithNoBouncesLeftTheClosingVertexIsThePathTracersLastVertex) {
+    // A blonde tuft over a floor under a sun and a world, Max Bounces = Exact Bounces = 2: the
+    // vertices that close paths are at depth 2, where the path tracer's paths end, so nothing of
+    // the multiple-scattering term may be added and the image's expectation is the path
+    // tracer's (their estimators differ: the continuation's density is a mixture). With every
+    // order (DualBounceLimit::None) it is brighter.
+    SceneDesc d;
+    d.materials = {dual_hair(blonde()), DiffuseMaterial{}};
+    d.curves = {tuft(300, 6, 0.006f)};
+    d.meshes = {quad_at(1.0f, 0.0f, 1)};
+    SunLight sun;
+    sun.to_sun = safe_normalize(Vec3{0.3f, -0.5f, 1.0f});
+    sun.strength = 2.0f;
+    d.suns = {sun};
+    d.world = {Rgb(0.3f), 1.0f};
+    d.camera = looking_down(0.3f, 0.3f, 1, 1);
+    const Scene scene = build(std::move(d));
+    RenderSettings path;
+    path.max_bounces = 2;
+    path.threads = 1;
+    RenderSettings limited = path, every_order = path;
+    limited.integrator = every_order.integrator = int(Integrator::DualScattering);
+    limited.dual_exact_bounces = every_order.dual_exact_bounces = 2;
+    every_order.dual_bounce_limit = int(DualBounceLimit::None);
+    const int n = 1500;
+    const Estimate limited_minus_path = mean_difference(scene, limited, scene, path, n);
+    const Estimate every_minus_path = mean_difference(scene, every_order, scene, path, n);
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_LT(std::fabs(limited_minus_path.mean[ch]), 4.0 * limited_minus_path.sigma[ch]) << "ch " << ch;
+        EXPECT_GT(every_minus_path.mean[ch], 8.0 * every_minus_path.sigma[ch]) << "the test tells them apart, ch " << ch;
+    }
 }
 
 }  // namespace

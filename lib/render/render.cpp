@@ -238,6 +238,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         Rgb beta;  // the path's throughput at that vertex
         Vec3 behind_origin;  // the vertex's spawn point along −ω_i (ω_i: the continuation)
         PrimRef self;
+        int bounces_left = -1;  // DualVertex::bounces_left
     } dual_from;
     alpha = 1.0f;
 
@@ -268,11 +269,20 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                 const ForwardScattering forward =
                     gather_forward_scattering(scene, strands.data(), strands.size(), dir, *dual_from.dual);
                 const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+                // The mesh is a vertex of its own, after the strands: it must be one the path
+                // tracer would shade.
                 const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward,
-                                                  dual_from.depth);
+                                                  dual_from.depth, bounces_after(dual_from.bounces_left, 1));
                 beta = dual_from.beta * m / bsdf_pdf;
                 if (is_black(beta) || !finite(beta)) break;
                 through_hair = true;
+                // The mesh's own bounces count the strands crossed, as the path tracer's would.
+                if (dual_from.bounces_left >= 0) {
+                    const int crossed = int(strands.size());
+                    depth += crossed;
+                    transmission_bounces += crossed;
+                    last_segment = last_segment || transmission_bounces > settings.max_transmission_bounces;
+                }
             }
         } else {
             hit = scene.intersect(origin, dir, tmin, tmax, skip);
@@ -343,9 +353,15 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // this light's travel, −ω_i (the mesh's emission above is f_s's alone: emitters' M is
         // the light and table samples').
         if (dual_from.dual && dual_layer && !through_hair) {
-            const int behind = scene.strands_before_mesh(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self,
-                                                         kMaxStrandsBehind, counters.dual.behind);
-            ++counters.rays;
+            // The mesh is a vertex of its own after the strands behind and back: the cut.
+            const int cap = backscatter_depth(-1, 0, bounces_after(dual_from.bounces_left, 1));
+            int behind = 0;
+            if (cap != 0) {
+                behind = scene.strands_before_mesh(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self,
+                                                   cap < 0 ? kMaxStrandsBehind : std::min(cap, kMaxStrandsBehind),
+                                                   counters.dual.behind);
+                ++counters.rays;
+            }
             const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
             const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, behind);
             beta += dual_from.beta * m / bsdf_pdf;
@@ -364,6 +380,12 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const auto *hair = dual ? std::get_if<HairMaterial>(&material) : nullptr;
         const bool dual_vertex = hair && hair->dual && hair->multiple && bsdf.hair() &&
                                  depth >= settings.dual_exact_bounces;
+        // The scattering events the path tracer would still add after this vertex.
+        const int dual_bounces_left =
+            settings.dual_bounce_limit == int(DualBounceLimit::Bounces)
+                ? std::max(0, std::min(settings.max_bounces - depth,
+                                       settings.max_transmission_bounces - transmission_bounces))
+                : -1;
         if (dual_vertex) {
             DualVertex v;
             v.point = &sp;
@@ -372,6 +394,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             v.frame = bsdf.frame();
             v.wo = wo;
             v.layer = dual_layer;
+            v.bounces_left = dual_bounces_left;
             const std::uint64_t before = counters.dual.rays;
             add(beta * dual_scattering_light(scene, v, dual_random(rng, depth), counters.dual));
             counters.shadow_rays += counters.dual.rays - before;
@@ -438,6 +461,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             dual_from.beta = beta;
             dual_from.behind_origin = sp.spawn_point(-wi);
             dual_from.self = sp.self;
+            dual_from.bounces_left = dual_bounces_left;
         }
         if (bsdf.is_hair())
             last_segment = ++transmission_bounces > settings.max_transmission_bounces;
@@ -482,7 +506,8 @@ Status validate(const RenderSettings &s) {
                        check::count_in_range("rr_start_bounce", s.rr_start_bounce, 1, 1024),
                        check::count_in_range("huang_sampling", s.huang_sampling, 0, 1),
                        check::count_in_range("dual_hair_volume", s.dual_hair_volume, 0, 1),
-                       check::count_in_range("dual_exact_bounces", s.dual_exact_bounces, 0, 1024));
+                       check::count_in_range("dual_exact_bounces", s.dual_exact_bounces, 0, 1024),
+                       check::count_in_range("dual_bounce_limit", s.dual_bounce_limit, 0, 1));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.

@@ -104,6 +104,16 @@ enum class DualHairVolume {
     Unbounded = 1,
 };
 
+/// Which orders of scattering the dual-scattering vertex that closes a path adds.
+enum class DualBounceLimit {
+    /// Those the path tracer would reach: light that crossed n strands needs n more scattering
+    /// events, and a backscatter series term through i strands behind 2i, within what Max
+    /// Bounces and Max Transmission Bounces leave after the vertex (as Cycles ends its paths).
+    Bounces = 0,
+    /// Zinke et al.'s: every order, whatever the bounce limits.
+    None = 1,
+};
+
 /// How Max Bounces: Transparent limits a path's transparent crossings, as each Cycles stores
 /// the setting.
 enum class TransparentLimit {
@@ -168,6 +178,8 @@ struct RenderSettings {
     /// dual scattering at the first hair hit. Each exact bounce leaves less of the light to the
     /// approximation: less bias, more noise (bench/results/dual_scattering.md measures both).
     int dual_exact_bounces = 3;
+    /// A DualBounceLimit for integrator=dual_scattering: "bounces" or "none".
+    int dual_bounce_limit = int(DualBounceLimit::Bounces);
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -189,6 +201,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.choice("huang_sampling", s.huang_sampling, {"strategy", "cycles"});
     f.choice("dual_hair_volume", s.dual_hair_volume, {"layer", "unbounded"});
     f.field("dual_exact_bounces", s.dual_exact_bounces, 0, 1024);
+    f.choice("dual_bounce_limit", s.dual_bounce_limit, {"bounces", "none"});
 }
 
 /// What a render did.

@@ -109,7 +109,8 @@ static const char *const kinds[][2] = {
     {"render", "integrator=path;samples=64;max_bounces=12;max_diffuse_bounces=4;max_glossy_bounces=4;"
                "max_transmission_bounces=12;max_transparent_bounces=8;transparent_limit=plus_one;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
-               "huang_sampling=strategy;dual_hair_volume=layer;dual_exact_bounces=3;strategy=table;"
+               "huang_sampling=strategy;dual_hair_volume=layer;dual_exact_bounces=3;"
+               "dual_bounce_limit=bounces;strategy=table;"
                "multiple_weight=0;n_h=2;"
                "curve_backfaces=ignore"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -1334,7 +1335,7 @@ typedef struct render_settings {
         dual_exact_bounces;
     unsigned long long seed;
     int integrator, strategy, film_transparent, curve_backfaces, huang_sampling, transparent_limit,
-        dual_hair_volume;
+        dual_hair_volume, dual_bounce_limit;
     double multiple_weight;
 } render_settings;
 
@@ -1342,6 +1343,7 @@ static int read_render_settings(const char *text, render_settings *r)
 {
     static const char *const huang_samplings[2] = {"strategy", "cycles"};
     static const char *const volumes[2] = {"layer", "unbounded"};
+    static const char *const bounce_limits[2] = {"bounces", "none"};
     options o;
     const char *flags[4] = {"0", "1", "false", "true"};
     const char *backfaces[2] = {"ignore", "hit"};
@@ -1364,6 +1366,7 @@ static int read_render_settings(const char *text, render_settings *r)
         word(&o, "huang_sampling", huang_samplings, 2, &r->huang_sampling) != HAIRIS_OK ||
         word(&o, "dual_hair_volume", volumes, 2, &r->dual_hair_volume) != HAIRIS_OK ||
         integer_in(&o, "dual_exact_bounces", 0, 1024, &r->dual_exact_bounces) != HAIRIS_OK ||
+        word(&o, "dual_bounce_limit", bounce_limits, 2, &r->dual_bounce_limit) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
     r->film_transparent %= 2;
@@ -1391,13 +1394,13 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
                "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
                "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
-               "dual_exact_bounces=%lld\n",
+               "dual_exact_bounces=%lld dual_bounce_limit=%s\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
             r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling,
             r->transparent_limit ? "setting" : "plus_one", r->dual_hair_volume ? "unbounded" : "layer",
-            r->dual_exact_bounces);
+            r->dual_exact_bounces, r->dual_bounce_limit ? "none" : "bounces");
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

@@ -248,10 +248,13 @@ def test_dual_scattering_needs_tables_whatever_the_strategy():
     assert summary_value(summary, "integrator") == "1"
     assert summary_value(summary, "strategy") == "1"
     assert summary_value(summary, "dual_exact_bounces") == "3"
+    assert summary_value(summary, "dual_bounce_limit") == "bounces"
     assert summary.count("tables=1") == 2, summary
     scene.hairis.dual_exact_bounces = 0
+    scene.hairis.dual_bounce_limit = "NONE"
     _pixels, summary = render(scene)
     assert summary_value(summary, "dual_exact_bounces") == "0"
+    assert summary_value(summary, "dual_bounce_limit") == "none"
     scene.hairis.integrator = "PATH"
     _pixels, summary = render(scene)
     assert summary_value(summary, "integrator") == "0"

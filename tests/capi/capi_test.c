@@ -314,6 +314,7 @@ static void test_defaults(void)
     expect_default("sampler", "n_h", "2");
     expect_default("render", "integrator", "path");
     expect_default("render", "dual_exact_bounces", "3");
+    expect_default("render", "dual_bounce_limit", "bounces");
     expect_default("render", "samples", "64");
     expect_default("render", "max_bounces", "12");
     expect_default("render", "max_diffuse_bounces", "4");
@@ -1555,6 +1556,7 @@ static void test_render(void)
                                 {"rr_start_bounce=0", "rr_start_bounce"},
                                 {"dual_exact_bounces=-1", "dual_exact_bounces"},
                                 {"dual_exact_bounces=1025", "dual_exact_bounces"},
+                                {"dual_bounce_limit=max_bounces", "dual_bounce_limit"},
                                 {"samples=16777217", "samples"},
                                 {"film_transparent=maybe", "film_transparent"},
                                 {"curve_backfaces=yes", "curve_backfaces"}};
