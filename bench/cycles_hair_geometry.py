@@ -1,12 +1,14 @@
 """Cycles 3.4 against Hairis PATH on the demo head's hair, by strand geometry: the whole image's
 mean per channel (256 spp each, blonde Principled Hair, the dual study's area light, 8 bounces)
-for the demo's strands, strands a third as thick, thick tips without Close Tip, and no children.
+for the demo's strands (also with Embree 4's rule for the insides of tubes in Hairis), strands a
+third as thick, thick tips without Close Tip, and no children.
 A diagnostic of the difference the dual study's head run shows between the two engines
 (README, Dual scattering); prints one GAP line per geometry.
 
     /usr/bin/python3 tests/blender/run_test.py --blender blender --zip build/hairis-addon.zip \\
         --timeout 3000 bench/cycles_hair_geometry.py
 """
+import importlib
 import os
 import sys
 
@@ -54,19 +56,27 @@ def scene_for(radius_scale, tip, close_tip, children):
 
 
 def main():
-    """Renders each geometry with both engines."""
-    cases = [(0.02, 0.2, True, 10), (0.006, 0.2, True, 10), (0.02, 0.5, False, 10),
-             (0.02, 0.2, True, 0)]
+    """Renders each geometry with both engines, and the demo's also with Embree 4's rule for
+    the insides of tubes (curve_backfaces=hit) in Hairis."""
+    compat = importlib.import_module(getattr(PACKAGE, "__name__", PACKAGE) + ".compat")
+    backfaces = compat.curve_backfaces
+    cases = [(0.02, 0.2, True, 10, None), (0.02, 0.2, True, 10, "hit"),
+             (0.006, 0.2, True, 10, None), (0.02, 0.5, False, 10, None),
+             (0.02, 0.2, True, 0, None)]
     for case in cases:
-        scene, sphere = scene_for(*case)
+        scene, _sphere = scene_for(*case[:4])
         means = {}
         for engine in ("CYCLES", "HAIRIS"):
+            if engine == "HAIRIS" and case[4]:
+                compat.curve_backfaces = lambda version=None, rule=case[4]: rule
             helpers.set_samples(scene, 256)
-            img, sec = helpers.render_pixels(scene, engine, 1, ARGS.workdir)
+            img, _seconds = helpers.render_pixels(scene, engine, 1, ARGS.workdir)
+            compat.curve_backfaces = backfaces
             means[engine] = img.reshape(-1, 3).mean(axis=0)
-        print("GAP radius_scale %.3f tip %.1f close %s children %d: Cycles %s Hairis %s rel %s"
-              % (case[0], case[1], case[2], case[3], np.round(means["CYCLES"], 4),
-                 np.round(means["HAIRIS"], 4),
+        print("GAP radius_scale %.3f tip %.1f close %s children %d backfaces %s: Cycles %s "
+              "Hairis %s rel %s"
+              % (case[0], case[1], case[2], case[3], case[4] or "as the add-on",
+                 np.round(means["CYCLES"], 4), np.round(means["HAIRIS"], 4),
                  np.round(means["CYCLES"] / means["HAIRIS"] - 1, 4)), flush=True)
 
 
