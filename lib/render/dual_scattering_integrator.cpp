@@ -46,10 +46,10 @@ bool same_ray(const LightSample &a, const LightSample &b) {
 }  // namespace
 
 int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
-                   std::vector<StrandCrossing> &scratch) {
+                   std::vector<StrandCrossing> &scratch, int cap) {
     const Vec3 dir = -wi;
     return scene.strands_before_mesh(point.spawn_point(dir), dir, 0.0f, INFINITY, point.self,
-                                     kMaxStrandsBehind, scratch);
+                                     std::clamp(cap, 1, kMaxStrandsBehind), scratch);
 }
 
 ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
@@ -135,11 +135,15 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         ++work.rays;
     }
     // Where Ā_b's series stop for light from ω_i (Layer): the strands behind the vertex along
-    // the light's travel, −ω_i, up to the first mesh (−1: unbounded).
+    // the light's travel, −ω_i, up to the first mesh (−1: unbounded). No term of this vertex
+    // cuts them deeper than the bounces left allow (backscatter_depth(−1, 0, ·)), so the count
+    // stops there, and is not traced where that is none.
+    const int behind_cap = backscatter_depth(-1, 0, v.bounces_left);
     auto depth_behind = [&](Vec3 wi) {
         if (!v.layer) return -1;
+        if (behind_cap == 0) return 0;
         ++work.rays;
-        return strands_behind(scene, sp, wi, work.behind);
+        return strands_behind(scene, sp, wi, work.behind, behind_cap < 0 ? kMaxStrandsBehind : behind_cap);
     };
     // The continuation's (the caller's): behind the vertex away from the probe's light point.
     const int depth = depth_behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));

@@ -117,9 +117,10 @@ ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCros
 constexpr int kMaxStrandsBehind = 64;
 
 /// Where Ā_b's series stop for light from unit direction wi at `point` (Layer): the strands
-/// behind it along the light's travel, −wi, up to the first mesh, at most kMaxStrandsBehind.
+/// behind it along the light's travel, −wi, up to the first mesh, at most `cap` (in
+/// [1, kMaxStrandsBehind]; the traversal stops there).
 int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
-                   std::vector<StrandCrossing> &scratch);
+                   std::vector<StrandCrossing> &scratch, int cap = kMaxStrandsBehind);
 
 /// A budget of scattering events (DualVertex::bounces_left) after `events` of it are spent:
 /// unlimited (−1) stays so, otherwise at least 0.

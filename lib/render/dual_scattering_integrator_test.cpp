@@ -660,11 +660,10 @@ TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter
         EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "ch " << ch;
 }
 
-TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
-    // The sun lights the top hair directly; three strands lie behind it along the light's way
-    // on (out of the camera's window). Layer: F = f_s + d_b f_back^direct with Ā_b cut at 3
-    // strands; Unbounded: the paper's series.
-    const float strength = 2.0f, a = 0.6f, step = 0.1f;
+// A hair seen from above, lit directly by a sun along (0, sin a, cos a), a = 0.6, with three
+// strands behind it along the light's way on (out of the camera's window).
+Scene sun_with_three_strands_behind(float strength) {
+    const float a = 0.6f, step = 0.1f;
     std::vector<Vec3> centres{{0, 0, 0}};
     for (int k = 1; k <= 3; ++k) centres.push_back({0, -float(k) * step * std::tan(a), -float(k) * step});
     SceneDesc d;
@@ -675,9 +674,23 @@ TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
     sun.strength = strength;
     d.suns = {sun};
     d.camera = looking_down(0.4f, 0.03f, 1, 1);
-    const Scene scene = build(std::move(d));
+    return build(std::move(d));
+}
+
+// f_s·cos θ_i of sun_with_three_strands_behind's light at the hair, seen from above.
+Rgb sun_with_three_strands_behind_f_s() {
+    const float a = 0.6f;
     const FiberFrame frame = FiberFrame::from_tangent_and_view({1, 0, 0}, {0, 0, 1});
-    const Rgb f_s = blonde().fiber->f_cos(frame.to_local(sun.to_sun), frame.to_local({0, 0, 1}));
+    return blonde().fiber->f_cos(frame.to_local({0.0f, std::sin(a), std::cos(a)}), frame.to_local({0, 0, 1}));
+}
+
+TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
+    // The sun lights the top hair directly; three strands lie behind it along the light's way
+    // on. Layer: F = f_s + d_b f_back^direct with Ā_b cut at 3 strands; Unbounded: the paper's
+    // series.
+    const float strength = 2.0f;
+    const Scene scene = sun_with_three_strands_behind(strength);
+    const Rgb f_s = sun_with_three_strands_behind_f_s();
     const Rgb layer = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f, 3)) * strength;
     const Rgb unbounded = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f)) * strength;
     const Estimate cut = hair_pixel(scene, dual_settings(0, DualHairVolume::Layer), 40000);
@@ -687,6 +700,28 @@ TEST(DualScatteringRender, ALayerCutsTheLocalBackscatterAtTheStrandsBehind) {
         EXPECT_NEAR(paper.mean[ch], unbounded[ch], 5.0 * paper.sigma[ch] + 1e-4 * unbounded[ch]) << "ch " << ch;
     }
     EXPECT_GT(unbounded.r - layer.r, 10.0f * float(cut.sigma[0])) << "the test tells the two apart";
+}
+
+TEST(DualScatteringRender, ABounceLimitCutsTheLayersBackscatterFurther) {
+    // sun_with_three_strands_behind with the Bounce Limit: at depth 0 with Max Bounces B the
+    // series through i strands behind cost 2i, so Ā_b is cut at min(3, B/2) strands.
+    const float strength = 2.0f;
+    const Scene scene = sun_with_three_strands_behind(strength);
+    const Rgb f_s = sun_with_three_strands_behind_f_s();
+    for (const int bounces : {0, 2, 4, 8}) {
+        RenderSettings s = dual_settings(bounces, DualHairVolume::Layer);
+        s.dual_bounce_limit = int(DualBounceLimit::Bounces);
+        const Rgb want = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f, std::min(3, bounces / 2))) * strength;
+        const Estimate e = hair_pixel(scene, s, 20000);
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "bounces " << bounces << " ch " << ch;
+    }
+    // Each cut moves the value by more than the noise.
+    const Rgb one = blonde().dual->local_f_cos(0.0f, 0.0f, 1), two = blonde().dual->local_f_cos(0.0f, 0.0f, 2),
+              three = blonde().dual->local_f_cos(0.0f, 0.0f, 3);
+    EXPECT_GT(one.r, 0.0f);
+    EXPECT_GT(two.r, 1.01f * one.r);
+    EXPECT_GT(three.r, 1.001f * two.r);
 }
 
 // The same sample's radiance minus the path tracer's, over n samples of pixel (0, 0): at depth
