@@ -134,19 +134,19 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                                               work.probe);
         ++work.rays;
     }
-    // Where Ā_b's series stop for light from ω_i (Layer): the strands behind the vertex along
-    // the light's travel, −ω_i, up to the first mesh (−1: unbounded). No term of this vertex
-    // cuts them deeper than the bounces left allow (backscatter_depth(−1, 0, ·)), so the count
-    // stops there, and is not traced where that is none.
-    const int behind_cap = backscatter_depth(-1, 0, v.bounces_left);
-    auto depth_behind = [&](Vec3 wi) {
+    // Where Ā_b's series stop for light from ω_i that crossed `strands` strands (Layer): the
+    // strands behind the vertex along the light's travel, −ω_i, up to the first mesh (−1:
+    // unbounded). The count stops at strands_behind_cap, and is not traced where the bounces
+    // left allow that light no strand behind.
+    const int behind_cap = strands_behind_cap(v.bounces_left);
+    auto depth_behind = [&](Vec3 wi, int strands) {
         if (!v.layer) return -1;
-        if (behind_cap == 0) return 0;
+        if (backscatter_depth(-1, strands, v.bounces_left) == 0) return 0;
         ++work.rays;
-        return strands_behind(scene, sp, wi, work.behind, behind_cap < 0 ? kMaxStrandsBehind : behind_cap);
+        return strands_behind(scene, sp, wi, work.behind, behind_cap);
     };
     // The continuation's (the caller's): behind the vertex away from the probe's light point.
-    const int depth = depth_behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
+    const int depth = depth_behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v), 0);
     work.last_depth = depth;
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;
@@ -180,12 +180,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                     if (v.layer) pdf_bsdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
-                // The probe's depth is this sample's when both drew the same delta light; none
-                // is needed where the bounces left allow no strand behind.
+                // The probe's depth is this sample's when both drew the same delta light.
                 const int light_depth =
-                    backscatter_depth(-1, forward.strands, v.bounces_left) == 0 ? 0
-                    : crossings == &work.probe                                ? depth
-                                                                              : depth_behind(ls->wi);
+                    crossings == &work.probe ? depth : depth_behind(ls->wi, forward.strands);
                 const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth, v.bounces_left);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
@@ -205,11 +202,11 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
         const float t_end = mesh ? mesh->t : INFINITY;
         const float inv_pdf = 1.0f / s.pdf;
-        // The strands behind along −ω_i, traced once, when light arrives (work.table stays).
+        // The strands behind along −ω_i, counted once, when light first arrives (work.table
+        // stays); later light has crossed more strands, so its cut is no deeper.
         int table_depth = -2;
         auto sample_depth = [&](int strands) {
-            if (backscatter_depth(-1, strands, v.bounces_left) == 0) return 0;
-            if (table_depth == -2) table_depth = depth_behind(wi);
+            if (table_depth == -2) table_depth = depth_behind(wi, strands);
             return table_depth;
         };
         // Lamps between crossings see the strands before them.

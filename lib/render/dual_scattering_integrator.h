@@ -85,6 +85,7 @@
 // with Unbounded: light that meshes reflect and that then crosses strands before reaching x.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -133,6 +134,13 @@ inline int bounces_after(int bounces_left, int events) {
 /// and back), so at min(depth, (bounces_left − strands)/2) and at least 0 (depth < 0: the
 /// series are otherwise unbounded).
 int backscatter_depth(int depth, int strands, int bounces_left);
+
+/// The most strands behind a vertex that any of its terms can use with `bounces_left` events
+/// left: min(bounces_left/2, kMaxStrandsBehind), kMaxStrandsBehind when unlimited (−1); 0: none,
+/// and no count is needed.
+inline int strands_behind_cap(int bounces_left) {
+    return bounces_left < 0 ? kMaxStrandsBehind : std::min(bounces_left / 2, kMaxStrandsBehind);
+}
 
 /// M·cos θ_i of light from θ_i (fiber frame of the shading point) that crossed `forward`:
 /// the local term for 0 strands, the global term with T_f = d_f·attenuation otherwise.

@@ -715,13 +715,12 @@ TEST(DualScatteringRender, ABounceLimitCutsTheLayersBackscatterFurther) {
         const Estimate e = hair_pixel(scene, s, 20000);
         for (int ch = 0; ch < 3; ++ch)
             EXPECT_NEAR(e.mean[ch], want[ch], 5.0 * e.sigma[ch] + 1e-4 * want[ch]) << "bounces " << bounces << " ch " << ch;
+        // The next deeper cut lies outside that tolerance where it differs (the test tells them apart).
+        if (bounces < 4) {
+            const Rgb deeper = (f_s + blonde().dual->local_f_cos(0.0f, 0.0f, bounces / 2 + 1)) * strength;
+            EXPECT_GT(deeper.r - want.r, 8.0f * float(e.sigma[0]) + 1e-4f * want.r) << "bounces " << bounces;
+        }
     }
-    // Each cut moves the value by more than the noise.
-    const Rgb one = blonde().dual->local_f_cos(0.0f, 0.0f, 1), two = blonde().dual->local_f_cos(0.0f, 0.0f, 2),
-              three = blonde().dual->local_f_cos(0.0f, 0.0f, 3);
-    EXPECT_GT(one.r, 0.0f);
-    EXPECT_GT(two.r, 1.01f * one.r);
-    EXPECT_GT(three.r, 1.001f * two.r);
 }
 
 // The same sample's radiance minus the path tracer's, over n samples of pixel (0, 0): at depth
@@ -950,10 +949,8 @@ TEST(TraceThroughHair, StrandsBeforeMeshIsTheCappedCountOfTheFullTrace) {
     EXPECT_GT(stopped_by_mesh, 100);
 }
 
-TEST(DualScatteringRender, ExactBouncesArePathTracedAndTheClosureMovesWithThem) {
-    // A blonde tuft over a floor under a sun and a world: with every bounce exact the dual
-    // render is the path tracer's image bit for bit; with fewer, each exact bounce moves the
-    // image, since the vertex that closes the path by dual scattering moves deeper.
+// A blonde tuft over a white floor under a sun and a grey world, seen by `camera`.
+Scene tuft_over_floor(CameraDesc camera) {
     SceneDesc d;
     d.materials = {dual_hair(blonde()), DiffuseMaterial{}};
     d.curves = {tuft(300, 6, 0.006f)};
@@ -963,8 +960,15 @@ TEST(DualScatteringRender, ExactBouncesArePathTracedAndTheClosureMovesWithThem) 
     sun.strength = 2.0f;
     d.suns = {sun};
     d.world = {Rgb(0.3f), 1.0f};
-    d.camera = looking_down(0.4f, 0.4f, 12, 12);
-    const Scene scene = build(std::move(d));
+    d.camera = camera;
+    return build(std::move(d));
+}
+
+TEST(DualScatteringRender, ExactBouncesArePathTracedAndTheClosureMovesWithThem) {
+    // A blonde tuft over a floor under a sun and a world: with every bounce exact the dual
+    // render is the path tracer's image bit for bit; with fewer, each exact bounce moves the
+    // image, since the vertex that closes the path by dual scattering moves deeper.
+    const Scene scene = tuft_over_floor(looking_down(0.4f, 0.4f, 12, 12));
     RenderSettings path;
     path.samples = 4;
     path.max_bounces = 6;
@@ -1057,17 +1061,7 @@ TEST(DualScatteringRender, WithNoBouncesLeftTheClosingVertexIsThePathTracersLast
     // the multiple-scattering term may be added and the image's expectation is the path
     // tracer's (their estimators differ: the continuation's density is a mixture). With every
     // order (DualBounceLimit::None) it is brighter.
-    SceneDesc d;
-    d.materials = {dual_hair(blonde()), DiffuseMaterial{}};
-    d.curves = {tuft(300, 6, 0.006f)};
-    d.meshes = {quad_at(1.0f, 0.0f, 1)};
-    SunLight sun;
-    sun.to_sun = safe_normalize(Vec3{0.3f, -0.5f, 1.0f});
-    sun.strength = 2.0f;
-    d.suns = {sun};
-    d.world = {Rgb(0.3f), 1.0f};
-    d.camera = looking_down(0.3f, 0.3f, 1, 1);
-    const Scene scene = build(std::move(d));
+    const Scene scene = tuft_over_floor(looking_down(0.3f, 0.3f, 1, 1));
     RenderSettings path;
     path.max_bounces = 2;
     path.threads = 1;

@@ -354,12 +354,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // the light and table samples').
         if (dual_from.dual && dual_layer && !through_hair) {
             // The mesh is a vertex of its own after the strands behind and back: the cut.
-            const int cap = backscatter_depth(-1, 0, bounces_after(dual_from.bounces_left, 1));
+            const int cap = strands_behind_cap(bounces_after(dual_from.bounces_left, 1));
             int behind = 0;
-            if (cap != 0) {
+            if (cap > 0) {
                 behind = scene.strands_before_mesh(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self,
-                                                   cap < 0 ? kMaxStrandsBehind : std::min(cap, kMaxStrandsBehind),
-                                                   counters.dual.behind);
+                                                   cap, counters.dual.behind);
                 ++counters.rays;
             }
             const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
@@ -380,9 +379,9 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const auto *hair = dual ? std::get_if<HairMaterial>(&material) : nullptr;
         const bool dual_vertex = hair && hair->dual && hair->multiple && bsdf.hair() &&
                                  depth >= settings.dual_exact_bounces;
-        // The scattering events the path tracer would still add after this vertex.
+        // The scattering events the path tracer would still add after a dual vertex.
         const int dual_bounces_left =
-            settings.dual_bounce_limit == int(DualBounceLimit::Bounces)
+            dual_vertex && settings.dual_bounce_limit == int(DualBounceLimit::Bounces)
                 ? std::max(0, std::min(settings.max_bounces - depth,
                                        settings.max_transmission_bounces - transmission_bounces))
                 : -1;
