@@ -228,6 +228,8 @@ BENCHMARK(render_sphere)
     ->Args({int(StrategyKind::Table), int(Integrator::DualScattering), 1000})
     ->Args({int(StrategyKind::Table), int(Integrator::Path), 12000})
     ->Args({int(StrategyKind::Table), int(Integrator::DualScattering), 12000})
+    ->Args({int(StrategyKind::Table), int(Integrator::Path), 40000})
+    ->Args({int(StrategyKind::Table), int(Integrator::DualScattering), 40000})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();

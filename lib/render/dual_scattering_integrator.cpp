@@ -130,8 +130,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         const Vec3 dir = probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v);
         const float tmax = probe ? shadow_tmax(*probe) : INFINITY;
         const PrimRef target = probe ? PrimRef{probe->skip_geometry, probe->skip_primitive} : PrimRef{};
-        probe_mesh = scene.trace_through_hair(sp.spawn_point(dir), dir, 0.0f, tmax, sp.self, target,
-                                              work.probe);
+        bool over = false;
+        probe_mesh = scene.trace_through_hair_within(sp.spawn_point(dir), dir, 0.0f, tmax, sp.self, target,
+                                                     v.bounces_left, work.probe, over);
         ++work.rays;
     }
     // Where Ā_b's series stop for light from ω_i that crossed `strands` strands (Layer): the
@@ -160,9 +161,10 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             const std::vector<StrandCrossing> *crossings = &work.probe;
             std::optional<Hit> mesh = probe_mesh;
             if (!(probe && probe->delta && ls->delta && same_ray(*probe, *ls))) {
-                mesh = scene.trace_through_hair(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax(*ls),
-                                                sp.self, {ls->skip_geometry, ls->skip_primitive},
-                                                work.light);
+                bool over = false;
+                mesh = scene.trace_through_hair_within(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax(*ls),
+                                                       sp.self, {ls->skip_geometry, ls->skip_primitive},
+                                                       v.bounces_left, work.light, over);
                 ++work.rays;
                 crossings = &work.light;
             }
@@ -196,11 +198,13 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
     if (s.pdf > 0.0f) {
         const Vec3 wi = s.wi;
         const Vec3 origin = sp.spawn_point(wi);
+        bool over = false;
         const std::optional<Hit> mesh =
-            scene.trace_through_hair(origin, wi, 0.0f, INFINITY, sp.self, {}, work.table);
+            scene.trace_through_hair_within(origin, wi, 0.0f, INFINITY, sp.self, {}, v.bounces_left, work.table, over);
         ++work.rays;
         const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
-        const float t_end = mesh ? mesh->t : INFINITY;
+        // Past the first bounces_left + 1 strands nothing reaches x within the limit.
+        const float t_end = over ? work.table.back().t : mesh ? mesh->t : INFINITY;
         const float inv_pdf = 1.0f / s.pdf;
         // The strands behind along −ω_i, counted once, when light first arrives (work.table
         // stays); later light has crossed more strands, so its cut is no deeper.
@@ -222,10 +226,10 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             if (k < work.table.size()) add_crossing(forward, scene, work.table[k], wi, dual);
             t_lo = t_hi;
         }
-        Rgb arriving;
-        if (!mesh) {
+        Rgb arriving;  // from beyond the strands: none past the cut
+        if (!over && !mesh) {
             arriving = lights.escaped(sp.position, wi, s.pdf, true, true);
-        } else if (mesh->prim.geometry != PrimRef::kNone) {
+        } else if (!over && mesh->prim.geometry != PrimRef::kNone) {
             const SurfacePoint hit = scene.surface_point(origin, wi, *mesh);
             const Rgb emission = material_emission(scene.materials()[hit.material]);
             if (!is_black(emission)) {

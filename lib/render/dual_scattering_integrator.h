@@ -34,7 +34,8 @@
 //    strands).
 // n_h estimate: the strands a probe ray crosses from x towards a point drawn from LightSet with
 // random numbers of its own (towards a direction uniform on the sphere when there is no lamp),
-// up to the first mesh; that count (at least 1) is rounded in log2 to the nearest strand count
+// up to the first mesh (and at most r + 1 under the bounce limit below: light past r strands
+// does not count); that count (at least 1) is rounded in log2 to the nearest strand count
 // the table holds. The probe is independent of the estimator's samples, so the table's density
 // is fixed given the probe and MIS stays unbiased; when the probe and the light sample draw the
 // same delta light their shadow rays coincide and one is traced.
@@ -70,10 +71,12 @@
 // adds only what the path tracer would reach with the r = bounces_left events after it: light
 // that crossed n strands needs n (none for n > r), and the i-th term of Ā_b's series (through
 // i strands behind and back) 2i more, so the series stop at (r − n)/2 strands behind; the
-// continuation's mesh counts the strands it crossed as the path tracer's bounces. On light
-// hair the orders past the limit are a large share: on the demo head's blonde hair at 8
-// bounces DUAL was +14% red with every order and the path tracer with 64 bounces +14% too
-// (bench/results/dual_head/). None keeps the paper's every order.
+// continuation's mesh counts the strands it crossed as the path tracer's bounces. Rays that
+// let hair through stop once they know of more strands than their light may cross
+// (Scene::trace_through_hair_within). On light hair the orders past the limit are a large
+// share: on the demo head's blonde hair at 8 bounces DUAL was +14% red with every order and
+// the path tracer with 64 bounces +14% too (bench/results/dual_head/). None keeps the paper's
+// every order.
 //
 // What dual scattering covers: light from lamps, suns, emissive triangles and the world that
 // reaches hair directly or through other strands. What is still traced: everything that

@@ -409,6 +409,7 @@ TEST(DualScatteringRender, TheBounceLimitKeepsTheOrdersThePathTracerReaches) {
 TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
     // The top hair of sun_through_strands(k), shaded directly: the n_h probe goes towards the
     // (only) lamp and crosses the k strands under it; the table's strand count is the nearest.
+    // The probe's count is the independent reference's: the strands the scene was built with.
     for (int k : {0, 1, 3, 6}) {
         const Scene scene = sun_through_strands(k, 1.0f);
         const Vec3 origin{0.05f, 0.004f, 1.0f}, down{0, 0, -1};
@@ -436,6 +437,13 @@ TEST(DualScatteringIntegrator, TheProbeCountsTheStrandsTowardsTheLight) {
         // The sun's probe ray is the light sample's shadow ray: traced once (and the table's).
         EXPECT_EQ(work.rays, 2u);
         EXPECT_GT(l.r, 0.0f);
+        // With r bounces left the probe stops after r + 1 strands: light past r does not count.
+        for (int r : {0, 2, 5}) {
+            v.bounces_left = r;
+            DualWork limited;
+            dual_scattering_light(scene, v, u, limited);
+            EXPECT_EQ(limited.last_probe_strands, std::min(k, r + 1)) << k << " strands, r = " << r;
+        }
     }
 }
 
@@ -918,9 +926,10 @@ HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
     return c;
 }
 
-TEST(TraceThroughHair, StrandsBeforeMeshIsTheCappedCountOfTheFullTrace) {
+TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
     // Random rays through a dense tuft cut by a floor half-way up: the capped count equals the
-    // full trace's count, capped, for every cap (the traversal stops early only once it knows).
+    // full trace's count, capped, for every cap, and a trace within a cap the full trace or its
+    // first cap + 1 strands (the traversal stops early only once it knows).
     SceneDesc d;
     d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
     d.curves = {tuft(1500, 6, 0.008f)};
@@ -944,6 +953,25 @@ TEST(TraceThroughHair, StrandsBeforeMeshIsTheCappedCountOfTheFullTrace) {
         for (const int cap : {1, 3, 16, 64})
             ASSERT_EQ(scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, {}, cap, scratch), std::min(n, cap))
                 << "ray " << i << " cap " << cap;
+        // Within a cap: the full trace where it holds at most cap strands, else its first cap + 1.
+        for (const int cap : {0, 1, 3, 16}) {
+            bool over = false;
+            const auto within =
+                scene.trace_through_hair_within(origin, dir, 0.0f, INFINITY, {}, {}, cap, scratch, over);
+            ASSERT_EQ(over, n > cap) << "ray " << i << " cap " << cap;
+            if (over) {
+                ASSERT_FALSE(within.has_value());
+                ASSERT_EQ(scratch.size(), std::size_t(cap) + 1);
+            } else {
+                ASSERT_EQ(within.has_value(), mesh.has_value());
+                if (mesh) {
+                    ASSERT_EQ(within->t, mesh->t);
+                }
+                ASSERT_EQ(scratch.size(), full.size());
+            }
+            for (std::size_t k = 0; k < std::min(scratch.size(), std::size_t(cap) + 1); ++k)
+                ASSERT_EQ(scratch[k].t, full[k].t) << "ray " << i << " cap " << cap << " crossing " << k;
+        }
     }
     EXPECT_GT(crossed_many, 100);  // the caps were exercised
     EXPECT_GT(stopped_by_mesh, 100);

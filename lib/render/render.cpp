@@ -258,8 +258,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             // Light meshes reflect onto the hair vertex through n ≥ 1 strands is the dual
             // estimate's global term: T_f d_f (f_s^scatter + π d_b f_back^scatter) for the
             // sampled direction, in place of f_s (lamps, suns and the world beyond hair are M's).
+            // Past the strands the mesh's bounces allow, nothing it reflects counts (hit unset).
             std::vector<StrandCrossing> &strands = counters.dual.continuation;
-            hit = scene.trace_through_hair(origin, dir, tmin, tmax, skip, {}, strands);
+            bool over = false;
+            hit = scene.trace_through_hair_within(origin, dir, tmin, tmax, skip, {},
+                                                  bounces_after(dual_from.bounces_left, 1), strands, over);
             ++counters.rays;
             if (hit && hit->prim.geometry == PrimRef::kNone) hit.reset();  // untraceable: as intersect()
             if (!strands.empty()) {

@@ -721,15 +721,31 @@ std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, 
     return mesh;
 }
 
+std::optional<Hit> Scene::trace_through_hair_within(Vec3 origin, Vec3 dir, float tmin, float tmax,
+                                                    PrimRef skip_a, PrimRef skip_b, int cap,
+                                                    std::vector<StrandCrossing> &strands,
+                                                    bool &over) const {
+    over = false;
+    if (cap < 0) return trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands);
+    // A crossing may leave two records (a joint of two segments): 2·(cap + 1) records hold at
+    // least cap + 1 crossings but for repeats, which the full trace below covers.
+    const std::size_t enough = std::size_t(cap) + 1;
+    bool stopped = false;
+    std::optional<Hit> mesh =
+        trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands, 2 * enough, stopped);
+    if (stopped && strands.size() < enough)
+        mesh = trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands);
+    over = strands.size() >= enough;
+    if (!over) return mesh;
+    strands.resize(enough);
+    return std::nullopt;
+}
+
 int Scene::strands_before_mesh(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip, int cap,
                                std::vector<StrandCrossing> &scratch) const {
     cap = std::max(cap, 1);
-    // A crossing may leave two records (a joint of two segments): 2·cap records hold at least
-    // cap crossings but for repeats, which the fallback below covers.
-    bool stopped = false;
-    trace_through_hair(origin, dir, tmin, tmax, skip, {}, scratch, 2 * std::size_t(cap), stopped);
-    if (!stopped || int(scratch.size()) >= cap) return std::min(int(scratch.size()), cap);
-    trace_through_hair(origin, dir, tmin, tmax, skip, {}, scratch);  // too few before the stop
+    bool over = false;
+    trace_through_hair_within(origin, dir, tmin, tmax, skip, {}, cap - 1, scratch, over);
     return std::min(int(scratch.size()), cap);
 }
 
