@@ -21,7 +21,7 @@ INTEGRATOR_ITEMS = (
      "Path tracing of the first bounces (Exact Bounces), then Zinke et al. 2008's dual "
      "scattering: light reaching hair through other strands in closed form from shadow rays "
      "that count the strands, multiple scattering sampled from the baked tables (needs baked "
-     "tables). Experimental: biased (at 3 Exact Bounces within about 1% of path tracing in the "
+     "tables). Experimental: biased (at 3 Exact Bounces within about 2% of path tracing in the "
      "mean on the study's thin hair, up to 8% darker on the demo head's thicker hair; flatter "
      "with fewer)", 1),
 )
