@@ -52,6 +52,15 @@ int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
                                      std::clamp(cap, 1, kMaxStrandsBehind), scratch);
 }
 
+int StrandsBehind::get(const Scene &scene, std::vector<StrandCrossing> &scratch, std::uint64_t &rays) {
+    if (value == -2) {
+        value = scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, self, std::clamp(cap, 1, kMaxStrandsBehind),
+                                          scratch);
+        ++rays;
+    }
+    return value;
+}
+
 ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
                                             std::size_t count, Vec3 dir,
                                             const DualScattering &fallback) {
@@ -146,9 +155,17 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         ++work.rays;
         return strands_behind(scene, sp, wi, work.behind, behind_cap);
     };
-    // The continuation's (the caller's): behind the vertex away from the probe's light point.
-    const int depth = depth_behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v), 0);
-    work.last_depth = depth;
+    // The continuation's (the caller's): behind the vertex away from the probe's light point,
+    // counted when first needed (as depth_behind(probe's ω_i, 0) would).
+    {
+        const Vec3 dir = -(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
+        StrandsBehind &d = work.last_depth;
+        d.origin = sp.spawn_point(dir);
+        d.dir = dir;
+        d.self = sp.self;
+        d.cap = behind_cap;
+        d.value = !v.layer ? -1 : backscatter_depth(-1, 0, v.bounces_left) == 0 ? 0 : -2;
+    }
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;
     work.last_probe_strands = int(work.probe.size());
@@ -184,7 +201,10 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                 }
                 // The probe's depth is this sample's when both drew the same delta light.
                 const int light_depth =
-                    crossings == &work.probe ? depth : depth_behind(ls->wi, forward.strands);
+                    crossings != &work.probe ? depth_behind(ls->wi, forward.strands)
+                    : backscatter_depth(-1, forward.strands, v.bounces_left) == 0
+                        ? 0  // the cut is 0 whatever lies behind
+                        : work.last_depth.get(scene, work.behind, work.rays);
                 const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth, v.bounces_left);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;

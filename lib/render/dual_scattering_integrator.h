@@ -47,7 +47,8 @@
 // light's travel, up to the first mesh (DualScattering::backscatter_attenuation(θ, depth)): for
 // each light or table sample that brings light from ω_i, a ray from x along −ω_i counts them
 // (the probe's when the light sample drew the probe's delta light); for the continuation's
-// global term, a second probe from x away from the probe's light point. Δ̄_b and σ̄_b, ratios
+// global term, a second probe from x away from the probe's light point, traced only when a
+// term needs it (StrandsBehind). Δ̄_b and σ̄_b, ratios
 // of the same series, are kept. In exchange, the continuation lets hair through: where it reaches a mesh after
 // n ≥ 1 strands, its weight is the global term of the sampled direction (T_f and σ_f² of the
 // strands it crossed, the vertex's depth) over the sampler's density instead of f_s over it,
@@ -196,10 +197,24 @@ struct DualVertex {
     int bounces_left = -1;
 };
 
+/// A count of the strands behind a point along `dir` up to the first mesh, at most `cap`
+/// (strands_behind), traced the first time it is asked for: `value` is −2 until then, and −1
+/// for an unbounded volume (no count).
+struct StrandsBehind {
+    Vec3 origin, dir;  ///< the point's spawn point along dir, and dir (unit)
+    PrimRef self;
+    int cap = kMaxStrandsBehind;
+    int value = -1;
+    /// The count; traces it (into `scratch`, adding 1 to `rays`) the first time.
+    int get(const Scene &scene, std::vector<StrandCrossing> &scratch, std::uint64_t &rays);
+};
+
 /// Per-thread buffers and counts of the estimator.
 struct DualWork {
     std::vector<StrandCrossing> light, probe, table, behind, continuation;
-    int last_depth = -1;          ///< the strands the second probe found behind the last vertex (−1: unbounded)
+    /// The strands behind the last vertex away from its probe's light point (the second probe):
+    /// Ā_b's cut for the continuation's global term, counted when first needed.
+    StrandsBehind last_depth;
     std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
     int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
     int last_strand_index = -1;   ///< the index into the table's n_h values it chose

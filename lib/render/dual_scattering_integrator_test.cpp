@@ -977,6 +977,40 @@ TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
     EXPECT_GT(stopped_by_mesh, 100);
 }
 
+TEST(TraceThroughHair, StrandsBehindIsCountedOnceAndOnlyWhenAskedFor) {
+    // A deferred count traces the ray of strands_before_mesh the first time it is asked for and
+    // then keeps it; a count known in advance (0: nothing allowed behind, −1: unbounded) traces
+    // nothing.
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
+    d.curves = {tuft(1500, 6, 0.008f)};
+    d.curves[0].material = 1;
+    d.meshes = {quad_at(0.2f, 0.45f, 0)};
+    d.camera = looking_down(1, 1, 4, 4);
+    const Scene scene = build(std::move(d));
+    std::vector<StrandCrossing> scratch, reference;
+    int counted = 0;
+    for (int i = 0; i < 40; ++i) {
+        const float a = 0.37f * float(i);
+        const Vec3 origin{0.2f * std::cos(a), 0.2f * std::sin(a), 0.6f};
+        const Vec3 dir = safe_normalize(Vec3{std::sin(a), std::cos(2.0f * a), -0.7f});
+        const int want = scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, {}, 5, reference);
+        counted += want > 0;
+        StrandsBehind deferred{origin, dir, {}, 5, -2};
+        std::uint64_t rays = 0;
+        ASSERT_EQ(deferred.get(scene, scratch, rays), want) << "ray " << i;
+        ASSERT_EQ(rays, 1u);
+        ASSERT_EQ(deferred.get(scene, scratch, rays), want);
+        ASSERT_EQ(rays, 1u);
+        for (const int known : {0, -1}) {
+            StrandsBehind preset{origin, dir, {}, 5, known};
+            ASSERT_EQ(preset.get(scene, scratch, rays), known);
+            ASSERT_EQ(rays, 1u);
+        }
+    }
+    EXPECT_GT(counted, 10);  // most rays found strands
+}
+
 // A blonde tuft over a white floor under a sun and a grey world, seen by `camera`.
 Scene tuft_over_floor(CameraDesc camera) {
     SceneDesc d;

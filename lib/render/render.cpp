@@ -234,7 +234,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const DualScattering *dual = nullptr;  // set when the ray left a hair vertex shaded by dual scattering
         FiberFrame frame;
         float theta_o = 0;
-        int depth = -1;
+        StrandsBehind depth;  // Ā_b's cut for the continuation's global term (DualWork::last_depth)
         Rgb beta;  // the path's throughput at that vertex
         Vec3 behind_origin;  // the vertex's spawn point along −ω_i (ω_i: the continuation)
         PrimRef self;
@@ -274,8 +274,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                 const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
                 // The mesh is a vertex of its own, after the strands: it must be one the path
                 // tracer would shade.
-                const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward,
-                                                  dual_from.depth, bounces_after(dual_from.bounces_left, 1));
+                const int budget = bounces_after(dual_from.bounces_left, 1);
+                const int behind = backscatter_depth(-1, forward.strands, budget) == 0
+                                       ? 0  // the cut is 0 whatever lies behind
+                                       : dual_from.depth.get(scene, counters.dual.behind, counters.shadow_rays);
+                const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward, behind, budget);
                 beta = dual_from.beta * m / bsdf_pdf;
                 if (is_black(beta) || !finite(beta)) break;
                 through_hair = true;
