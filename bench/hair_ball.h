@@ -18,9 +18,22 @@
 
 namespace hairis::bench {
 
-/// `count` strands whose radius falls from 4 mm at the root to 1 mm at the tip, times `thickness`.
-inline HairCurves ball_strands(std::size_t count, float thickness = 1.0f) {
+constexpr int kBallStrandPoints = 9;
+
+/// How ball_strands grow: out from the root along the sphere's normal, bending towards a
+/// random lean (x and y uniform in ±spread/2, z `droop`), the radius falling linearly.
+struct StrandShape {
+    float length = 0.5f;
+    float spread = 0.4f, droop = -0.3f;
+    float root_radius = 0.004f, tip_radius = 0.001f;
+};
+
+/// `count` strands of kBallStrandPoints points rooted uniformly on the unit sphere (material 0).
+inline HairCurves ball_strands(std::size_t count, const StrandShape &shape = {}) {
     HairCurves c;
+    c.points.reserve(count * kBallStrandPoints);
+    c.radii.reserve(count * kBallStrandPoints);
+    c.first.reserve(count + 1);
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     c.first.push_back(0);
@@ -28,11 +41,11 @@ inline HairCurves ball_strands(std::size_t count, float thickness = 1.0f) {
         const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng);
         const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
         const Vec3 root{r * std::cos(phi), r * std::sin(phi), z};
-        const Vec3 lean{0.4f * (u(rng) - 0.5f), 0.4f * (u(rng) - 0.5f), -0.3f};
-        for (int k = 0; k < 9; ++k) {
-            const float t = float(k) / 8.0f;
-            c.points.push_back(root + (0.5f * t) * (root + t * lean));
-            c.radii.push_back(thickness * (0.004f + (0.001f - 0.004f) * t));
+        const Vec3 lean{shape.spread * (u(rng) - 0.5f), shape.spread * (u(rng) - 0.5f), shape.droop};
+        for (int k = 0; k < kBallStrandPoints; ++k) {
+            const float t = float(k) / float(kBallStrandPoints - 1);
+            c.points.push_back(root + (shape.length * t) * (root + t * lean));
+            c.radii.push_back(shape.root_radius + (shape.tip_radius - shape.root_radius) * t);
         }
         c.first.push_back(std::uint32_t(c.points.size()));
     }
@@ -63,7 +76,7 @@ inline TriangleMesh ball_mesh(int rings = 24, int segments = 48) {
 
 struct HairBall {
     std::size_t strands = 1000;
-    float thickness = 1.0f;  ///< ball_strands' radius scale
+    float thickness = 1.0f;  ///< scales StrandShape's radii
     float melanin = 0.25f;   ///< Principled Hair's, Roughness 0.3
     bool mesh = true;        ///< the sphere under the roots
     int size = 96;           ///< pixels a side
@@ -110,7 +123,10 @@ inline Expected<Scene> hair_ball_scene(const HairBall &ball, StrategyKind kind, 
     DiffuseMaterial skin;
     skin.albedo = {0.6f, 0.5f, 0.45f};
     desc.materials.push_back(skin);
-    desc.curves.push_back(ball_strands(ball.strands, ball.thickness));
+    StrandShape shape;
+    shape.root_radius *= ball.thickness;
+    shape.tip_radius *= ball.thickness;
+    desc.curves.push_back(ball_strands(ball.strands, shape));
     if (ball.mesh) desc.meshes.push_back(ball_mesh());
     SunLight sun;
     sun.to_sun = safe_normalize(Vec3{0.5f, -0.6f, 0.6f});

@@ -9,7 +9,6 @@
 
 #include <cmath>
 #include <ctime>
-#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,7 +17,6 @@
 #include "render/render.h"
 #include "render/scene.h"
 #include "sampling/strategy.h"
-#include "tables/bake.h"
 
 namespace hairis::bench {
 namespace {

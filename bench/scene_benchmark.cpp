@@ -9,12 +9,10 @@
 // SceneDesc's points, radii and offsets).
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <memory>
-#include <random>
 
+#include "hair_ball.h"
 #include "render/scene.h"
 #include "sampling/analytic_sampler.h"
 #include "sampling/hair_bsdf.h"
@@ -22,39 +20,18 @@
 namespace hairis::bench {
 namespace {
 
-constexpr int kPointsPerCurve = 9;
-
-// `count` strands of 9 points: roots uniform on the unit sphere, growing outwards 0.4 with a
-// random lean, radius 0.01 at the root down to 0.002 at the tip.
-HairCurves synthetic_strands(std::size_t count, std::uint32_t seed = 1) {
-    HairCurves c;
-    c.points.reserve(count * kPointsPerCurve);
-    c.radii.reserve(count * kPointsPerCurve);
-    c.first.reserve(count + 1);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    c.first.push_back(0);
-    for (std::size_t s = 0; s < count; ++s) {
-        const float z = 2.0f * u(rng) - 1.0f, phi = 6.2831853f * u(rng);
-        const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const Vec3 root{r * std::cos(phi), r * std::sin(phi), z};
-        const Vec3 lean{0.3f * (u(rng) - 0.5f), 0.3f * (u(rng) - 0.5f), -0.2f};
-        for (int k = 0; k < kPointsPerCurve; ++k) {
-            const float t = float(k) / float(kPointsPerCurve - 1);
-            c.points.push_back(root + (0.4f * t) * (root + t * lean));
-            c.radii.push_back(0.01f + (0.002f - 0.01f) * t);
-        }
-        c.first.push_back(std::uint32_t(c.points.size()));
-    }
-    c.material = 0;
-    return c;
-}
-
 SceneDesc strand_scene(std::size_t count) {
     SceneDesc desc;
     auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(ChiangParams{}).value());
     desc.materials.push_back(HairMaterial{HairShading::create(fiber, std::make_shared<const AnalyticSampler>(fiber)).value()});
-    desc.curves.push_back(synthetic_strands(count));
+    // Roots on the unit sphere, 0.4 long, radius 0.01 at the root down to 0.002 at the tip.
+    StrandShape shape;
+    shape.length = 0.4f;
+    shape.spread = 0.3f;
+    shape.droop = -0.2f;
+    shape.root_radius = 0.01f;
+    shape.tip_radius = 0.002f;
+    desc.curves.push_back(ball_strands(count, shape));
     desc.suns.push_back(SunLight{});
     desc.camera.camera_to_world = Mat4::translation({0, 0, 5});
     desc.camera.width = 16;
@@ -92,7 +69,7 @@ void scene_build_strands(benchmark::State &state) {
     state.counters["peak_MB"] = double(last.estimated_peak_bytes) / MB;
     state.counters["input_MB"] = input_bytes / MB;
     state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(count));
-    state.SetLabel(std::to_string(count) + " strands x " + std::to_string(kPointsPerCurve) +
+    state.SetLabel(std::to_string(count) + " strands x " + std::to_string(kBallStrandPoints) +
                    " points");
 }
 BENCHMARK(scene_build_strands)

@@ -45,20 +45,16 @@ bool same_ray(const LightSample &a, const LightSample &b) {
 
 }  // namespace
 
-int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
-                   std::vector<StrandCrossing> &scratch, int cap) {
-    const Vec3 dir = -wi;
-    return scene.strands_before_mesh(point.spawn_point(dir), dir, 0.0f, INFINITY, point.self,
-                                     std::clamp(cap, 1, kMaxStrandsBehind), scratch);
-}
-
-int StrandsBehind::get(const Scene &scene, std::vector<StrandCrossing> &scratch, std::uint64_t &rays) {
-    if (value == -2) {
-        value = scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, self, std::clamp(cap, 1, kMaxStrandsBehind),
-                                          scratch);
+int StrandsBehind::depth(const Scene &scene, int strands, int bounces_left,
+                         std::vector<StrandCrossing> &scratch, std::uint64_t &rays) {
+    if (!layer) return -1;
+    if (backscatter_depth(-1, strands, bounces_left) == 0) return 0;
+    if (counted < 0) {
+        counted = scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, self,
+                                            std::clamp(cap, 1, kMaxStrandsBehind), scratch);
         ++rays;
     }
-    return value;
+    return counted;
 }
 
 ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
@@ -139,33 +135,17 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         const Vec3 dir = probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v);
         const float tmax = probe ? shadow_tmax(*probe) : INFINITY;
         const PrimRef target = probe ? PrimRef{probe->skip_geometry, probe->skip_primitive} : PrimRef{};
-        bool over = false;
         probe_mesh = scene.trace_through_hair_within(sp.spawn_point(dir), dir, 0.0f, tmax, sp.self, target,
-                                                     v.bounces_left, work.probe, over);
+                                                     v.bounces_left, work.probe);
         ++work.rays;
     }
-    // Where Ā_b's series stop for light from ω_i that crossed `strands` strands (Layer): the
-    // strands behind the vertex along the light's travel, −ω_i, up to the first mesh (−1:
-    // unbounded). The count stops at strands_behind_cap, and is not traced where the bounces
-    // left allow that light no strand behind.
-    const int behind_cap = strands_behind_cap(v.bounces_left);
-    auto depth_behind = [&](Vec3 wi, int strands) {
-        if (!v.layer) return -1;
-        if (backscatter_depth(-1, strands, v.bounces_left) == 0) return 0;
-        ++work.rays;
-        return strands_behind(scene, sp, wi, work.behind, behind_cap);
+    // The strands behind the vertex along the travel of light from ω_i, −ω_i, where Ā_b's
+    // series stop for that light (Layer), counted up to strands_behind_cap when a term needs it.
+    auto behind = [&](Vec3 wi) {
+        return StrandsBehind{sp.spawn_point(-wi), -wi, sp.self, strands_behind_cap(v.bounces_left), v.layer};
     };
-    // The continuation's (the caller's): behind the vertex away from the probe's light point,
-    // counted when first needed (as depth_behind(probe's ω_i, 0) would).
-    {
-        const Vec3 dir = -(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
-        StrandsBehind &d = work.last_depth;
-        d.origin = sp.spawn_point(dir);
-        d.dir = dir;
-        d.self = sp.self;
-        d.cap = behind_cap;
-        d.value = !v.layer ? -1 : backscatter_depth(-1, 0, v.bounces_left) == 0 ? 0 : -2;
-    }
+    // The continuation's (the caller's): behind the vertex away from the probe's light point.
+    work.last_depth = behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;
     work.last_probe_strands = int(work.probe.size());
@@ -178,10 +158,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             const std::vector<StrandCrossing> *crossings = &work.probe;
             std::optional<Hit> mesh = probe_mesh;
             if (!(probe && probe->delta && ls->delta && same_ray(*probe, *ls))) {
-                bool over = false;
                 mesh = scene.trace_through_hair_within(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax(*ls),
                                                        sp.self, {ls->skip_geometry, ls->skip_primitive},
-                                                       v.bounces_left, work.light, over);
+                                                       v.bounces_left, work.light);
                 ++work.rays;
                 crossings = &work.light;
             }
@@ -199,12 +178,11 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                     if (v.layer) pdf_bsdf = dual_mixture_pdf(pdf_bsdf, pdf_table);
                     sum += f * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_bsdf));
                 }
-                // The probe's depth is this sample's when both drew the same delta light.
+                // The probe's count is this sample's when both drew the same delta light.
+                StrandsBehind along_light = behind(ls->wi);
+                StrandsBehind &light_behind = crossings == &work.probe ? work.last_depth : along_light;
                 const int light_depth =
-                    crossings != &work.probe ? depth_behind(ls->wi, forward.strands)
-                    : backscatter_depth(-1, forward.strands, v.bounces_left) == 0
-                        ? 0  // the cut is 0 whatever lies behind
-                        : work.last_depth.get(scene, work.behind, work.rays);
+                    light_behind.depth(scene, forward.strands, v.bounces_left, work.behind, work.rays);
                 const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth, v.bounces_left);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
@@ -218,20 +196,19 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
     if (s.pdf > 0.0f) {
         const Vec3 wi = s.wi;
         const Vec3 origin = sp.spawn_point(wi);
-        bool over = false;
         const std::optional<Hit> mesh =
-            scene.trace_through_hair_within(origin, wi, 0.0f, INFINITY, sp.self, {}, v.bounces_left, work.table, over);
+            scene.trace_through_hair_within(origin, wi, 0.0f, INFINITY, sp.self, {}, v.bounces_left, work.table);
         ++work.rays;
-        const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
         // Past the first bounces_left + 1 strands nothing reaches x within the limit.
+        const bool over = v.bounces_left >= 0 && work.table.size() > std::size_t(v.bounces_left);
+        const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
         const float t_end = over ? work.table.back().t : mesh ? mesh->t : INFINITY;
         const float inv_pdf = 1.0f / s.pdf;
         // The strands behind along −ω_i, counted once, when light first arrives (work.table
         // stays); later light has crossed more strands, so its cut is no deeper.
-        int table_depth = -2;
+        StrandsBehind table_behind = behind(wi);
         auto sample_depth = [&](int strands) {
-            if (table_depth == -2) table_depth = depth_behind(wi, strands);
-            return table_depth;
+            return table_behind.depth(scene, strands, v.bounces_left, work.behind, work.rays);
         };
         // Lamps between crossings see the strands before them.
         ForwardScattering forward;

@@ -121,12 +121,6 @@ ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCros
 /// to 0.95 there), and a ray that has found them stops.
 constexpr int kMaxStrandsBehind = 64;
 
-/// Where Ā_b's series stop for light from unit direction wi at `point` (Layer): the strands
-/// behind it along the light's travel, −wi, up to the first mesh, at most `cap` (in
-/// [1, kMaxStrandsBehind]; the traversal stops there).
-int strands_behind(const Scene &scene, const SurfacePoint &point, Vec3 wi,
-                   std::vector<StrandCrossing> &scratch, int cap = kMaxStrandsBehind);
-
 /// A budget of scattering events (DualVertex::bounces_left) after `events` of it are spent:
 /// unlimited (−1) stays so, otherwise at least 0.
 inline int bounces_after(int bounces_left, int events) {
@@ -197,23 +191,26 @@ struct DualVertex {
     int bounces_left = -1;
 };
 
-/// A count of the strands behind a point along `dir` up to the first mesh, at most `cap`
-/// (strands_behind), traced the first time it is asked for: `value` is −2 until then, and −1
-/// for an unbounded volume (no count).
+/// The strands behind a point along unit `dir` up to the first mesh, where a layer cuts Ā_b's
+/// series (DualHairVolume::Layer), counted the first time a term needs them.
 struct StrandsBehind {
-    Vec3 origin, dir;  ///< the point's spawn point along dir, and dir (unit)
-    PrimRef self;
-    int cap = kMaxStrandsBehind;
-    int value = -1;
-    /// The count; traces it (into `scratch`, adding 1 to `rays`) the first time.
-    int get(const Scene &scene, std::vector<StrandCrossing> &scratch, std::uint64_t &rays);
+    Vec3 origin, dir;             ///< the point's spawn point along dir, and dir
+    PrimRef self;                 ///< the point's curve
+    int cap = kMaxStrandsBehind;  ///< the count stops there (strands_behind_cap)
+    bool layer = true;            ///< false: the unbounded series, nothing to count
+    int counted = -1;             ///< the count once traced
+    /// backscatter_depth's `depth` for light that crossed `strands` strands with `bounces_left`
+    /// events left: −1 outside a layer, 0 without a ray where those events allow no strand
+    /// behind, else the count (traced into `scratch` the first time, adding 1 to `rays`).
+    int depth(const Scene &scene, int strands, int bounces_left, std::vector<StrandCrossing> &scratch,
+              std::uint64_t &rays);
 };
 
 /// Per-thread buffers and counts of the estimator.
 struct DualWork {
     std::vector<StrandCrossing> light, probe, table, behind, continuation;
     /// The strands behind the last vertex away from its probe's light point (the second probe):
-    /// Ā_b's cut for the continuation's global term, counted when first needed.
+    /// Ā_b's cut for the continuation's global term.
     StrandsBehind last_depth;
     std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
     int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed

@@ -926,17 +926,23 @@ HairCurves tuft(int count, int points, float radius, std::uint32_t seed = 1) {
     return c;
 }
 
-TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
-    // Random rays through a dense tuft cut by a floor half-way up: the capped count equals the
-    // full trace's count, capped, for every cap, and a trace within a cap the full trace or its
-    // first cap + 1 strands (the traversal stops early only once it knows).
+// A dense tuft of 1500 strands cut half-way up by a floor (so rays meet many strands, and
+// some a mesh after them).
+Scene tuft_cut_by_floor() {
     SceneDesc d;
     d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
     d.curves = {tuft(1500, 6, 0.008f)};
     d.curves[0].material = 1;
     d.meshes = {quad_at(0.2f, 0.45f, 0)};
     d.camera = looking_down(1, 1, 4, 4);
-    const Scene scene = build(std::move(d));
+    return build(std::move(d));
+}
+
+TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
+    // Random rays through a dense tuft cut by a floor half-way up: the capped count equals the
+    // full trace's count, capped, for every cap, and a trace within a cap the full trace or its
+    // first cap + 1 strands (the traversal stops early only once it knows).
+    const Scene scene = tuft_cut_by_floor();
     std::vector<StrandCrossing> full, scratch;
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
@@ -955,11 +961,8 @@ TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
                 << "ray " << i << " cap " << cap;
         // Within a cap: the full trace where it holds at most cap strands, else its first cap + 1.
         for (const int cap : {0, 1, 3, 16}) {
-            bool over = false;
-            const auto within =
-                scene.trace_through_hair_within(origin, dir, 0.0f, INFINITY, {}, {}, cap, scratch, over);
-            ASSERT_EQ(over, n > cap) << "ray " << i << " cap " << cap;
-            if (over) {
+            const auto within = scene.trace_through_hair_within(origin, dir, 0.0f, INFINITY, {}, {}, cap, scratch);
+            if (n > cap) {
                 ASSERT_FALSE(within.has_value());
                 ASSERT_EQ(scratch.size(), std::size_t(cap) + 1);
             } else {
@@ -978,16 +981,10 @@ TEST(TraceThroughHair, CappedTracesAgreeWithTheFullTrace) {
 }
 
 TEST(TraceThroughHair, StrandsBehindIsCountedOnceAndOnlyWhenAskedFor) {
-    // A deferred count traces the ray of strands_before_mesh the first time it is asked for and
-    // then keeps it; a count known in advance (0: nothing allowed behind, −1: unbounded) traces
-    // nothing.
-    SceneDesc d;
-    d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
-    d.curves = {tuft(1500, 6, 0.008f)};
-    d.curves[0].material = 1;
-    d.meshes = {quad_at(0.2f, 0.45f, 0)};
-    d.camera = looking_down(1, 1, 4, 4);
-    const Scene scene = build(std::move(d));
+    // A count of the strands behind traces strands_before_mesh's ray the first time a term can
+    // use it and then keeps it; where the bounces left allow no strand behind it is 0, and
+    // outside a layer −1, without a ray.
+    const Scene scene = tuft_cut_by_floor();
     std::vector<StrandCrossing> scratch, reference;
     int counted = 0;
     for (int i = 0; i < 40; ++i) {
@@ -996,17 +993,18 @@ TEST(TraceThroughHair, StrandsBehindIsCountedOnceAndOnlyWhenAskedFor) {
         const Vec3 dir = safe_normalize(Vec3{std::sin(a), std::cos(2.0f * a), -0.7f});
         const int want = scene.strands_before_mesh(origin, dir, 0.0f, INFINITY, {}, 5, reference);
         counted += want > 0;
-        StrandsBehind deferred{origin, dir, {}, 5, -2};
+        StrandsBehind behind{origin, dir, {}, 5};
         std::uint64_t rays = 0;
-        ASSERT_EQ(deferred.get(scene, scratch, rays), want) << "ray " << i;
+        // 4 events left after light through 3 strands: (4 − 3)/2 = 0 strands behind.
+        ASSERT_EQ(behind.depth(scene, 3, 4, scratch, rays), 0) << "ray " << i;
+        ASSERT_EQ(rays, 0u);
+        ASSERT_EQ(behind.depth(scene, 0, -1, scratch, rays), want) << "ray " << i;
         ASSERT_EQ(rays, 1u);
-        ASSERT_EQ(deferred.get(scene, scratch, rays), want);
+        ASSERT_EQ(behind.depth(scene, 1, 8, scratch, rays), want);
         ASSERT_EQ(rays, 1u);
-        for (const int known : {0, -1}) {
-            StrandsBehind preset{origin, dir, {}, 5, known};
-            ASSERT_EQ(preset.get(scene, scratch, rays), known);
-            ASSERT_EQ(rays, 1u);
-        }
+        StrandsBehind unbounded{origin, dir, {}, 5, false};
+        ASSERT_EQ(unbounded.depth(scene, 0, -1, scratch, rays), -1);
+        ASSERT_EQ(rays, 1u);
     }
     EXPECT_GT(counted, 10);  // most rays found strands
 }

@@ -260,9 +260,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             // sampled direction, in place of f_s (lamps, suns and the world beyond hair are M's).
             // Past the strands the mesh's bounces allow, nothing it reflects counts (hit unset).
             std::vector<StrandCrossing> &strands = counters.dual.continuation;
-            bool over = false;
             hit = scene.trace_through_hair_within(origin, dir, tmin, tmax, skip, {},
-                                                  bounces_after(dual_from.bounces_left, 1), strands, over);
+                                                  bounces_after(dual_from.bounces_left, 1), strands);
             ++counters.rays;
             if (hit && hit->prim.geometry == PrimRef::kNone) hit.reset();  // untraceable: as intersect()
             if (!strands.empty()) {
@@ -275,9 +274,8 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                 // The mesh is a vertex of its own, after the strands: it must be one the path
                 // tracer would shade.
                 const int budget = bounces_after(dual_from.bounces_left, 1);
-                const int behind = backscatter_depth(-1, forward.strands, budget) == 0
-                                       ? 0  // the cut is 0 whatever lies behind
-                                       : dual_from.depth.get(scene, counters.dual.behind, counters.shadow_rays);
+                const int behind =
+                    dual_from.depth.depth(scene, forward.strands, budget, counters.dual.behind, counters.shadow_rays);
                 const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward, behind, budget);
                 beta = dual_from.beta * m / bsdf_pdf;
                 if (is_black(beta) || !finite(beta)) break;
@@ -360,13 +358,9 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // the light and table samples').
         if (dual_from.dual && dual_layer && !through_hair) {
             // The mesh is a vertex of its own after the strands behind and back: the cut.
-            const int cap = strands_behind_cap(bounces_after(dual_from.bounces_left, 1));
-            int behind = 0;
-            if (cap > 0) {
-                behind = scene.strands_before_mesh(dual_from.behind_origin, -dir, 0.0f, INFINITY, dual_from.self,
-                                                   cap, counters.dual.behind);
-                ++counters.rays;
-            }
+            const int budget = bounces_after(dual_from.bounces_left, 1);
+            StrandsBehind behind_mesh{dual_from.behind_origin, -dir, dual_from.self, strands_behind_cap(budget)};
+            const int behind = behind_mesh.depth(scene, 0, budget, counters.dual.behind, counters.rays);
             const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
             const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, behind);
             beta += dual_from.beta * m / bsdf_pdf;

@@ -723,9 +723,7 @@ std::optional<Hit> Scene::trace_through_hair(Vec3 origin, Vec3 dir, float tmin, 
 
 std::optional<Hit> Scene::trace_through_hair_within(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                                     PrimRef skip_a, PrimRef skip_b, int cap,
-                                                    std::vector<StrandCrossing> &strands,
-                                                    bool &over) const {
-    over = false;
+                                                    std::vector<StrandCrossing> &strands) const {
     if (cap < 0) return trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands);
     // A crossing may leave two records (a joint of two segments): 2·(cap + 1) records hold at
     // least cap + 1 crossings but for repeats, which the full trace below covers.
@@ -735,8 +733,7 @@ std::optional<Hit> Scene::trace_through_hair_within(Vec3 origin, Vec3 dir, float
         trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands, 2 * enough, stopped);
     if (stopped && strands.size() < enough)
         mesh = trace_through_hair(origin, dir, tmin, tmax, skip_a, skip_b, strands);
-    over = strands.size() >= enough;
-    if (!over) return mesh;
+    if (strands.size() < enough) return mesh;
     strands.resize(enough);
     return std::nullopt;
 }
@@ -744,8 +741,7 @@ std::optional<Hit> Scene::trace_through_hair_within(Vec3 origin, Vec3 dir, float
 int Scene::strands_before_mesh(Vec3 origin, Vec3 dir, float tmin, float tmax, PrimRef skip, int cap,
                                std::vector<StrandCrossing> &scratch) const {
     cap = std::max(cap, 1);
-    bool over = false;
-    trace_through_hair_within(origin, dir, tmin, tmax, skip, {}, cap - 1, scratch, over);
+    trace_through_hair_within(origin, dir, tmin, tmax, skip, {}, cap - 1, scratch);
     return std::min(int(scratch.size()), cap);
 }
 

@@ -272,13 +272,12 @@ class Scene {
                                           PrimRef skip_a, PrimRef skip_b,
                                           std::vector<StrandCrossing> &strands) const;
     /// trace_through_hair for a caller that needs no more than `cap` strands (cap < 0: every
-    /// one): where more than cap lie before the first mesh (or tmax), `over` is set, `strands`
-    /// holds the first cap + 1 of them and no mesh is returned; the traversal stops
-    /// once that is known. Otherwise (over false) as trace_through_hair.
+    /// one): where more than cap lie before the first mesh (or tmax), `strands` holds the first
+    /// cap + 1 of them and no mesh is returned, the traversal stopping once that is known;
+    /// otherwise as trace_through_hair (so strands.size() > cap says which).
     std::optional<Hit> trace_through_hair_within(Vec3 origin, Vec3 dir, float tmin, float tmax,
                                                  PrimRef skip_a, PrimRef skip_b, int cap,
-                                                 std::vector<StrandCrossing> &strands,
-                                                 bool &over) const;
+                                                 std::vector<StrandCrossing> &strands) const;
     /// min(cap, the strands trace_through_hair reports along the ray), cap >= 1: the traversal
     /// stops once cap crossings are known to lie before any mesh (so a long ray through dense
     /// hair costs about what its first cap crossings cost). `scratch` is overwritten.
