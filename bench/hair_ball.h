@@ -1,6 +1,7 @@
 // The benchmarks' and studies' ball of hair without Blender: strands of 9 points rooted
-// uniformly on the unit sphere, 0.5 long and leaning at random, over a diffuse sphere of
-// radius 0.98, under a sun and a dim world, seen along +y from 6 m.
+// uniformly on the unit sphere, 0.5 long and leaning at random (or straight along the normal,
+// as Blender's particle hair grows without dynamics), over a diffuse sphere of radius 0.98,
+// under a sun and a dim world, seen along +y from 6 m.
 #pragma once
 
 #include <cmath>
@@ -79,6 +80,8 @@ struct HairBall {
     float thickness = 1.0f;  ///< scales StrandShape's radii
     float melanin = 0.25f;   ///< Principled Hair's, Roughness 0.3
     bool mesh = true;        ///< the sphere under the roots
+    bool straight = false;   ///< strands straight along the sphere's normal (no lean or droop)
+    DualScatteringParams dual;  ///< the dual-scattering averages' (the paper's d_f = d_b = 0.7)
     int size = 96;           ///< pixels a side
 };
 
@@ -114,7 +117,7 @@ inline Expected<Scene> hair_ball_scene(const HairBall &ball, StrategyKind kind, 
     SceneDesc desc;
     HairMaterial hair{shading.value()};
     if (dual) {
-        auto averages = DualScattering::create(*fiber, DualScatteringParams{});
+        auto averages = DualScattering::create(*fiber, ball.dual);
         if (!averages) return averages.error();
         hair.dual = std::make_shared<const DualScattering>(std::move(averages).value());
         hair.multiple = tables->multiple;
@@ -126,6 +129,7 @@ inline Expected<Scene> hair_ball_scene(const HairBall &ball, StrategyKind kind, 
     StrandShape shape;
     shape.root_radius *= ball.thickness;
     shape.tip_radius *= ball.thickness;
+    if (ball.straight) shape.spread = shape.droop = 0.0f;
     desc.curves.push_back(ball_strands(ball.strands, shape));
     if (ball.mesh) desc.meshes.push_back(ball_mesh());
     SunLight sun;
