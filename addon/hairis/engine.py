@@ -102,10 +102,10 @@ def dual_scattering_warning(exact_bounces, bounce_limit="BOUNCES"):
     text = ("Dual Scattering is experimental and biased (README, Dual scattering): with %d "
             "Exact Bounces" % exact_bounces)
     if exact_bounces >= 3:
-        text += (" its mean is within about 2% of path tracing on the study's thin hair and "
-                 "4% on denser or thicker hair of varied directions, but light hair whose "
-                 "strands run parallel (straight particle hair, as on the demo head) comes out "
-                 "up to 10% darker, the more so the thicker it is")
+        text += (" its mean is within about 5% of path tracing on the studies' hair, thin or "
+                 "thick, straight or of varied directions: light straight hair (as on the "
+                 "demo head) up to 5% darker, dense light hair of varied directions up to 5% "
+                 "brighter")
     else:
         text += (", fewer than the default 3, its shading is flatter than path tracing's: "
                  "shaded regions brighter, lit ones darker (at 0, by 15-30% region by "

@@ -21,9 +21,9 @@ INTEGRATOR_ITEMS = (
      "Path tracing of the first bounces (Exact Bounces), then Zinke et al. 2008's dual "
      "scattering: light reaching hair through other strands in closed form from shadow rays "
      "that count the strands, multiple scattering sampled from the baked tables (needs baked "
-     "tables). Experimental: biased (at 3 Exact Bounces within about 2% of path tracing in the "
-     "mean on the study's thin hair, up to 10% darker on thick light hair whose strands run "
-     "parallel, as on the demo head; flatter with fewer)", 1),
+     "tables). Experimental: biased (at 3 Exact Bounces within about 5% of path tracing in the "
+     "mean on the studies' hair, thin or thick, straight or of varied directions; flatter "
+     "with fewer)", 1),
 )
 """Values match the C API's ``integrator`` (path | dual_scattering)."""
 

@@ -359,6 +359,13 @@ LobeShape DualScattering::lobe_shape(int p) const {
 
 Rgb DualScattering::forward_attenuation(double t) const { return to_rgb(lookup(a_f_, t)); }
 Rgb DualScattering::backward_attenuation(double t) const { return to_rgb(lookup(a_b_, t)); }
+Rgb DualScattering::crossing_attenuation(double t) const {
+    const double s = std::sin(t);
+    const Rgbd f = lookup(a_f_, t), b = lookup(a_b_, t);
+    Rgbd a;
+    for (int c = 0; c < 3; ++c) a.v[c] = std::clamp(f.v[c] + s * s * b.v[c], 0.0, 1.0);
+    return to_rgb(a);
+}
 Rgb DualScattering::forward_shift(double t) const { return to_rgb(lookup(alpha_f_, t)); }
 Rgb DualScattering::backward_shift(double t) const { return to_rgb(lookup(alpha_b_, t)); }
 Rgb DualScattering::backscatter_attenuation(double t) const { return to_rgb(lookup(big_a_b_, t)); }

@@ -54,6 +54,22 @@
 //         NOTE: the seed's source used σ_f² = n_h β̄_f (no square); we use the paper's form:
 //         the variances of the n_h independent forward-scattering events add up.
 //
+// Crossings (crossing_attenuation; the renderer multiplies it strand by strand). The paper's
+// volume is hair lying across the light's way, where scattering into the backward azimuths
+// turns light around. Scattering keeps a ray on its fiber's specular cone: it reverses the light's travel
+// across the fiber and keeps its travel along it. So of the light a strand scatters back, the
+// share that travels along the fiber, sin²θ (θ the light's inclination to that strand), goes on
+// with the forward light:
+//   a(θ) = ā_f(θ) + sin²θ ā_b(θ),
+// ā_f for light across the fiber (the paper's), ā_f + ā_b along it, where forward and backward
+// azimuths head the same way. DECISION: sin²θ, the axial share of the direction's energy, is
+// the simplest weight with both limits; on hair standing straight off a sphere (the light
+// travels along the strands to the points below) the paper's ā_f left DUAL 4–10% dark, this
+// within 5%, and hair lying or leaning at random moved by 1–3% (bench/results/dual_density.md).
+// The distributions and the baked multiple-scattering tables keep the paper's T_f = d_f ā_f^n_h
+// (the seed's S_multiple): with a(θ) their many-strand rows would all peak at grazing θ_i,
+// where light runs along the fibers; they only shape where the renderer's samples go.
+//
 //   N_p^G(θ_d): the lobe's azimuthal function averaged over the forward azimuths (the paper's
 //   N_p^G, eq. 25, a constant in φ). A FiberModel only exposes f_p·cos θ_i, so we extract it:
 //   with G_p(θ_i, θ_o) = (1/π) ∫_{|φ|>π/2} f_p cos θ_i dφ (the lobe averaged over forward
@@ -164,7 +180,12 @@ class DualScattering {
     Rgb backscatter_shift(double theta) const;        ///< Δ̄_b (radians)
     Rgb backscatter_width(double theta) const;        ///< σ̄_b (radians)
 
-    /// T_f = d_f ā_f^n_h for n_h ≥ 1; 1 for n_h = 0 (nothing in the way); 0 for n_h < 0.
+    /// The share of light crossing a strand at inclination θ that goes on towards the point
+    /// behind it: ā_f + sin²θ ā_b, at most 1 (see "Crossings" above); ā_f at θ = 0, as in the paper.
+    Rgb crossing_attenuation(double theta) const;
+
+    /// T_f = d_f ā_f^n_h for n_h ≥ 1; 1 for n_h = 0 (nothing in the way); 0 for n_h < 0 (the
+    /// paper's, as the distributions and tables use it; the renderer's is crossing_attenuation's).
     Rgb forward_transmittance(double theta, int n_h) const;
     /// σ_f² = n_h β̄_f² (radians²); 0 for n_h ≤ 0.
     Rgb forward_spread_variance(double theta, int n_h) const;

@@ -72,6 +72,17 @@ class FlatFiber : public FiberModel {
     static Rgb expected_backward(int p, double theta_l) {
         return kScale[p] * float((1.0 - 0.5 * sqr(std::sin(theta_l))) * kHalfPi * test_n_backward(p));
     }
+    // ā_f and ā_b: the lobes' closed forms summed.
+    static Rgb expected_forward(double theta_l) {
+        Rgb sum;
+        for (int p = 0; p < 3; ++p) sum += expected_forward(p, theta_l);
+        return sum;
+    }
+    static Rgb expected_backward(double theta_l) {
+        Rgb sum;
+        for (int p = 0; p < 3; ++p) sum += expected_backward(p, theta_l);
+        return sum;
+    }
 
   private:
     bool eccentric_;
@@ -163,15 +174,12 @@ TEST(DualScattering, AttenuationsMatchHandComputedIntegrals) {
     const DualScattering ds = make(fiber);
     for (int k = 0; k < ds.theta_count(); k += 7) {
         const double t = ds.table_theta(k);
-        Rgb sum_f, sum_b;
         for (int p = 0; p < 3; ++p) {
             expect_rgb_near(ds.lobe_forward_attenuation(p, t), FlatFiber::expected_forward(p, t), 2e-6, "a_f,p");
             expect_rgb_near(ds.lobe_backward_attenuation(p, t), FlatFiber::expected_backward(p, t), 2e-6, "a_b,p");
-            sum_f += FlatFiber::expected_forward(p, t);
-            sum_b += FlatFiber::expected_backward(p, t);
         }
-        expect_rgb_near(ds.forward_attenuation(t), sum_f, 5e-6, "a_f");
-        expect_rgb_near(ds.backward_attenuation(t), sum_b, 5e-6, "a_b");
+        expect_rgb_near(ds.forward_attenuation(t), FlatFiber::expected_forward(t), 5e-6, "a_f");
+        expect_rgb_near(ds.backward_attenuation(t), FlatFiber::expected_backward(t), 5e-6, "a_b");
         for (int ch = 0; ch < 3; ++ch) {
             const HandTerms h = hand_terms(t, ch, ds.params().d_b);
             EXPECT_NEAR(ds.forward_shift(t)[ch], h.alpha_f, 1e-6);
@@ -186,10 +194,23 @@ TEST(DualScattering, AttenuationsMatchHandComputedIntegrals) {
     // Between nodes the tables interpolate linearly: close to the smooth hand values.
     for (double deg : {-61.3, -12.0, 0.4, 33.3, 70.7}) {
         const double t = radians(deg);
-        Rgb sum_f;
-        for (int p = 0; p < 3; ++p) sum_f += FlatFiber::expected_forward(p, t);
-        expect_rgb_near(ds.forward_attenuation(t), sum_f, 1.5e-3, "a_f between nodes");
+        expect_rgb_near(ds.forward_attenuation(t), FlatFiber::expected_forward(t), 1.5e-3, "a_f between nodes");
     }
+}
+
+TEST(DualScattering, CrossingsPassOnTheBackwardLightThatTravelsAlongTheFiber) {
+    // a(θ) = ā_f + sin²θ ā_b against the flat fiber's closed forms (not the tables): the
+    // paper's ā_f for light across the fiber, the whole scattered albedo ā_f + ā_b along it.
+    const FlatFiber fiber;
+    const DualScattering ds = make(fiber);
+    for (int k = 0; k < ds.theta_count(); k += 5) {
+        const double t = ds.table_theta(k);
+        const Rgb expected = FlatFiber::expected_forward(t) + FlatFiber::expected_backward(t) * float(sqr(std::sin(t)));
+        expect_rgb_near(ds.crossing_attenuation(t), expected, 5e-6, "a(θ)");
+    }
+    // Along the fiber nearly all the backward light goes on.
+    const double last = ds.table_theta(ds.theta_count() - 1);
+    EXPECT_GT(ds.crossing_attenuation(last).r, ds.forward_attenuation(last).r + 0.9f * ds.backward_attenuation(last).r);
 }
 
 TEST(DualScattering, EnergyScaleMultipliesTheModel) {

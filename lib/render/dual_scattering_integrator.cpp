@@ -21,7 +21,7 @@ void add_crossing(ForwardScattering &forward, const Scene &scene, const StrandCr
         if (const auto *hair = std::get_if<HairMaterial>(&scene.materials()[c.material]))
             if (hair->dual) dual = hair->dual.get();
     const double theta = std::asin(clamp_unit(dot(dir, c.tangent)));
-    forward.attenuation *= dual->forward_attenuation(theta);
+    forward.attenuation *= dual->crossing_attenuation(theta);
     forward.spread_variance += dual->forward_spread_variance(theta, 1);
     ++forward.strands;
 }

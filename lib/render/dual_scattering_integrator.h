@@ -10,8 +10,10 @@
 // k = 1..n before reaching x (meshes block it):
 //   n = 0:  F·cos θ_i = f_s·cos θ_i  +  d_b f_back^direct cos θ_i              = D + M
 //   n ≥ 1:  F·cos θ_i = T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i    =     M
-//   T_f = d_f Π_k ā_f(θ_k),  σ_f² = Σ_k β̄_f²(θ_k),  θ_k = asin(ω_i · tangent_k),
-// with ā_f and β̄_f² from each crossed strand's own material, and d_f, d_b, the backscatter
+//   T_f = d_f Π_k a(θ_k),  σ_f² = Σ_k β̄_f²(θ_k),  θ_k = asin(ω_i · tangent_k),
+// a(θ) = ā_f(θ) + sin²θ ā_b(θ) (DualScattering::crossing_attenuation: the paper's ā_f, and the
+// backward-scattered light that still travels along the fiber), with a and β̄_f² from each
+// crossed strand's own material, and d_f, d_b, the backscatter
 // terms and f^scatter from the shading point's. D is single scattering of unoccluded light, M
 // the multiple-scattering term (the local d_b f_back^direct where the light is visible, the
 // global term where it is not).
@@ -101,7 +103,7 @@
 
 namespace hairis {
 
-/// The forward scattering gathered along a ray: strands crossed, Π ā_f(θ_k) and Σ β̄_f²(θ_k)
+/// The forward scattering gathered along a ray: strands crossed, Π a(θ_k) and Σ β̄_f²(θ_k)
 /// (T_f without d_f, and σ_f²).
 struct ForwardScattering {
     int strands = 0;
@@ -110,8 +112,8 @@ struct ForwardScattering {
 };
 
 /// Gathers the crossings strands[0 .. count) of a ray along unit direction `dir` (towards the
-/// light): each strand's ā_f and β̄_f² at θ_k = asin(dir · tangent_k) from its material's
-/// dual-scattering data (`fallback` for a material without one).
+/// light): each strand's a (crossing_attenuation) and β̄_f² at θ_k = asin(dir · tangent_k)
+/// from its material's dual-scattering data (`fallback` for a material without one).
 ForwardScattering gather_forward_scattering(const Scene &scene, const StrandCrossing *strands,
                                             std::size_t count, Vec3 dir,
                                             const DualScattering &fallback);

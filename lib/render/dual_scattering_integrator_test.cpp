@@ -209,9 +209,18 @@ StrandCrossing crossing_with_tangent(Vec3 tangent) {
     return c;
 }
 
-TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveThePapersFixedCountForm) {
-    // k strands crossed at the shading fiber's own inclination: T_f = d_f ā_f^k and
-    // σ_f² = k β̄_f² (DualScattering's closed forms), and the multiple term is multiple_f_cos.
+// T_f of k strands crossed at inclination θ: d_f (ā_f + sin²θ ā_b)^k, from the averages.
+Rgb fixed_count_transmittance(const DualScattering &dual, double theta, int k) {
+    const Rgb a_f = dual.forward_attenuation(theta), a_b = dual.backward_attenuation(theta);
+    const double s2 = std::sin(theta) * std::sin(theta), d_f = dual.params().d_f;
+    auto channel = [&](int ch) { return float(d_f * std::pow(double(a_f[ch]) + s2 * double(a_b[ch]), k)); };
+    return {channel(0), channel(1), channel(2)};
+}
+
+TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveTheFixedCountForm) {
+    // k strands crossed at the shading fiber's own inclination: T_f = d_f (ā_f + sin²θ ā_b)^k
+    // and σ_f² = k β̄_f² (forward_spread_variance), and the multiple term is scattered_f_cos of
+    // them; with a(θ) = ā_f (θ = 0) it is the paper's multiple_f_cos.
     const Blonde &b = blonde();
     SceneDesc d;
     d.materials = {dual_hair(b)};
@@ -224,7 +233,7 @@ TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveThePapersFixedCountFor
             const std::vector<StrandCrossing> strands(std::size_t(k), crossing_with_tangent({1, 0, 0}));
             const ForwardScattering f = gather_forward_scattering(scene, strands.data(), strands.size(), dir, *b.dual);
             EXPECT_EQ(f.strands, k);
-            const Rgb t_f = b.dual->forward_transmittance(theta, k);
+            const Rgb t_f = fixed_count_transmittance(*b.dual, theta, k);
             const Rgb s_f = b.dual->forward_spread_variance(theta, k);
             for (int ch = 0; ch < 3; ++ch) {
                 EXPECT_NEAR(b.dual->params().d_f * f.attenuation[ch], t_f[ch], 1e-5 * t_f[ch] + 1e-12);
@@ -232,8 +241,12 @@ TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveThePapersFixedCountFor
             }
             for (double theta_o : {-0.5, 0.0, 0.8}) {
                 const Rgb got = dual_multiple_f_cos(*b.dual, float(theta), float(theta_o), f);
-                const Rgb want = b.dual->multiple_f_cos(float(theta), float(theta_o), k);
+                const Rgb want = b.dual->scattered_f_cos(float(theta), float(theta_o), t_f, s_f);
                 for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], want[ch], 1e-4 * want[ch] + 1e-12);
+                if (theta == 0.0) {
+                    const Rgb paper = b.dual->multiple_f_cos(float(theta), float(theta_o), k);
+                    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], paper[ch], 1e-4 * paper[ch] + 1e-12);
+                }
             }
         }
         const ForwardScattering none = gather_forward_scattering(scene, nullptr, 0, dir, *b.dual);
@@ -244,9 +257,9 @@ TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveThePapersFixedCountFor
 }
 
 TEST(DualScatteringIntegrator, EachStrandCountsAtItsOwnInclination) {
-    // Strands of different orientations: T_f/d_f is the product of each one's ā_f at the
-    // inclination of the light to it, σ_f² the sum of its β̄_f², and reversing a tangent flips
-    // the sign of that inclination.
+    // Strands of different orientations: T_f/d_f is the product of each one's
+    // a = ā_f + sin²θ ā_b at the inclination θ of the light to it, σ_f² the sum of its β̄_f²,
+    // and reversing a tangent flips the sign of that inclination.
     const Blonde &b = blonde();
     SceneDesc d;
     d.materials = {dual_hair(b)};
@@ -260,10 +273,10 @@ TEST(DualScatteringIntegrator, EachStrandCountsAtItsOwnInclination) {
     for (Vec3 t : tangents) {
         strands.push_back(crossing_with_tangent(t));
         const double theta = std::asin(double(dot(dir, safe_normalize(t))));
-        const Rgb a = b.dual->forward_attenuation(theta);
+        const Rgb a_f = b.dual->forward_attenuation(theta), a_b = b.dual->backward_attenuation(theta);
         const Rgb w = b.dual->forward_width(theta);
         for (int ch = 0; ch < 3; ++ch) {
-            attenuation[ch] *= a[ch];
+            attenuation[ch] *= double(a_f[ch]) + std::sin(theta) * std::sin(theta) * double(a_b[ch]);
             spread[ch] += double(w[ch]) * w[ch];
         }
     }
@@ -349,12 +362,16 @@ Scene sun_through_strands(int k, float strength) {
 
 TEST(DualScatteringRender, SunThroughKStrandsIsTheClosedForm) {
     // Every sample sees the top hair at θ_o = 0 with the sun behind k strands: its light is
-    // E·T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i, DualScattering's fixed-count form
-    // (the strands are parallel to the shading fiber), whatever h and the other samples do.
+    // E·T_f d_f (f_s^scatter + π d_b f_back^scatter) cos θ_i, the fixed-count form with
+    // T_f = d_f a(0.4)^k (the strands are parallel to the shading fiber), whatever h and the
+    // other samples do.
     const float strength = 2.0f;
+    const DualScattering &dual = *blonde().dual;
     for (int k : {1, 3, 6}) {
         const Scene scene = sun_through_strands(k, strength);
-        const Rgb want = blonde().dual->multiple_f_cos(0.4f, 0.0f, k) * strength;
+        const Rgb want = dual.scattered_f_cos(0.4f, 0.0f, fixed_count_transmittance(dual, 0.4, k),
+                                              dual.forward_spread_variance(0.4, k)) *
+                         strength;
         for (int bounces : {0, 4}) {
             const RenderSettings s = dual_settings(bounces);
             for (int x = 0; x < 8; x += 3)
@@ -383,7 +400,7 @@ TEST(DualScatteringRender, TheBounceLimitKeepsTheOrdersThePathTracerReaches) {
     for (int k : {1, 3, 6}) {
         const Scene scene = sun_through_strands(k, strength);
         for (int limit : {2, 5, 8}) {
-            const Rgb t_f = dual.forward_transmittance(0.4, k);
+            const Rgb t_f = fixed_count_transmittance(dual, 0.4, k);
             const Rgb s_f2 = dual.forward_spread_variance(0.4, k);
             const Rgb want = k > limit ? Rgb(0.0f) : dual.scattered_f_cos(0.4f, 0.0f, t_f, s_f2, (limit - k) / 2) * strength;
             for (const bool by_transmission : {false, true}) {
@@ -399,9 +416,9 @@ TEST(DualScatteringRender, TheBounceLimitKeepsTheOrdersThePathTracerReaches) {
             }
         }
         // The cut moves the value: the series through 0 strands behind is not the unbounded one.
-        const Rgb unbounded = dual.multiple_f_cos(0.4f, 0.0f, k) * strength;
-        const Rgb cut = dual.scattered_f_cos(0.4f, 0.0f, dual.forward_transmittance(0.4, k),
-                                             dual.forward_spread_variance(0.4, k), 0) * strength;
+        const Rgb t_f = fixed_count_transmittance(dual, 0.4, k), s_f2 = dual.forward_spread_variance(0.4, k);
+        const Rgb unbounded = dual.scattered_f_cos(0.4f, 0.0f, t_f, s_f2) * strength;
+        const Rgb cut = dual.scattered_f_cos(0.4f, 0.0f, t_f, s_f2, 0) * strength;
         EXPECT_GT(unbounded.r, 1.01f * cut.r) << "k " << k;
     }
 }
@@ -818,7 +835,7 @@ TEST(DualScatteringRender, ALayerCutsEachSamplesBackscatterAlongItsOwnLight) {
         ForwardScattering forward;
         forward.strands = crossed(y, z);
         for (int k = 0; k < forward.strands; ++k) {
-            forward.attenuation *= dual.forward_attenuation(theta_i);
+            forward.attenuation *= dual.crossing_attenuation(theta_i);
             forward.spread_variance += dual.forward_spread_variance(theta_i, 1);
         }
         return dual_multiple_f_cos(dual, theta_i, 0.0f, forward, depth);

@@ -552,7 +552,8 @@ def machine_info():
     except OSError:
         pass
     try:
-        commit = subprocess.run(["git", "-C", REPOSITORY, "rev-parse", "--short", "HEAD"],
+        commit = subprocess.run(["git", "-C", REPOSITORY, "describe", "--always",
+                                 "--dirty=+changes"],
                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                                 universal_newlines=True).stdout.strip()
     except OSError:
