@@ -620,8 +620,7 @@ def test_huang_materials_export():
     """Blender 4.0+: a new hair node is Chiang (RNA's default says Huang); with model Huang it
     exports every Huang input by identifier and none of Chiang's; all lobes 0 exports black
     diffuse strands with Cycles' reason."""
-    if helpers.VERSION < (4, 0, 0):
-        return  # Blender 3.4 has no model setting (the stub tests cover the reading)
+    helpers.skip_without_huang()
     helpers.make_test_scene(with_curves=False)
     material = bpy.data.materials["Hair"]
     node = material.node_tree.nodes["Principled Hair BSDF"]
@@ -659,8 +658,7 @@ def test_curves_normals_for_huang():
     minimum-twist normals keep one angle to the plane along each curve (parallel transport): unit
     length and a constant |n_z| per curve, which a misread array would break. A Chiang
     material or aspect 1 exports none; a rotated object warns and exports the same normals."""
-    if helpers.VERSION < (4, 0, 0):
-        return
+    helpers.skip_without_huang()
     scene = helpers.reset()
     helpers.make_camera(scene)
     material = helpers.make_hair_material("Oval", "COLOR")

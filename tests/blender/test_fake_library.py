@@ -346,8 +346,7 @@ def test_huang_material_by_bake_and_render():
     the Chiang material's; F12 with the Table strategy renders it with them, refuses them once
     a Huang-only input (Aspect Ratio, a lobe multiplier) changed, and auto-bakes them again;
     Cycles' own Huang sampling needs no tables."""
-    if helpers.VERSION < (4, 0, 0):
-        return  # no model setting before 4.0
+    helpers.skip_without_huang()
     scene = helpers.make_test_scene()
     scene.hairis.auto_bake = False
     scene.hairis.strategy = "TABLE"

@@ -182,9 +182,7 @@ def test_dual_scattering_renders_huang():
     """Blender 4.0+: the Hair material switched to the Huang model (Blender's default since
     4.0) renders with Dual Scattering under the default Huang Sampling (Cycles), auto-baking
     Huang tables with their multiple part, as check_dual_against_path asks."""
-    if bpy.app.version < (4, 0, 0):
-        print("skipped: Blender %s has no Huang model" % bpy.app.version_string)
-        return
+    helpers.skip_without_huang()
     node = next(n for n in bpy.data.materials["Hair"].node_tree.nodes
                 if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
     node.model = "HUANG"
