@@ -53,6 +53,10 @@ struct FiberFrame {
 /// Local direction to (θ, φ): sin θ = ω.x, φ = atan2(ω.z, ω.y).
 FiberAngles angles_of(Vec3 local);
 
+/// θ of the world direction `w` in `frame`: asin(ω·x), sin θ clamped to [−1, 1] (asin rather
+/// than angles_of's atan2, which rounds differently).
+inline float theta_of(const FiberFrame &frame, Vec3 w) { return safe_asin(frame.to_local(w).x); }
+
 /// (θ, φ) to a unit local direction (sin θ, cos θ cos φ, cos θ sin φ).
 Vec3 direction_of(float theta, float phi);
 Vec3 direction_of(FiberAngles a);

@@ -77,6 +77,8 @@ struct Rgb {
 
     constexpr float operator[](int i) const { return i == 0 ? r : (i == 1 ? g : b); }
     constexpr float max_component() const { return std::max(r, std::max(g, b)); }
+    /// Exactly zero in every channel (what a light or BSDF returns where it adds nothing).
+    constexpr bool is_black() const { return r == 0.0f && g == 0.0f && b == 0.0f; }
 };
 
 constexpr Rgb operator*(float s, Rgb c) { return c * s; }

@@ -9,8 +9,6 @@ namespace hairis {
 
 namespace {
 
-bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
-
 float clamp_unit(float s) { return std::clamp(s, -1.0f, 1.0f); }
 
 // Adds one crossed strand to the forward scattering of light travelling along −dir.
@@ -20,7 +18,7 @@ void add_crossing(ForwardScattering &forward, const Scene &scene, const StrandCr
     if (c.material < scene.materials().size())
         if (const auto *hair = std::get_if<HairMaterial>(&scene.materials()[c.material]))
             if (hair->dual) dual = hair->dual.get();
-    const double theta = std::asin(clamp_unit(dot(dir, c.tangent)));
+    const double theta = safe_asin(dot(dir, c.tangent));
     forward.attenuation *= dual->crossing_attenuation(theta);
     forward.spread_variance += dual->forward_spread_variance(theta, 1);
     ++forward.strands;
@@ -98,7 +96,7 @@ int nearest_strand_index(const MultipleTable &table, int strands) {
 MultipleTableSample sample_multiple_table(const MultipleTable &table, int strand,
                                           const FiberFrame &frame, Vec3 wo_local, float u0,
                                           float u1, float u2) {
-    const float theta_o = std::asin(clamp_unit(wo_local.x));
+    const float theta_o = safe_asin(wo_local.x);
     const TableSample s = table.sample(strand, theta_o, u0, u1, u2);
     if (!(s.pdf > 0.0f)) return {};
     // The view's azimuth in the fiber frame (Cycles' frame: φ_o = −π/2).
@@ -112,7 +110,7 @@ MultipleTableSample sample_multiple_table(const MultipleTable &table, int strand
 
 float multiple_table_pdf(const MultipleTable &table, int strand, const FiberFrame &frame,
                          Vec3 wo_local, Vec3 wi) {
-    const float theta_o = std::asin(clamp_unit(wo_local.x));
+    const float theta_o = safe_asin(wo_local.x);
     return table.pdf_sin(strand, theta_o, clamp_unit(frame.to_local(wi).x));
 }
 
@@ -123,7 +121,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
     const MultipleTable &table = *v.material->multiple;
     const LightSet &lights = scene.lights();
     const Vec3 wo_local = v.frame.to_local(v.wo);
-    const float theta_o = std::asin(clamp_unit(wo_local.x));
+    const float theta_o = safe_asin(wo_local.x);
     Rgb out;
 
     // The n_h probe: strands towards an independently drawn light point.
@@ -166,8 +164,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
             }
             if (!mesh) {
                 const Vec3 l = v.frame.to_local(ls->wi);
-                const float sin_i = clamp_unit(l.x);
-                const float theta_i = std::asin(sin_i);
+                const float theta_i = safe_asin(l.x);
                 const ForwardScattering forward =
                     gather_forward_scattering(scene, crossings->data(), crossings->size(), ls->wi, dual);
                 Rgb sum;
@@ -201,7 +198,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         ++work.rays;
         // Past the first bounces_left + 1 strands nothing reaches x within the limit.
         const bool over = v.bounces_left >= 0 && work.table.size() > std::size_t(v.bounces_left);
-        const float theta_i = std::asin(clamp_unit(s.sin_theta_i));
+        const float theta_i = safe_asin(s.sin_theta_i);
         const float t_end = over ? work.table.back().t : mesh ? mesh->t : INFINITY;
         const float inv_pdf = 1.0f / s.pdf;
         // The strands behind along −ω_i, counted once, when light first arrives (work.table
@@ -216,7 +213,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         for (std::size_t k = 0; k <= work.table.size(); ++k) {
             const float t_hi = k < work.table.size() ? work.table[k].t : t_end;
             const Rgb lamps = lights.lamps_along_ray(origin, wi, t_lo, t_hi, s.pdf, true, sp.position);
-            if (!is_black(lamps))
+            if (!lamps.is_black())
                 out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth(forward.strands),
                                            v.bounces_left) *
                        lamps * inv_pdf;
@@ -229,7 +226,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         } else if (!over && mesh->prim.geometry != PrimRef::kNone) {
             const SurfacePoint hit = scene.surface_point(origin, wi, *mesh);
             const Rgb emission = material_emission(scene.materials()[hit.material]);
-            if (!is_black(emission)) {
+            if (!emission.is_black()) {
                 const float w = hit.is_light
                                     ? power_heuristic(s.pdf, lights.emissive_triangle_pdf(
                                                                  mesh->t, std::fabs(dot(hit.normal, wi))))
@@ -237,7 +234,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                 arriving = emission * w;
             }
         }
-        if (!is_black(arriving))
+        if (!arriving.is_black())
             out += dual_multiple_f_cos(dual, theta_i, theta_o, forward, sample_depth(forward.strands),
                                        v.bounces_left) *
                    arriving * inv_pdf;

@@ -12,8 +12,6 @@ constexpr float kPiF = float(kPi);
 
 bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
-
 Status check_color(const std::string &name, Rgb c) {
     for (int i = 0; i < 3; ++i)
         if (auto e = check::non_negative((name + " colour").c_str(), c[i])) return e;
@@ -235,7 +233,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
             return Error{name + ": angle must be in [0, pi) radians (got " +
                          std::to_string(s.angle) + ")"};
         if (auto e = check_version(name, s.cycles, true)) return *e;
-        if (s.strength == 0.0f || is_black(s.color)) continue;
+        if (s.strength == 0.0f || s.color.is_black()) continue;
         Lamp lamp;
         lamp.type = LampType::Sun;
         lamp.cycles = s.cycles;
@@ -262,7 +260,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
         if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
         if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
-        if (p.power == 0.0f || is_black(p.color)) continue;
+        if (p.power == 0.0f || p.color.is_black()) continue;
         Lamp lamp;
         lamp.type = LampType::Point;
         lamp.cycles = p.cycles;
@@ -300,7 +298,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         if (p.cycles == CyclesVersion::V4_5 && !invert_linear(p.light_to_world, lamp.world_to_light))
             return Error{name + ": light_to_world is singular (Cycles 4.5 shapes the cone in the "
                                 "light's own frame)"};
-        if (p.power == 0.0f || is_black(p.color)) continue;
+        if (p.power == 0.0f || p.color.is_black()) continue;
         lamp.position = p.light_to_world.column(3);
         lamp.direction = safe_normalize(-z);
         lamp.radius = p.radius;
@@ -331,7 +329,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         const Vec3 z = a.light_to_world.column(2);
         if (!(length(z) > 0.0f))
             return Error{name + ": light_to_world has a zero Z axis (no emitting direction)"};
-        if (a.power == 0.0f || is_black(a.color)) continue;
+        if (a.power == 0.0f || a.color.is_black()) continue;
         const float area = cycles_light::area_light_area(a);
         if (!(area > 0.0f) || !std::isfinite(area)) {
             if (warnings)
@@ -382,7 +380,7 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
     double total = 0;
     for (const EmissiveTriangle &t : emissive) {
         const float area = 0.5f * length(cross(t.p1 - t.p0, t.p2 - t.p0));
-        if (!(area > 0.0f) || is_black(t.radiance)) continue;
+        if (!(area > 0.0f) || t.radiance.is_black()) continue;
         set.triangles_.push_back(t);
         total += area;
         set.triangle_cdf_.push_back(float(total));
@@ -496,7 +494,7 @@ std::optional<LightSample> LightSet::sample_lamp(const Lamp &lamp, Vec3 p, float
         case LampType::Spot: return sample_point_like(lamp, p, u0, u1, pick);
         case LampType::Environment: {
             const EnvironmentSample e = environment_->sample(u0, u1);
-            if (!(e.pdf > 0.0f) || is_black(e.radiance)) return std::nullopt;
+            if (!(e.pdf > 0.0f) || e.radiance.is_black()) return std::nullopt;
             s.wi = e.wi;
             s.distance = INFINITY;
             s.value = e.radiance;
@@ -623,7 +621,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
         s.distance = std::sqrt(d2);
         s.wi = -to_p / s.distance;
         s.value = point_like_value(lamp, p, s.wi) / d2;
-        if (is_black(s.value)) return std::nullopt;
+        if (s.value.is_black()) return std::nullopt;
         s.pdf = pick;
         s.delta = true;
         return s;
@@ -646,7 +644,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
         s.distance = d2 > r2 ? d * cos_theta - disc : d * cos_theta + disc;
         if (!(s.distance > 0.0f)) return std::nullopt;
         s.value = point_like_value(lamp, p, s.wi);
-        if (is_black(s.value)) return std::nullopt;
+        if (s.value.is_black()) return std::nullopt;
         s.pdf = pick * sphere_pdf(d2, r2);
         return s;
     }
@@ -663,7 +661,7 @@ std::optional<LightSample> LightSet::sample_point_like(const Lamp &lamp, Vec3 p,
     if (!(cos_light > 0.0f)) return std::nullopt;
     s.distance = t;
     s.value = point_like_value(lamp, p, s.wi);
-    if (is_black(s.value)) return std::nullopt;
+    if (s.value.is_black()) return std::nullopt;
     s.pdf = pick * lamp.invarea * t * t / cos_light;
     return s;
 }
@@ -722,7 +720,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
                 const float t = d2 > r2 ? b - half_chord : b + half_chord;
                 if (!(t > tmin && t < tmax)) continue;
                 const Rgb value = point_like_value(lamp, origin, dir);
-                if (!is_black(value)) visit(value, picks(lamp) * sphere_pdf(d2, r2));
+                if (!value.is_black()) visit(value, picks(lamp) * sphere_pdf(d2, r2));
                 continue;
             }
             const Vec3 n = safe_normalize(to_origin);
@@ -733,7 +731,7 @@ void LightSet::visit_lamps_along_ray(Vec3 origin, Vec3 dir, float tmin, float tm
             const Vec3 q = origin + dir * t - lamp.position;
             if (dot(q, q) > lamp.radius * lamp.radius) continue;
             const Rgb value = point_like_value(lamp, origin, dir);
-            if (!is_black(value)) visit(value, picks(lamp) * lamp.invarea * t * t / -denom);
+            if (!value.is_black()) visit(value, picks(lamp) * lamp.invarea * t * t / -denom);
         } else if (lamp.type == LampType::Area) {
             const float denom = dot(dir, lamp.direction);
             if (!(denom < 0.0f)) continue;  // one-sided
@@ -793,7 +791,7 @@ Rgb LightSet::escaped(Vec3 origin, Vec3 dir, float bsdf_pdf, bool use_mis, bool 
     if (!include_world) return sum;
     if (!environment_) return sum + world_;  // a constant world is never light-sampled
     const Rgb radiance = environment_->eval(dir);
-    if (is_black(radiance)) return sum;
+    if (radiance.is_black()) return sum;
     const float w = use_mis && environment_sampled_
                         ? power_heuristic(bsdf_pdf, world_pdf(origin, dir))
                         : 1.0f;

@@ -22,54 +22,14 @@
 #include "core/rng.h"
 #include "core/scratch.h"
 #include "render/dual_scattering_integrator.h"
+#include "render/sample_dims.h"
 #include "fiber/huang.h"
 
 namespace hairis {
 
 namespace {
 
-// Random-number dimensions: 2 for the pixel jitter, then a fixed block per path vertex.
-constexpr std::uint32_t kDimJitterU = 0, kDimJitterV = 1;
-constexpr std::uint32_t kDimFirstVertex = 2;
-// SobolSampleRng stratifies dimensions 2k and 2k + 1 together, so the layout keeps the pairs
-// that belong together: jitter (0, 1), light position (4, 5), BSDF φ and θ (6, 7) per vertex.
-constexpr std::uint32_t kDimsPerVertex = 8;
-enum VertexDim : std::uint32_t {
-    kDimRoulette = 0,
-    kDimLightSelect = 1,
-    kDimLightU = 2,
-    kDimLightV = 3,
-    kDimBsdf0 = 4,
-    kDimBsdf1 = 5,
-    kDimBsdf2 = 6,
-};
-
-constexpr std::uint32_t dim(int depth, VertexDim d) {
-    return kDimFirstVertex + std::uint32_t(depth) * kDimsPerVertex + std::uint32_t(d);
-}
-
-// Dual scattering's extra numbers per vertex, in a block of their own far above the path's
-// (paths stop at depth 1025), so that integrator=path draws what it always drew. Pairs: probe
-// point (0, 1), table θ_i and φ (2, 3), probe light and table node (4, 5).
-constexpr std::uint32_t kDimDualFirst = 1u << 24;
-DualRandom dual_random(const SobolSampleRng &rng, int depth) {
-    const std::uint32_t b = kDimDualFirst + std::uint32_t(depth) * kDimsPerVertex;
-    DualRandom u;
-    u.light_select = rng.get(dim(depth, kDimLightSelect));
-    u.light_u = rng.get(dim(depth, kDimLightU));
-    u.light_v = rng.get(dim(depth, kDimLightV));
-    u.probe_u = rng.get(b + 0);
-    u.probe_v = rng.get(b + 1);
-    u.table_u0 = rng.get(b + 2);
-    u.table_u1 = rng.get(b + 3);
-    u.probe_select = rng.get(b + 4);
-    u.table_u2 = rng.get(b + 5);
-    return u;
-}
-
 bool finite(Rgb c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b); }
-bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
-
 struct Counters {
     std::uint64_t rays = 0, shadow_rays = 0, dropped = 0;
     DualWork dual;
@@ -200,11 +160,6 @@ class Bsdf {
     SurfaceBsdf surface_;
 };
 
-// The seed of the random numbers of the point at vertex `depth` of a path (Huang's eval).
-std::uint32_t vertex_seed(const SampleRng &key, int depth) {
-    return std::uint32_t(mix64(key.key() ^ (std::uint64_t(depth + 1) * 0xd1b54a32d192ed03ull)) >> 32);
-}
-
 // One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
 Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                std::uint64_t sample, float &alpha, Counters &counters, ScratchBuffer &scratch) {
@@ -266,11 +221,11 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             if (hit && hit->prim.geometry == PrimRef::kNone) hit.reset();  // untraceable: as intersect()
             if (!strands.empty()) {
                 const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, strands[0].t, bsdf_pdf, use_mis, from);
-                if (!is_black(lamps)) add(beta * lamps);
+                if (!lamps.is_black()) add(beta * lamps);
                 if (!hit) break;
                 const ForwardScattering forward =
                     gather_forward_scattering(scene, strands.data(), strands.size(), dir, *dual_from.dual);
-                const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+                const float theta_i = theta_of(dual_from.frame, dir);
                 // The mesh is a vertex of its own, after the strands: it must be one the path
                 // tracer would shade.
                 const int budget = bounces_after(dual_from.bounces_left, 1);
@@ -278,7 +233,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
                     dual_from.depth.depth(scene, forward.strands, budget, counters.dual.behind, counters.shadow_rays);
                 const Rgb m = dual_multiple_f_cos(*dual_from.dual, theta_i, dual_from.theta_o, forward, behind, budget);
                 beta = dual_from.beta * m / bsdf_pdf;
-                if (is_black(beta) || !finite(beta)) break;
+                if (beta.is_black() || !finite(beta)) break;
                 through_hair = true;
                 // The mesh's own bounces count the strands crossed, as the path tracer's would.
                 if (dual_from.bounces_left >= 0) {
@@ -297,14 +252,14 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         // Lamps are transparent: every one crossed before the surface contributes.
         if (!through_hair) {
             const Rgb lamps = lights.lamps_along_ray(origin, dir, tmin, t_end, bsdf_pdf, use_mis, from);
-            if (!is_black(lamps)) add(beta * lamps);
+            if (!lamps.is_black()) add(beta * lamps);
         }
 
         if (!hit) {
             const bool transparent = depth == 0 && settings.film_transparent;
             if (transparent) alpha = 0.0f;
             const Rgb escaped = lights.escaped(from, dir, bsdf_pdf, use_mis, !transparent);
-            if (!is_black(escaped)) add(beta * escaped);
+            if (!escaped.is_black()) add(beta * escaped);
             break;
         }
 
@@ -314,7 +269,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         const Vec3 wo = -dir;
 
         // Surface emission (mesh triangles are light-sampled, curves are not).
-        if (const Rgb emission = material_emission(material); !is_black(emission) && !through_hair) {
+        if (const Rgb emission = material_emission(material); !emission.is_black() && !through_hair) {
             float w = 1.0f;
             if (use_mis && sp.is_light) {
                 const float abs_cos = std::fabs(dot(sp.normal, dir));
@@ -361,7 +316,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             const int budget = bounces_after(dual_from.bounces_left, 1);
             StrandsBehind behind_mesh{dual_from.behind_origin, -dir, dual_from.self, strands_behind_cap(budget)};
             const int behind = behind_mesh.depth(scene, 0, budget, counters.dual.behind, counters.rays);
-            const float theta_i = std::asin(std::clamp(dual_from.frame.to_local(dir).x, -1.0f, 1.0f));
+            const float theta_i = theta_of(dual_from.frame, dir);
             const Rgb m = dual_from.dual->local_f_cos(theta_i, dual_from.theta_o, behind);
             beta += dual_from.beta * m / bsdf_pdf;
             if (!finite(beta)) break;
@@ -404,7 +359,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             if (ls && ls->pdf > 0.0f) {
                 float pdf_bsdf = 0.0f;
                 const Rgb f = bsdf.eval(ls->wi, pdf_bsdf);
-                if (!is_black(f)) {
+                if (!f.is_black()) {
                     const float shadow_tmax =
                         std::isinf(ls->distance) ? INFINITY : ls->distance * (1.0f - 1e-5f);
                     ++counters.shadow_rays;
@@ -434,7 +389,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             const Vec3 wo_local = bsdf.frame().to_local(wo);
             float pdf_bsdf = 0.0f, pdf_table = 0.0f;
             Rgb f_cos;
-            if (rng.get(kDimDualFirst + std::uint32_t(depth) * kDimsPerVertex + 6) < kDualMixture) {
+            if (rng.get(dual_dim(depth, kDimDualMixture)) < kDualMixture) {
                 if (!bsdf.sample(u0, u1, u2, wi, weight, pdf_bsdf, glossy)) break;
                 f_cos = weight * pdf_bsdf;
                 pdf_table = multiple_table_pdf(table, strand, bsdf.frame(), wo_local, wi);
@@ -455,7 +410,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
         dual_from.dual = dual_vertex ? hair->dual.get() : nullptr;
         if (dual_vertex) {
             dual_from.frame = bsdf.frame();
-            dual_from.theta_o = std::asin(std::clamp(bsdf.frame().to_local(wo).x, -1.0f, 1.0f));
+            dual_from.theta_o = theta_of(bsdf.frame(), wo);
             dual_from.depth = counters.dual.last_depth;
             dual_from.beta = beta;
             dual_from.behind_origin = sp.spawn_point(-wi);
@@ -474,7 +429,7 @@ Rgb trace_path(const Scene &scene, const RenderSettings &settings, int x, int y,
             break;
         }
         // A layer's continuation may carry the multiple term where f_s is 0: it decides there.
-        if (is_black(beta) && !(dual_vertex && dual_layer)) break;
+        if (beta.is_black() && !(dual_vertex && dual_layer)) break;
         origin = sp.spawn_point(wi);
         from = sp.position;
         dir = wi;

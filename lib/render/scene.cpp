@@ -120,7 +120,6 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
 }
 
 bool finite3(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool is_black(Rgb c) { return c.r == 0.0f && c.g == 0.0f && c.b == 0.0f; }
 bool is_hair(const Material &m) { return std::holds_alternative<HairMaterial>(m); }
 
 std::string describe(Vec3 v) {
@@ -459,7 +458,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             const Rgb emission = material_emission(desc.materials[m]);
             geo.indices.insert(geo.indices.end(), {i0, i1, i2});
             geo.materials.push_back(m);
-            geo.emissive.push_back(is_black(emission) ? 0 : 1);
+            geo.emissive.push_back(emission.is_black() ? 0 : 1);
             if (!tm.normals.empty())
                 for (int k = 0; k < 3; ++k) geo.normals.push_back(safe_normalize(tm.normals[3 * t + k]));
             if (!tm.uvs.empty()) geo.uvs.insert(geo.uvs.end(), &tm.uvs[6 * t], &tm.uvs[6 * t] + 6);
