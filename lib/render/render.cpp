@@ -21,6 +21,7 @@
 #include "core/frame.h"
 #include "core/rng.h"
 #include "core/scratch.h"
+#include "render/bsdf.h"
 #include "render/dual_scattering_integrator.h"
 #include "render/sample_dims.h"
 #include "fiber/huang.h"
@@ -33,131 +34,6 @@ bool finite(Rgb c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isf
 struct Counters {
     std::uint64_t rays = 0, shadow_rays = 0, dropped = 0;
     DualWork dual;
-};
-
-// What a hair BSDF needs besides the hit point: whether the ray is a camera ray (Cycles'
-// PATH_RAY_CAMERA, kept through transparent crossings), its footprint there, and the seed of
-// the point's random numbers.
-struct HitContext {
-    bool camera_ray = false;
-    float footprint = 0;
-    std::uint32_t seed = 0;
-    bool cycles_huang = false;  // RenderSettings::huang_sampling == Cycles
-};
-
-// Cycles turns Ng, N and dP/du towards ω_o at a back-facing hit (shader_setup_from_ray; on a
-// curve, the inside of the tube seen through its open end): the hair frame follows −tangent.
-bool back_facing(const SurfacePoint &sp, Vec3 wo) { return dot(sp.normal, wo) < 0.0f; }
-
-FiberFrame hair_frame(const SurfacePoint &sp, Vec3 wo) {
-    return FiberFrame::from_tangent_and_view(back_facing(sp, wo) ? -sp.tangent : sp.tangent, wo);
-}
-
-// `frame`: hair_frame(sp, wo). `oriented`: fill the fields only models that read_orientation()
-// use (Huang).
-FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context,
-                   bool oriented = true) {
-    FiberHit hit;
-    hit.wo = frame.to_local(wo);
-    const bool back = back_facing(sp, wo);
-    const Vec3 ng = back ? -sp.normal : sp.normal, tangent = back ? -sp.tangent : sp.tangent;
-    hit.h = std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
-    if (!oriented) return hit;
-    // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
-    const Vec3 axis = HuangFiber::major_axis(tangent, sp.curve_normal);
-    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(tangent));
-    hit.pixel_coverage = context.camera_ray ? cycles_pixel_coverage(context.footprint, sp.curve_radius) : 1.0f;
-    hit.seed = context.seed;
-    return hit;
-}
-
-// A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
-// Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`; surfaces build their
-// lobes (surface_material.h) with both normals on ω_o's side, as Cycles flips them for back
-// faces.
-class Bsdf {
-  public:
-    // `inputs`: the hit's per-strand node inputs (hair), null for the material's own.
-    Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
-         const HairInputValues *inputs, ScratchBuffer &scratch) {
-        if (const auto *hair = std::get_if<HairMaterial>(&material)) {
-            frame_ = hair_frame(sp, wo);
-            const ShadingModel *model = hair->shading.model();
-            FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
-            hit.inputs = inputs;
-            const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
-            if (huang) {
-                huang_ = &scratch.make<HuangPoint>(*huang, hit);
-                lcg_.state = hit.seed ^ 0x9e3779b9u;
-            } else {
-                hair_.emplace(hair->shading.at(hit, scratch));
-            }
-            return;
-        }
-        const bool back = back_facing(sp, wo);
-        const Vec3 ng = back ? -sp.normal : sp.normal;
-        if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
-            const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
-            surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, context.camera_ray});
-        } else {
-            const auto &d = std::get<DiffuseMaterial>(material);
-            surface_ = SurfaceBsdf(ng, ng, wo);
-            SurfaceLobe lambert;
-            lambert.kind = SurfaceLobeKind::Lambert;
-            lambert.weight = d.albedo;
-            lambert.select = 1.0f;
-            surface_.add(lambert);
-        }
-    }
-
-    bool black() const { return !is_hair() && surface_.black(); }
-    bool is_hair() const { return hair_.has_value() || huang_; }
-    // The ray passes without scattering (Huang outside its ellipse).
-    bool transparent() const { return (hair_ && hair_->transparent()) || (huang_ && huang_->transparent()); }
-    const HairBsdf *hair() const { return hair_ ? &*hair_ : nullptr; }
-    const FiberFrame &frame() const { return frame_; }
-
-    // f·|cos θ_i| and the density with which sample() draws wi (Cycles' Huang: its eval and
-    // pdf 1, what Cycles' MIS weighs with).
-    Rgb eval(Vec3 wi, float &pdf) const {
-        if (huang_) {
-            pdf = 1.0f;
-            return huang_->f(frame_.to_local(wi));
-        }
-        if (hair_) return hair_->f_and_pdf(frame_.to_local(wi), pdf);
-        return surface_.eval(wi, pdf);
-    }
-
-    // Draws wi; returns false when there is none. weight = f·|cos|/pdf (Cycles' Huang: its
-    // sampler's weight, with pdf 1).
-    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
-                bool &glossy) const {
-        glossy = false;
-        if (huang_) {
-            const std::optional<HuangCyclesSample> s = huang_->sample_cycles(u0, u1, u2, lcg_);
-            if (!s) return false;
-            wi = safe_normalize(frame_.to_world(s->wi));
-            pdf = 1.0f;
-            weight = s->weight;
-            return dot(wi, wi) > 0.0f;
-        }
-        if (hair_) {
-            const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
-            if (!s || !(s->pdf > 0.0f)) return false;
-            wi = safe_normalize(frame_.to_world(s->wi));
-            pdf = s->pdf;
-            weight = s->f / pdf;
-            return dot(wi, wi) > 0.0f;
-        }
-        return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy);
-    }
-
-  private:
-    std::optional<HairBsdf> hair_;
-    const HuangPoint *huang_ = nullptr;  // Cycles' Huang sampling
-    mutable CyclesLcg lcg_;              // its sampler's numbers beyond the path's three
-    FiberFrame frame_;
-    SurfaceBsdf surface_;
 };
 
 // One camera sample's path. Returns the radiance; alpha receives the sample's coverage.
@@ -482,39 +358,6 @@ struct Tile {
 };
 
 }  // namespace
-
-int transparent_crossings(TransparentLimit limit, int setting) {
-    return limit == TransparentLimit::Setting ? std::max(setting, 1) : setting + 1;
-}
-
-float cycles_pixel_coverage(float footprint, float curve_radius) {
-    return curve_radius > 0.0f ? 0.5f * footprint / curve_radius : INFINITY;
-}
-
-FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
-                          std::uint32_t seed) {
-    return fiber_hit(sp, wo, hair_frame(sp, wo),
-                     HitContext{camera_ray, footprint, seed});
-}
-
-std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v) {
-    const CameraRay cr = scene.camera().generate_ray(x, y, u, v);
-    float tmin = cr.tmin;
-    PrimRef skip;
-    ScratchBuffer scratch;
-    for (;;) {
-        const std::optional<Hit> hit = scene.intersect(cr.origin, cr.direction, tmin, cr.tmax, skip);
-        if (!hit) return std::nullopt;
-        const SurfacePoint sp = scene.surface_point(cr.origin, cr.direction, *hit);
-        const auto *hair = std::get_if<HairMaterial>(&scene.materials()[sp.material]);
-        if (!hair) return std::nullopt;
-        const FiberHit fh = cycles_fiber_hit(sp, -cr.direction, true, cr.footprint_at(hit->t), 0);
-        scratch.reset();
-        if (!hair->shading.at(fh, scratch).transparent()) return fh;
-        tmin = hit->t;
-        skip = sp.self;
-    }
-}
 
 Rgb render_sample(const Scene &scene, const RenderSettings &settings, int x, int y,
                   std::uint64_t sample, float *alpha) {

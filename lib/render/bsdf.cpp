@@ -1,0 +1,106 @@
+#include "render/bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+namespace hairis {
+
+float cycles_pixel_coverage(float footprint, float curve_radius) {
+    return curve_radius > 0.0f ? 0.5f * footprint / curve_radius : INFINITY;
+}
+
+FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context,
+                   bool oriented) {
+    FiberHit hit;
+    hit.wo = frame.to_local(wo);
+    const bool back = back_facing(sp, wo);
+    const Vec3 ng = back ? -sp.normal : sp.normal, tangent = back ? -sp.tangent : sp.tangent;
+    hit.h = std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    if (!oriented) return hit;
+    // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
+    const Vec3 axis = HuangFiber::major_axis(tangent, sp.curve_normal);
+    hit.normal = frame.to_local(dot(axis, axis) > 0.0f ? axis : HuangFiber::fallback_major_axis(tangent));
+    hit.pixel_coverage = context.camera_ray ? cycles_pixel_coverage(context.footprint, sp.curve_radius) : 1.0f;
+    hit.seed = context.seed;
+    return hit;
+}
+
+FiberHit cycles_fiber_hit(const SurfacePoint &sp, Vec3 wo, bool camera_ray, float footprint,
+                          std::uint32_t seed) {
+    return fiber_hit(sp, wo, hair_frame(sp, wo), HitContext{camera_ray, footprint, seed});
+}
+
+std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float u, float v) {
+    const CameraRay cr = scene.camera().generate_ray(x, y, u, v);
+    float tmin = cr.tmin;
+    PrimRef skip;
+    ScratchBuffer scratch;
+    for (;;) {
+        const std::optional<Hit> hit = scene.intersect(cr.origin, cr.direction, tmin, cr.tmax, skip);
+        if (!hit) return std::nullopt;
+        const SurfacePoint sp = scene.surface_point(cr.origin, cr.direction, *hit);
+        const auto *hair = std::get_if<HairMaterial>(&scene.materials()[sp.material]);
+        if (!hair) return std::nullopt;
+        const FiberHit fh = cycles_fiber_hit(sp, -cr.direction, true, cr.footprint_at(hit->t), 0);
+        scratch.reset();
+        if (!hair->shading.at(fh, scratch).transparent()) return fh;
+        tmin = hit->t;
+        skip = sp.self;
+    }
+}
+
+Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
+           const HairInputValues *inputs, ScratchBuffer &scratch) {
+    if (const auto *hair = std::get_if<HairMaterial>(&material)) {
+        frame_ = hair_frame(sp, wo);
+        const ShadingModel *model = hair->shading.model();
+        FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
+        hit.inputs = inputs;
+        const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
+        if (huang) {
+            huang_ = &scratch.make<HuangPoint>(*huang, hit);
+            lcg_.state = hit.seed ^ 0x9e3779b9u;
+        } else {
+            hair_.emplace(hair->shading.at(hit, scratch));
+        }
+        return;
+    }
+    const bool back = back_facing(sp, wo);
+    const Vec3 ng = back ? -sp.normal : sp.normal;
+    if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
+        const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
+        surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, context.camera_ray});
+    } else {
+        const auto &d = std::get<DiffuseMaterial>(material);
+        surface_ = SurfaceBsdf(ng, ng, wo);
+        SurfaceLobe lambert;
+        lambert.kind = SurfaceLobeKind::Lambert;
+        lambert.weight = d.albedo;
+        lambert.select = 1.0f;
+        surface_.add(lambert);
+    }
+}
+
+bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy) const {
+    glossy = false;
+    if (huang_) {
+        const std::optional<HuangCyclesSample> s = huang_->sample_cycles(u0, u1, u2, lcg_);
+        if (!s) return false;
+        wi = safe_normalize(frame_.to_world(s->wi));
+        pdf = 1.0f;
+        weight = s->weight;
+        return dot(wi, wi) > 0.0f;
+    }
+    if (hair_) {
+        const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
+        if (!s || !(s->pdf > 0.0f)) return false;
+        wi = safe_normalize(frame_.to_world(s->wi));
+        pdf = s->pdf;
+        weight = s->f / pdf;
+        return dot(wi, wi) > 0.0f;
+    }
+    return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy);
+}
+
+}  // namespace hairis
