@@ -713,6 +713,41 @@ static void test_fiber_eval(void)
         CHECK(far[0] > 1e-4f, "a direction pair with a visible value (%g)", far[0]);
     }
 
+    /* Which argument is ω_i: Marschner's f is reciprocal (M_R,TT,TRT depend on θ_h and |θ_d|,
+     * N_p on φ and |θ_d|, the eccentric η* on φ_h, all unchanged by swapping ω_i and ω_o), so
+     * eval(ω_i, ω_o) / |cos θ_i| = eval(ω_o, ω_i) / |cos θ_o| where the cosines differ; with
+     * ω_i and ω_o swapped at the ABI the cosine factor is the wrong one and the sides differ by
+     * (cos θ_o / cos θ_i)². */
+    {
+        const float pairs[][4] = {/* θ_i, φ_i, θ_o, φ_o */
+                                  {-0.9f, 2.9f, 0.2f, -1.5707963f},
+                                  {0.1f, -2.8f, -0.4f, 1.0f},
+                                  {-0.35f, 0.4f, 0.95f, -0.6f},
+                                  {0.9f, 3.0f, -1.2f, -0.3f}};
+        enum { P = sizeof pairs / sizeof pairs[0] };
+        float forward_i[3 * P], forward_o[3 * P], forward[3 * P], backward[3 * P];
+        for (int k = 0; k < P; ++k) {
+            direction_from_angles(pairs[k][0], pairs[k][1], forward_i + 3 * k);
+            direction_from_angles(pairs[k][2], pairs[k][3], forward_o + 3 * k);
+        }
+        CHECK(hairis_fiber_eval(marschner, P, forward_i, forward_o, NULL, forward) == HAIRIS_OK,
+              "Marschner forward");
+        CHECK(hairis_fiber_eval(marschner, P, forward_o, forward_i, NULL, backward) == HAIRIS_OK,
+              "Marschner backward");
+        for (int k = 0; k < P; ++k) {
+            const double cos_i = cos(pairs[k][0]), cos_o = cos(pairs[k][2]);
+            for (int c = 0; c < 3; ++c) {
+                const double f_forward = forward[3 * k + c] / cos_i;
+                const double f_backward = backward[3 * k + c] / cos_o;
+                CHECK(f_forward > 1e-4, "pair %d channel %d: a visible value (%g)", k, c,
+                      f_forward);
+                CHECK(fabs(f_forward - f_backward) <= 1e-4 * f_forward,
+                      "pair %d channel %d: eval/cos θ_i %g, swapped eval/cos θ_o %g (ω_i and ω_o "
+                      "taken the other way round?)", k, c, f_forward, f_backward);
+            }
+        }
+    }
+
     /* Refusals: the batch is checked whole before anything is written. */
     CHECK(hairis_fiber_eval(marschner, N, wi, wo, h, rgb) == HAIRIS_ERROR_INVALID_ARGUMENT,
           "no near field for Marschner");
