@@ -1,5 +1,9 @@
 #include "render/dual_scattering_integrator.h"
 
+#include "render/bsdf.h"
+#include "render/path_integrator.h"
+#include "render/sample_dims.h"
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -43,7 +47,7 @@ bool same_ray(const LightSample &a, const LightSample &b) {
 
 }  // namespace
 
-int StrandsBehind::depth(const Scene &scene, int strands, int bounces_left,
+int StrandsBehind::cut(const Scene &scene, int strands, int bounces_left,
                          std::vector<StrandCrossing> &scratch, std::uint64_t &rays) {
     if (!layer) return -1;
     if (backscatter_depth(-1, strands, bounces_left) == 0) return 0;
@@ -143,7 +147,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         return StrandsBehind{sp.spawn_point(-wi), -wi, sp.self, strands_behind_cap(v.bounces_left), v.layer};
     };
     // The continuation's (the caller's): behind the vertex away from the probe's light point.
-    work.last_depth = behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
+    work.strands_behind = behind(probe ? probe->wi : uniform_sphere(u.probe_u, u.probe_v));
     const int strand = nearest_strand_index(table, int(work.probe.size()));
     work.last_strand_index = strand;
     work.last_probe_strands = int(work.probe.size());
@@ -177,9 +181,9 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                 }
                 // The probe's count is this sample's when both drew the same delta light.
                 StrandsBehind along_light = behind(ls->wi);
-                StrandsBehind &light_behind = crossings == &work.probe ? work.last_depth : along_light;
+                StrandsBehind &light_behind = crossings == &work.probe ? work.strands_behind : along_light;
                 const int light_depth =
-                    light_behind.depth(scene, forward.strands, v.bounces_left, work.behind, work.rays);
+                    light_behind.cut(scene, forward.strands, v.bounces_left, work.behind, work.rays);
                 const Rgb m = dual_multiple_f_cos(dual, theta_i, theta_o, forward, light_depth, v.bounces_left);
                 sum += m * (ls->delta ? 1.0f : power_heuristic(ls->pdf, pdf_table));
                 out += sum * ls->value / ls->pdf;
@@ -205,7 +209,7 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
         // stays); later light has crossed more strands, so its cut is no deeper.
         StrandsBehind table_behind = behind(wi);
         auto sample_depth = [&](int strands) {
-            return table_behind.depth(scene, strands, v.bounces_left, work.behind, work.rays);
+            return table_behind.cut(scene, strands, v.bounces_left, work.behind, work.rays);
         };
         // Lamps between crossings see the strands before them.
         ForwardScattering forward;
@@ -240,6 +244,135 @@ Rgb dual_scattering_light(const Scene &scene, const DualVertex &v, const DualRan
                    arriving * inv_pdf;
     }
     return out;
+}
+
+DualScatteringIntegrator::DualScatteringIntegrator(const Scene &scene, const RenderSettings &settings)
+    : scene_(scene),
+      settings_(settings),
+      enabled_(settings.integrator == int(Integrator::DualScattering)),
+      layer_(settings.dual_hair_volume == int(DualHairVolume::Layer)),
+      exact_bounces_(settings.dual_exact_bounces) {}
+
+bool DualScatteringIntegrator::trace_through_hair(PathState &path, const PathRay &ray, std::optional<Hit> &hit,
+                                                  bool &through_hair) {
+    // Light meshes reflect onto the hair vertex through n ≥ 1 strands is the dual estimate's
+    // global term: T_f d_f (f_s^scatter + π d_b f_back^scatter) for the sampled direction, in
+    // place of f_s (lamps, suns and the world beyond hair are M's). Past the strands the
+    // mesh's bounces allow, nothing it reflects counts (hit unset).
+    PathCounters &counters = *path.counters;
+    std::vector<StrandCrossing> &strands = counters.dual.continuation;
+    const int budget = bounces_after(from_.bounces_left, 1);
+    hit = scene_.trace_through_hair_within(ray.origin, ray.dir, ray.tmin, ray.tmax, ray.skip, {}, budget, strands);
+    ++counters.rays;
+    if (hit && hit->prim.geometry == PrimRef::kNone) hit.reset();  // untraceable: as intersect()
+    if (strands.empty()) return true;
+    path.add_reached(scene_.lights().lamps_along_ray(ray.origin, ray.dir, ray.tmin, strands[0].t,
+                                                     path.prev_bsdf_pdf, path.use_mis, ray.from));
+    if (!hit) return false;
+    const ForwardScattering forward =
+        gather_forward_scattering(scene_, strands.data(), strands.size(), ray.dir, *from_.dual);
+    // The mesh is a vertex of its own, after the strands: it must be one the path tracer
+    // would shade.
+    const int behind = from_.strands_behind.cut(scene_, forward.strands, budget, counters.dual.behind,
+                                                counters.shadow_rays);
+    const Rgb m = dual_multiple_f_cos(*from_.dual, theta_of(from_.frame, ray.dir), from_.theta_o, forward,
+                                      behind, budget);
+    path.beta = from_.beta * m / path.prev_bsdf_pdf;
+    if (path.beta.is_black() || !finite(path.beta)) return false;
+    through_hair = true;
+    // The mesh's own bounces count the strands crossed, as the path tracer's would.
+    if (from_.bounces_left >= 0) {
+        const int crossed = int(strands.size());
+        path.vertex += crossed;
+        path.transmission_bounces += crossed;
+        path.last_segment = path.last_segment || path.transmission_bounces > settings_.max_transmission_bounces;
+    }
+    return true;
+}
+
+bool DualScatteringIntegrator::add_mesh_light(PathState &path, Vec3 dir, bool through_hair) {
+    if (!from_.dual || !layer_ || through_hair) return true;
+    // What the mesh reflects also carries the local multiple term over the continuation's
+    // density, Ā_b cut at the strands behind the vertex along this light's travel, −ω_i (the
+    // mesh's emission is f_s's alone: emitters' M is the light and table samples'). The mesh
+    // is a vertex of its own after the strands behind and back: the cut.
+    const int budget = bounces_after(from_.bounces_left, 1);
+    StrandsBehind behind_mesh{from_.behind_origin, -dir, from_.self, strands_behind_cap(budget)};
+    const int behind = behind_mesh.cut(scene_, 0, budget, path.counters->dual.behind, path.counters->rays);
+    const Rgb m = from_.dual->local_f_cos(theta_of(from_.frame, dir), from_.theta_o, behind);
+    path.beta += from_.beta * m / path.prev_bsdf_pdf;
+    return finite(path.beta);
+}
+
+bool DualScatteringIntegrator::closes_path(const Material &material, const Bsdf &bsdf, const PathState &path) {
+    // render() refuses hair without dual-scattering data; render_sample() path-traces it.
+    const auto *hair = enabled_ ? std::get_if<HairMaterial>(&material) : nullptr;
+    const bool closes = hair && hair->dual && hair->multiple && bsdf.hair() && path.vertex >= exact_bounces_;
+    closing_ = closes ? hair : nullptr;
+    // The scattering events the path tracer would still add after the vertex.
+    closing_bounces_left_ = closes && settings_.dual_bounce_limit == int(DualBounceLimit::Bounces)
+                                ? std::max(0, std::min(settings_.max_bounces - path.vertex,
+                                                       settings_.max_transmission_bounces - path.transmission_bounces))
+                                : -1;
+    return closes;
+}
+
+void DualScatteringIntegrator::add_light(PathState &path, const SurfacePoint &sp, const Bsdf &bsdf, Vec3 wo,
+                                         const SobolSampleRng &rng) {
+    DualVertex v;
+    v.point = &sp;
+    v.material = closing_;
+    v.bsdf = bsdf.hair();
+    v.frame = bsdf.frame();
+    v.wo = wo;
+    v.layer = layer_;
+    v.bounces_left = closing_bounces_left_;
+    DualWork &work = path.counters->dual;
+    const std::uint64_t before = work.rays;
+    path.add(path.beta * dual_scattering_light(scene_, v, dual_random(rng, path.vertex), work));
+    path.counters->shadow_rays += work.rays - before;
+}
+
+bool DualScatteringIntegrator::sample_continuation(const PathState &path, const Bsdf &bsdf, Vec3 wo,
+                                                   const SobolSampleRng &rng, float u0, float u1, float u2,
+                                                   Vec3 &wi, Rgb &weight, float &pdf, bool &glossy) const {
+    if (!layer_) return bsdf.sample(u0, u1, u2, wi, weight, pdf, glossy);
+    // A layer's continuation also carries the light meshes send through strands, the multiple
+    // term's: a one-sample mixture of the material's sampler and the vertex's multiple table
+    // (DualVertex::layer; its light samples MIS against the same).
+    const MultipleTable &table = *closing_->multiple;
+    const int strand = path.counters->dual.last_strand_index;
+    const Vec3 wo_local = bsdf.frame().to_local(wo);
+    float sampler_pdf = 0.0f, table_pdf = 0.0f;
+    Rgb f_cos;
+    if (rng.get(dual_dim(path.vertex, kDimDualMixture)) < kDualMixture) {
+        if (!bsdf.sample(u0, u1, u2, wi, weight, sampler_pdf, glossy)) return false;
+        f_cos = weight * sampler_pdf;
+        table_pdf = multiple_table_pdf(table, strand, bsdf.frame(), wo_local, wi);
+    } else {
+        const MultipleTableSample t = sample_multiple_table(table, strand, bsdf.frame(), wo_local, u0, u1, u2);
+        if (!(t.pdf > 0.0f)) return false;
+        wi = t.wi;
+        table_pdf = t.pdf;
+        f_cos = bsdf.eval(wi, sampler_pdf);
+    }
+    pdf = dual_mixture_pdf(sampler_pdf, table_pdf);
+    if (!(pdf > 0.0f)) return false;
+    weight = f_cos / pdf;
+    return true;
+}
+
+void DualScatteringIntegrator::leave(const PathState &path, const SurfacePoint &sp, const Bsdf &bsdf, Vec3 wo,
+                                     Vec3 wi) {
+    from_.dual = closing_ ? closing_->dual.get() : nullptr;
+    if (!closing_) return;
+    from_.frame = bsdf.frame();
+    from_.theta_o = theta_of(bsdf.frame(), wo);
+    from_.strands_behind = path.counters->dual.strands_behind;
+    from_.beta = path.beta;
+    from_.behind_origin = sp.spawn_point(-wi);
+    from_.self = sp.self;
+    from_.bounces_left = closing_bounces_left_;
 }
 
 }  // namespace hairis

@@ -93,15 +93,22 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/frame.h"
 #include "fiber/dual_scattering.h"
+#include "core/rng.h"
+#include "render/render_settings.h"
 #include "render/scene.h"
 #include "sampling/hair_bsdf.h"
 #include "sampling/sampling_table.h"
 
 namespace hairis {
+
+class Bsdf;
+struct PathRay;
+struct PathState;
 
 /// The forward scattering gathered along a ray: strands crossed, Π a(θ_k) and Σ β̄_f²(θ_k)
 /// (T_f without d_f, and σ_f²).
@@ -201,11 +208,12 @@ struct StrandsBehind {
     int cap = kMaxStrandsBehind;  ///< the count stops there (strands_behind_cap)
     bool layer = true;            ///< false: the unbounded series, nothing to count
     int counted = -1;             ///< the count once traced
-    /// backscatter_depth's `depth` for light that crossed `strands` strands with `bounces_left`
-    /// events left: −1 outside a layer, 0 without a ray where those events allow no strand
-    /// behind, else the count (traced into `scratch` the first time, adding 1 to `rays`).
-    int depth(const Scene &scene, int strands, int bounces_left, std::vector<StrandCrossing> &scratch,
-              std::uint64_t &rays);
+    /// Where Ā_b's series stop (backscatter_depth's `depth`) for light that crossed `strands`
+    /// strands with `bounces_left` events left: −1 outside a layer, 0 without a ray where those
+    /// events allow no strand behind, else the count (traced into `scratch` the first time,
+    /// adding 1 to `rays`).
+    int cut(const Scene &scene, int strands, int bounces_left, std::vector<StrandCrossing> &scratch,
+            std::uint64_t &rays);
 };
 
 /// Per-thread buffers and counts of the estimator.
@@ -213,7 +221,7 @@ struct DualWork {
     std::vector<StrandCrossing> light, probe, table, behind, continuation;
     /// The strands behind the last vertex away from its probe's light point (the second probe):
     /// Ā_b's cut for the continuation's global term.
-    StrandsBehind last_depth;
+    StrandsBehind strands_behind;
     std::uint64_t rays = 0;       ///< rays traced (probe, light, table)
     int last_probe_strands = -1;  ///< the strands the last vertex's probe crossed
     int last_strand_index = -1;   ///< the index into the table's n_h values it chose
@@ -231,5 +239,79 @@ inline float dual_mixture_pdf(float pdf_bsdf, float pdf_table) {
 /// caller's). Adds the rays it traces to work.rays.
 Rgb dual_scattering_light(const Scene &scene, const DualVertex &vertex, const DualRandom &u,
                           DualWork &work);
+
+
+/// What a dual vertex leaves for its continuation ray (DualScatteringIntegrator).
+struct DualContinuation {
+    const DualScattering *dual = nullptr;  ///< set while the ray comes from a dual vertex
+    FiberFrame frame;                      ///< the vertex's fiber frame
+    float theta_o = 0;                     ///< its view's θ
+    StrandsBehind strands_behind;          ///< Ā_b's cut for the global term (DualWork::strands_behind)
+    Rgb beta;                              ///< the path's throughput at the vertex
+    Vec3 behind_origin;                    ///< the vertex's spawn point along −ω_i (ω_i: the continuation)
+    PrimRef self;                          ///< the vertex's curve
+    int bounces_left = -1;                 ///< DualVertex::bounces_left
+};
+
+/// integrator=dual_scattering inside one camera sample's path (PathIntegrator::li): which hair
+/// vertex closes the path, that vertex's light estimate and continuation, and what the
+/// continuation reaches (a mesh seen directly, which adds the local multiple term with Layer,
+/// or through strands, whose weight is the global term). With integrator=path every hook does
+/// nothing. The path calls, per vertex:
+///  - traces_through_hair / trace_through_hair: the ray a Layer vertex left lets hair through;
+///  - ends_at: hair that ray reaches ends the path (hair-to-hair light is the estimate's);
+///  - add_mesh_light: the mesh term of light a mesh reflects onto the vertex;
+///  - closes_path: whether this vertex is the dual one, then add_light (in place of
+///    next-event estimation) and sample_continuation (in place of the BSDF sample);
+///  - leave: at every vertex once its continuation is drawn.
+class DualScatteringIntegrator {
+  public:
+    DualScatteringIntegrator(const Scene &scene, const RenderSettings &settings);
+
+    /// Whether a hair vertex at `vertex` may be the dual one (past the exact bounces).
+    bool may_shade(int vertex) const { return enabled_ && vertex >= exact_bounces_; }
+
+    /// Whether the ray comes from a Layer vertex: trace it with trace_through_hair.
+    bool traces_through_hair() const { return from_.dual && layer_; }
+    /// Traces the continuation of a Layer vertex through hair to the first mesh within the
+    /// strands its bounces allow (`hit`, unset past them). Where it crossed strands, it adds the
+    /// lamps before the first one, takes the global term as the path's throughput and counts the
+    /// strands as bounces (`through_hair`). False: the path ends.
+    bool trace_through_hair(PathState &path, const PathRay &ray, std::optional<Hit> &hit,
+                            bool &through_hair);
+
+    /// Whether the hit ends the path: hair reached from a dual vertex.
+    bool ends_at(const SurfacePoint &sp) const { return from_.dual && sp.is_curve; }
+
+    /// A mesh a Layer vertex sees along `dir` with no strand in the way sends it light as a
+    /// lamp does, F = f_s + d_b f_back^direct: adds the local multiple term over the
+    /// continuation's density to the throughput. False: the throughput is not finite.
+    bool add_mesh_light(PathState &path, Vec3 dir, bool through_hair);
+
+    /// Whether the vertex of `material` with `bsdf` closes the path (a hair vertex with
+    /// dual-scattering data past the exact bounces); remembered for the hooks below.
+    bool closes_path(const Material &material, const Bsdf &bsdf, const PathState &path);
+    /// The closing vertex's light by dual scattering (dual_scattering_light), added to the path.
+    void add_light(PathState &path, const SurfacePoint &sp, const Bsdf &bsdf, Vec3 wo,
+                   const SobolSampleRng &rng);
+    /// The closing vertex's continuation from (u0, u1, u2): with Layer a one-sample mixture of
+    /// the material's sampler and the vertex's multiple table (dual_mixture_pdf), otherwise the
+    /// BSDF's sample. As Bsdf::sample.
+    bool sample_continuation(const PathState &path, const Bsdf &bsdf, Vec3 wo, const SobolSampleRng &rng,
+                             float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
+                             bool &glossy) const;
+    /// The path leaves the vertex along `wi`: what its continuation needs, if it closes the path.
+    void leave(const PathState &path, const SurfacePoint &sp, const Bsdf &bsdf, Vec3 wo, Vec3 wi);
+
+  private:
+    const Scene &scene_;
+    const RenderSettings &settings_;
+    bool enabled_;      // integrator=dual_scattering
+    bool layer_;        // DualHairVolume::Layer
+    int exact_bounces_;
+    const HairMaterial *closing_ = nullptr;  // the vertex's material when it closes the path
+    int closing_bounces_left_ = -1;          // its DualVertex::bounces_left
+    DualContinuation from_;
+};
 
 }  // namespace hairis

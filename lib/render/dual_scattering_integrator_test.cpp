@@ -1013,14 +1013,14 @@ TEST(TraceThroughHair, StrandsBehindIsCountedOnceAndOnlyWhenAskedFor) {
         StrandsBehind behind{origin, dir, {}, 5};
         std::uint64_t rays = 0;
         // 4 events left after light through 3 strands: (4 − 3)/2 = 0 strands behind.
-        ASSERT_EQ(behind.depth(scene, 3, 4, scratch, rays), 0) << "ray " << i;
+        ASSERT_EQ(behind.cut(scene, 3, 4, scratch, rays), 0) << "ray " << i;
         ASSERT_EQ(rays, 0u);
-        ASSERT_EQ(behind.depth(scene, 0, -1, scratch, rays), want) << "ray " << i;
+        ASSERT_EQ(behind.cut(scene, 0, -1, scratch, rays), want) << "ray " << i;
         ASSERT_EQ(rays, 1u);
-        ASSERT_EQ(behind.depth(scene, 1, 8, scratch, rays), want);
+        ASSERT_EQ(behind.cut(scene, 1, 8, scratch, rays), want);
         ASSERT_EQ(rays, 1u);
         StrandsBehind unbounded{origin, dir, {}, 5, false};
-        ASSERT_EQ(unbounded.depth(scene, 0, -1, scratch, rays), -1);
+        ASSERT_EQ(unbounded.cut(scene, 0, -1, scratch, rays), -1);
         ASSERT_EQ(rays, 1u);
     }
     EXPECT_GT(counted, 10);  // most rays found strands

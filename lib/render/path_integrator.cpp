@@ -1,0 +1,167 @@
+#include "render/path_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <variant>
+
+#include "core/rng.h"
+#include "render/bsdf.h"
+#include "render/sample_dims.h"
+
+namespace hairis {
+
+PathIntegrator::PathIntegrator(const Scene &scene, const RenderSettings &settings)
+    : scene_(scene),
+      settings_(settings),
+      transparent_crossings_(transparent_crossings(TransparentLimit(settings.transparent_limit),
+                                                   settings.max_transparent_bounces)) {}
+
+Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCounters &counters,
+                       ScratchBuffer &scratch) const {
+    const Camera &camera = scene_.camera();
+    const LightSet &lights = scene_.lights();
+    const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x);
+    // Stratified per pixel (jitter, light and BSDF pairs): hair is thinner than a pixel, and
+    // stratifying where a sample lands in the pixel is what Cycles' Sobol patterns buy it.
+    const SobolSampleRng rng(settings_.seed, pixel, sample);
+    const SampleRng seeds(settings_.seed, pixel, sample);
+
+    const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
+    PathRay ray{cr.origin, cr.direction, cr.origin, cr.tmin, cr.tmax, PrimRef{}};
+    PathState path(counters);
+    DualScatteringIntegrator dual(scene_, settings_);
+    alpha = 1.0f;
+
+    for (;;) {
+        std::optional<Hit> hit;
+        bool through_hair = false;  // a dual continuation that crossed strands to a mesh
+        if (dual.traces_through_hair()) {
+            if (!dual.trace_through_hair(path, ray, hit, through_hair)) break;
+        } else {
+            hit = scene_.intersect(ray.origin, ray.dir, ray.tmin, ray.tmax, ray.skip);
+            ++counters.rays;
+        }
+        const float t_end = hit ? hit->t : ray.tmax;
+
+        // Lamps are transparent: every one crossed before the surface contributes.
+        if (!through_hair)
+            path.add_reached(lights.lamps_along_ray(ray.origin, ray.dir, ray.tmin, t_end, path.prev_bsdf_pdf,
+                                                    path.use_mis, ray.from));
+
+        if (!hit) {
+            const bool transparent = path.vertex == 0 && settings_.film_transparent;
+            if (transparent) alpha = 0.0f;
+            path.add_reached(lights.escaped(ray.from, ray.dir, path.prev_bsdf_pdf, path.use_mis, !transparent));
+            break;
+        }
+
+        const SurfacePoint sp = scene_.surface_point(ray.origin, ray.dir, *hit);
+        if (dual.ends_at(sp)) break;
+        const Material &material = scene_.materials()[sp.material];
+        const Vec3 wo = -ray.dir;
+
+        // Surface emission (mesh triangles are light-sampled, curves are not).
+        if (const Rgb emission = material_emission(material); !emission.is_black() && !through_hair) {
+            float w = 1.0f;
+            if (path.use_mis && sp.is_light) {
+                const float abs_cos = std::fabs(dot(sp.normal, ray.dir));
+                w = power_heuristic(path.prev_bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
+            }
+            path.add(path.beta * emission * w);
+        }
+
+        // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
+        // transparency does not apply either).
+        if (path.vertex > settings_.max_bounces || path.last_segment) break;
+
+        scratch.reset();  // the previous vertex's BSDF is done with
+        HitContext context;
+        context.camera_ray = path.vertex == 0;
+        context.footprint = cr.footprint_at(hit->t);
+        context.seed = vertex_seed(seeds, path.vertex);
+        // A vertex dual scattering may shade needs the strategy's sampler (its MIS needs a
+        // density); the exact bounces before it are path-traced as integrator=path traces them.
+        context.cycles_huang =
+            settings_.huang_sampling == int(HuangSampling::Cycles) && !dual.may_shade(path.vertex);
+        const HairInputValues *inputs = nullptr;
+        if (sp.is_curve) {
+            HairInputValues values;
+            if (scene_.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
+        }
+        const Bsdf bsdf(material, sp, wo, context, inputs, scratch);
+        if (bsdf.transparent()) {
+            // The same ray goes on beyond this curve.
+            path.last_segment = ++path.transparent_bounces >= transparent_crossings_;
+            ray.tmin = hit->t;
+            ray.skip = sp.self;
+            continue;
+        }
+        if (bsdf.black()) break;
+
+        // Light a mesh reflects onto the dual vertex the ray left.
+        if (!dual.add_mesh_light(path, ray.dir, through_hair)) break;
+
+        // Russian roulette.
+        if (path.vertex >= settings_.rr_start_bounce) {
+            const float q = std::min(1.0f, std::sqrt(path.beta.max_component()));
+            if (!(rng.get(dim(path.vertex, kDimRoulette)) < q)) break;
+            path.beta = path.beta / q;
+        }
+
+        // Next-event estimation (the dual-scattering estimate at the vertex that closes the path).
+        const bool closes = dual.closes_path(material, bsdf, path);
+        if (closes) {
+            dual.add_light(path, sp, bsdf, wo, rng);
+        } else if (!lights.empty()) {
+            const auto ls = lights.sample(sp.position, rng.get(dim(path.vertex, kDimLightSelect)),
+                                          rng.get(dim(path.vertex, kDimLightU)),
+                                          rng.get(dim(path.vertex, kDimLightV)));
+            if (ls && ls->pdf > 0.0f) {
+                float light_dir_bsdf_pdf = 0.0f;
+                const Rgb f = bsdf.eval(ls->wi, light_dir_bsdf_pdf);
+                if (!f.is_black()) {
+                    const float shadow_tmax = std::isinf(ls->distance) ? INFINITY : ls->distance * (1.0f - 1e-5f);
+                    ++counters.shadow_rays;
+                    const PrimRef target{ls->skip_geometry, ls->skip_primitive};
+                    if (!scene_.occluded(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax, sp.self, target)) {
+                        const float w = ls->delta ? 1.0f : power_heuristic(ls->pdf, light_dir_bsdf_pdf);
+                        path.add(path.beta * f * ls->value * (w / ls->pdf));
+                    }
+                }
+            }
+        }
+
+        // Continue along a BSDF sample.
+        const float u0 = rng.get(dim(path.vertex, kDimBsdf0)), u1 = rng.get(dim(path.vertex, kDimBsdf1)),
+                    u2 = rng.get(dim(path.vertex, kDimBsdf2));
+        Vec3 wi;
+        Rgb weight;
+        float scatter_pdf = 0.0f;
+        bool glossy = false;
+        if (!(closes ? dual.sample_continuation(path, bsdf, wo, rng, u0, u1, u2, wi, weight, scatter_pdf, glossy)
+                     : bsdf.sample(u0, u1, u2, wi, weight, scatter_pdf, glossy)))
+            break;
+        dual.leave(path, sp, bsdf, wo, wi);
+        if (bsdf.is_hair())
+            path.last_segment = ++path.transmission_bounces > settings_.max_transmission_bounces;
+        else if (glossy)
+            path.last_segment = ++path.glossy_bounces > settings_.max_glossy_bounces;
+        else
+            path.last_segment = ++path.diffuse_bounces > settings_.max_diffuse_bounces;
+        path.beta *= weight;
+        if (!finite(path.beta)) {
+            ++counters.dropped;
+            break;
+        }
+        // A layer's continuation may carry the multiple term where f_s is 0: it decides there.
+        if (path.beta.is_black() && !dual.traces_through_hair()) break;
+        ray = PathRay{sp.spawn_point(wi), wi, sp.position, 0.0f, INFINITY, sp.self};
+        path.prev_bsdf_pdf = scatter_pdf;
+        path.use_mis = true;
+        ++path.vertex;
+    }
+    return path.radiance;
+}
+
+}  // namespace hairis
