@@ -21,6 +21,39 @@ def run(*args, env=None):
     return subprocess.run([BAKE, *args], capture_output=True, text=True, env=full_env, timeout=600)
 
 
+def decode_log_panels(png_path, colormap, count):
+    """The images of a figure of ``count`` side-by-side imshow panels in ``colormap``: per
+    panel (left to right) the colormap position t in [0, 1] at the centre of each cell, as a
+    function ``cells(rows, columns)`` -> array (row 0 at the bottom); and the largest distance
+    of a sampled colour from the colormap. Panels are the wide runs of columns that are
+    mostly non-white (the colour bar is narrow, labels are short)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.image
+    import numpy as np
+    pixels = matplotlib.image.imread(png_path)[:, :, :3].astype(np.float64)
+    inked = pixels.sum(axis=2) < 2.9
+    tall = inked.sum(axis=0) > 0.5 * pixels.shape[0]
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], tall.astype(int), [0]])))
+    runs = [(a, b) for a, b in zip(edges[::2], edges[1::2]) if b - a > 50]
+    assert len(runs) == count, runs
+    lut = matplotlib.colormaps[colormap](np.linspace(0.0, 1.0, 256))[:, :3]
+    panels = []
+    for left, right in runs:
+        rows = np.flatnonzero(inked[:, left:right].mean(axis=1) > 0.9)
+        top, bottom = rows[0], rows[-1] + 1
+        panels.append((left + 1, right - 1, top + 1, bottom - 1))  # inside the spines
+
+    def cells(panel, n_rows, n_columns):
+        left, right, top, bottom = panels[panel]
+        ys = bottom - (np.arange(n_rows) + 0.5) * (bottom - top) / n_rows
+        xs = left + (np.arange(n_columns) + 0.5) * (right - left) / n_columns
+        colours = pixels[ys.astype(int)][:, xs.astype(int)]
+        distance = np.linalg.norm(colours[:, :, None, :] - lut[None, None, :, :], axis=3)
+        return distance.argmin(axis=2) / 255.0, float(distance.min(axis=2).max())
+    return cells
+
+
 class HairisBakeTest(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="hairis_cli_")
@@ -315,6 +348,19 @@ class HairisBakeTest(unittest.TestCase):
         far = np.load(os.path.join(out, "table_far.npy"))
         self.assertEqual(far.shape, (5, 16, 16))
         self.assertTrue((far >= 0).all() and (far > 0).any())
+        # The PNG shows these numbers: each cell's colour, read back through the log colour
+        # scale (six decades below the largest value), is the table's value at that cell, for
+        # the five θ_r nodes left to right, θ_i upwards and φ rightwards.
+        cells = decode_log_panels(os.path.join(out, "table_far.png"), "magma", 5)
+        top = np.log(far.max())
+        low = max(np.log(far[far > 0].min()), top - np.log(1e6))
+        for r in range(5):
+            shown, off_map = cells(r, 16, 16)
+            self.assertLess(off_map, 0.02, "panel %d: a colour not on the colour map" % r)
+            expected = np.clip((np.log(np.maximum(far[r], 1e-300)) - low) / (top - low), 0, 1)
+            worst = np.abs(shown - expected).max()
+            self.assertLess(worst, 2.5 / 255, "θ_r node %d: pixels differ from the table by "
+                            "%.3f of the colour scale" % (r, worst))
         near = np.load(os.path.join(out, "table_near.npy"))
         self.assertEqual(near.shape[1], 4)
         # Each near row is a density over θ_i: it integrates to 1 ...
