@@ -67,6 +67,28 @@ def check_hair_material(material_data, material, overrides=None, fields=HAIR_FIE
             assert actual == float(expected), (name, actual, expected)
 
 
+def check_tilt_convention(hair):
+    """The exported Chiang material evaluates as this Blender's Cycles: 3.4 to 4.1 tilt the
+    cuticle cones on θ_i, 4.2 and later on θ_o, which gives another f wherever θ_o ≠ 0."""
+    expected = "%d.%d" % tuple(bpy.app.version[:2])
+    assert hair.cycles == expected, (hair.cycles, expected)
+    assert abs(hair.offset) > 0.01, hair.offset  # no tilt, no difference to see
+    native = helpers.module("native")
+    lib = native.load_library()
+    options = native.principled_options(hair.as_dict())
+    wi = np.array([[-0.4, 0.9 * math.cos(2.6), 0.9 * math.sin(2.6)]], np.float32)
+    wo = np.array([[0.5, 0.0, -math.sqrt(0.75)]], np.float32)
+    wi /= np.linalg.norm(wi)
+
+    def f(cycles):
+        with lib.fiber(dict(options, cycles=cycles)) as fiber:
+            return fiber.eval(wi, wo)[0]
+    exported = f(options["cycles"])
+    incident, outgoing = f("3.4"), f("4.5")
+    assert np.all(np.abs(incident - outgoing) > 0.01 * outgoing), (incident, outgoing)
+    np.testing.assert_array_equal(exported, incident if helpers.VERSION < (4, 2, 0) else outgoing)
+
+
 def check_strand_random(domain, random, count):
     """Per-curve numbers distributed as Cycles' curve random: uniform in [0, 1] (test_cycles_
     strands checks them against Cycles' own)."""
@@ -135,6 +157,7 @@ def test_particle_hair_viewport():
     # Random Color/Roughness with Random unlinked: Cycles' per-strand random number, per
     # curve; the fiber itself (what tables are baked for) is the middle strand, Random 0.5.
     check_hair_material(material, bpy.data.materials["Hair"], {"random": 0.5})
+    check_tilt_convention(material.hair)
     assert scene.render.engine == "HAIRIS"
     assert set(curves.inputs) == {"random"}, curves.inputs.keys()
     domain, random = curves.inputs["random"]
