@@ -298,6 +298,7 @@ class ChiangFiber final : public FiberModel, public ShadingModel {
     static Expected<ChiangFiber> create(const ChiangParams &params);
 
     std::string name() const override { return "chiang2016"; }
+    const ChiangFiber *as_chiang() const override { return this; }
     int lobe_count() const override { return 4; }
 
     /// The fiber at a hit.

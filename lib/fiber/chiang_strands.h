@@ -37,6 +37,7 @@ class ChiangStrands final : public ShadingModel, public StrandInputReader {
 
     /// The inputs the node's parametrization reads (reads() in hair_inputs.h).
     bool reads_input(HairInput input) const override { return reads(node_.parametrization, input); }
+    const StrandInputReader *strand_inputs() const override { return this; }
     /// The node with its own (unlinked) values.
     const PrincipledHairNode &node() const { return node_; }
     /// The node's own fiber: what the TABLE strategy's tables are baked for.

@@ -10,6 +10,9 @@
 
 namespace hairis {
 
+class ChiangFiber;
+class HuangFiber;
+
 /// Lobe indices shared by both models: p = number of internal path segments.
 enum LobeIndex : int { kLobeR = 0, kLobeTT = 1, kLobeTRT = 2, kLobeResidual = 3 };
 
@@ -81,6 +84,11 @@ class FiberModel {
     /// fiber that fills its curve; Huang's ellipse seen along w (Cycles makes hits outside it
     /// transparent). f is per hit inside that fraction.
     virtual double projected_width(Vec3 /*w*/) const { return 1.0; }
+
+    /// This model as a ChiangFiber, or null (what a bake adds Chiang's near-field table for).
+    virtual const ChiangFiber *as_chiang() const { return nullptr; }
+    /// This model as a HuangFiber, or null (a Huang fiber bakes a Huang table instead).
+    virtual const HuangFiber *as_huang() const { return nullptr; }
 };
 
 }  // namespace hairis

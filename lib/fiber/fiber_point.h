@@ -11,6 +11,8 @@
 namespace hairis {
 
 struct HairInputValues;
+class HuangFiber;
+class StrandInputReader;
 
 /// Where a ray met a fiber, in the fiber frame of frame.h (x = tangent).
 struct FiberHit {
@@ -67,6 +69,10 @@ class ShadingModel {
     /// Whether prepare() reads FiberHit::normal, pixel_coverage and seed (a renderer may leave
     /// them at their defaults otherwise).
     virtual bool reads_orientation() const { return false; }
+    /// This model as a HuangFiber, or null (a renderer may sample Huang with Cycles' own sampler).
+    virtual const HuangFiber *as_huang() const { return nullptr; }
+    /// What the model says about per-strand inputs, or null when it reads none.
+    virtual const StrandInputReader *strand_inputs() const { return nullptr; }
 };
 
 }  // namespace hairis

@@ -213,6 +213,8 @@ class HuangFiber final : public FiberModel, public ShadingModel {
     static Expected<HuangFiber> create(const HuangParams &params, const HuangQuadrature &far_field = {});
 
     std::string name() const override { return "huang2022"; }
+    /// Overrides FiberModel's and ShadingModel's.
+    const HuangFiber *as_huang() const override { return this; }
     /// R, TT, TRT, TRRT+.
     int lobe_count() const override { return 4; }
     /// The far field from ω_o (Huang's frame) with the quadrature given to create().

@@ -57,7 +57,7 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
         const ShadingModel *model = hair->shading.model();
         FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
         hit.inputs = inputs;
-        const auto *huang = context.cycles_huang ? dynamic_cast<const HuangFiber *>(hair->shading.model()) : nullptr;
+        const HuangFiber *huang = context.cycles_huang && model ? model->as_huang() : nullptr;
         if (huang) {
             huang_ = &scratch.make<HuangPoint>(*huang, hit);
             lcg_.state = hit.seed ^ 0x9e3779b9u;

@@ -154,7 +154,8 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
 Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
     if (hc.inputs.empty()) return std::nullopt;
     const auto *hair = std::get_if<HairMaterial>(&material);
-    const auto *strands = hair ? dynamic_cast<const StrandInputReader *>(hair->shading.model()) : nullptr;
+    const ShadingModel *model = hair ? hair->shading.model() : nullptr;
+    const StrandInputReader *strands = model ? model->strand_inputs() : nullptr;
     if (!strands)
         return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
                      " does not vary per strand (it needs a hair material made for curve inputs, e.g. ChiangStrands)"};

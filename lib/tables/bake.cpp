@@ -141,7 +141,7 @@ Expected<TableSet> bake_in_arena(const FiberModel &model,
     }
     // Chiang's near field, whatever the far part's source: what TABLE samples single
     // scattering from for a fiber (near_field_table.h).
-    if (const auto *chiang = dynamic_cast<const ChiangFiber *>(&model)) {
+    if (const ChiangFiber *chiang = model.as_chiang()) {
         Expected<NearFieldTable> near_field = NearFieldTable::create(std::make_shared<const ChiangFiber>(*chiang));
         if (!near_field) return Error{"near-field table: " + near_field.error().message};
         t.near_field = near_field.value().shared_data();
@@ -157,7 +157,7 @@ Expected<TableSet> bake_tables(const FiberModel &model,
                                const std::vector<std::pair<std::string, double>> &parameters,
                                const BakeOptions &options, const ProgressFn &progress) {
     if (Status s = options.validate()) return *s;
-    if (const auto *huang = dynamic_cast<const HuangFiber *>(&model)) {
+    if (const HuangFiber *huang = model.as_huang()) {
         if (canonical_parameters(parameters) != canonical_parameters(huang_parameters(huang->params())))
             return Error{"the parameters \"" + canonical_parameters(parameters) + "\" are not the huang2022 fiber's"};
         return bake_huang_tables(*huang, options, progress);
@@ -166,7 +166,7 @@ Expected<TableSet> bake_tables(const FiberModel &model,
     // the bake rather than by the writer after it.
     const long long far_rows = (long long)options.theta_r_count * options.theta_i_count;
     TableImageSize image{options.phi_count, far_rows};
-    if (dynamic_cast<const ChiangFiber *>(&model)) {
+    if (model.as_chiang()) {
         const NearFieldTableOptions near;
         image.width = std::max<long long>(image.width, near.theta_i_cells + 1);
         image.height += 4ll * near.theta_o_nodes;
