@@ -128,6 +128,9 @@ void add_bake_command(CLI::App &app, int &exit_code) {
     cmd->add_flag("!--no-huang-multiple", b.huang_multiple,
                   "Huang fibers: bake the Huang table alone, without the multiple-scattering part that "
                   "integrator=dual_scattering samples (it takes several seconds)");
+    cmd->add_flag("!--no-huang-f", b.huang_f,
+                  "Huang fibers: bake no f part, so that renders shade with Cycles' noisy eval instead of the "
+                  "baked expectation");
     cmd->add_option("--threads", b.threads, "worker threads, 0 for all cores (the output does not depend on it)")
         ->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--output,-o", flags->output, "the EXR file to write (atomically)")->required();

@@ -41,11 +41,19 @@ int run_inspect(const std::string &path) {
                     "(R cell value of luminance(f cos theta_i))\n",
                     rows - 1, h->phi_o_count(), h->theta_o_count(), h->theta_i_count, h->phi_count);
         int width = h->phi_count, height = rows;
+        if (h->has_f()) {
+            std::printf("  f  rows %d-%d: the same cells (RGB expectation of f cos theta_i of TT, TRT and TRRT+, "
+                        "what renders shade with)\n",
+                        rows, 2 * rows - 1);
+            height += rows;
+        } else {
+            std::printf("  (no f part: renders shade with Cycles' noisy eval; bake without --no-huang-f)\n");
+        }
         if (s.has_multiple()) {
             const int multiple_rows = s.theta_r_count() * s.theta_i_count, bands = int(s.n_h_values.size());
             std::printf("  multiple  rows %d-%d: %d theta_r nodes (%.2f .. %.2f deg) x %d theta_i cells, columns "
                         "n_h =",
-                        rows, rows + multiple_rows - 1, s.theta_r_count(), degrees(s.theta_r_nodes.front()),
+                        height, height + multiple_rows - 1, s.theta_r_count(), degrees(s.theta_r_nodes.front()),
                         degrees(s.theta_r_nodes.back()), s.theta_i_count);
             for (int n : s.n_h_values) std::printf(" %d", n);
             std::printf(" (G multiple-scattering density; integrator=dual_scattering samples it)\n");
@@ -54,12 +62,13 @@ int run_inspect(const std::string &path) {
         } else {
             std::printf("  (no multiple part: integrator=dual_scattering needs a bake without --no-huang-multiple)\n");
         }
-        std::printf("cells:           %zu\n", h->values.size() + s.multiple.size());
+        std::printf("cells:           %zu\n", h->values.size() + h->f.size() / 3 + s.multiple.size());
         std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", width, height,
                     double(width) * height * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
         std::printf("sampling table:  %.1f MB\n",
                     double(HuangTable::bytes_needed(h->theta_o_count(), h->phi_o_count(), h->theta_i_count,
                                                     h->phi_count)) / 1e6);
+        if (h->has_f()) std::printf("baked f:         %.1f MB\n", double(h->f.size() * sizeof(float)) / 1e6);
         std::printf("valid:           yes (metadata, sizes, values and pixel hash checked)\n");
         return 0;
     }

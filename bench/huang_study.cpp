@@ -9,6 +9,7 @@
 //  6. TABLE weighted with the renderer's f (one Cycles eval, a Monte Carlo estimate).
 //  7. The tails of TABLE's and Cycles' sample weights.
 //  8. The noise of one Cycles eval, lobe by lobe.
+//  9. The baked f (renders' Huang f) against the expectation: error, bake time, memory, speed.
 //
 // The integrand is luminance(f) with f = HuangExpectation (f·cos θ_i, the expectation of
 // Cycles' eval) at the rule (6,4). For samplers with a density the relative variance of
@@ -45,6 +46,7 @@
 #include "fiber/huang.h"
 #include "fiber/principled_hair.h"
 #include "sampling/hair_bsdf.h"
+#include "sampling/huang_f_table.h"
 #include "sampling/huang_table_sampler.h"
 #include "sampling/strategy.h"
 #include "tables/huang_bake.h"
@@ -318,9 +320,17 @@ HairShading shading_of(std::shared_ptr<const HuangFiber> fiber, StrategyKind kin
                        float uniform_weight = kHuangUniformWeight) {
     StrategyInputs in;
     in.huang = fiber;
-    in.huang_table = table;
+    in.huang_table = std::shared_ptr<const HuangSamplingTable>(std::shared_ptr<const HuangSamplingTable>(), table);  // not owned
     in.huang_uniform_weight = uniform_weight;
     return HairShading::create(fiber, make_sampler(kind, in).value()).value();
+}
+
+// TABLE as renders shade with it: the table's sampler weighted with the table's baked f.
+HairShading baked_f_shading(std::shared_ptr<const HuangFiber> fiber, const HuangSamplingTable &table) {
+    StrategyInputs in;
+    in.huang = fiber;
+    in.huang_table = std::make_shared<const HuangSamplingTable>(table);
+    return make_hair_shading(StrategyKind::Table, in, fiber).value();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -582,10 +592,12 @@ void section_renderer_f() {
           "them with one Cycles eval (HuangPoint::f: Simpson nodes in h with one microfacet chain each), a "
           "Monte Carlo estimate whose own variance adds to the sampler's. Relative variance per sample "
           "(Monte Carlo, %d samples per view, each at its own shading point's LCG) of luminance(f)/pdf: "
-          "TABLE with the expectation, TABLE with one eval and with the mean of four, and Cycles' sampler with its own "
-          "weight.\n\n"
+          "TABLE with the expectation, TABLE with one eval and with the mean of four, TABLE with the baked f (what "
+          "renders weight with: R exact, the other lobes interpolated from the table's baked expectation), and Cycles' "
+          "sampler with its own weight.\n\n"
           "| aspect | roughness | view (θ_o, φ_o) | TABLE, expectation f | TABLE, one Cycles eval | TABLE, mean of 4 evals | "
-          "Cycles' sampler | TABLE (one eval) / Cycles |\n|---|---|---|---|---|---|---|---|\n",
+          "TABLE, baked f | Cycles' sampler | TABLE (one eval) / Cycles | TABLE (baked f) / Cycles |\n"
+          "|---|---|---|---|---|---|---|---|---|---|\n",
           quick ? 4000 : 40000);
     for (const FiberCase &c : {FiberCase{0.85f, 0.3f}, FiberCase{0.5f, 0.25f}, FiberCase{0.85f, 0.05f}}) {
         const auto fiber = make_fiber(params_of(c.aspect, c.roughness));
@@ -593,17 +605,19 @@ void section_renderer_f() {
         o.threads = 2;
         const TableStrategy t = bake(*fiber, o);
         const HairShading table = shading_of(fiber, StrategyKind::Table, &t.table);
+        const HairShading baked = baked_f_shading(fiber, t.table);
         for (const ViewAngles &a : {ViewAngles{-35, 40}, ViewAngles{0, 10}, ViewAngles{30, 75}, ViewAngles{65, 40}}) {
             const FiberHit hit = hit_at(a.theta_o, a.phi_o);
             const int n = quick ? 4000 : 40000;
             const double expectation = mc_variance(*fiber, table, hit, n);
             const double one_eval = mc_variance_renderer_f(*fiber, table, hit, n);
             const double four_evals = mc_variance_renderer_f(*fiber, table, hit, n, 4);
+            const double baked_f = mc_variance_renderer_f(*fiber, baked, hit, n);
             const double cycles = cycles_moments(*fiber, hit, n).relative_variance;
-            print("| %.2f | %.2f | (%.0f°, %.0f°) | %s | %s | %s | %s | %s |\n", c.aspect, c.roughness, a.theta_o,
+            print("| %.2f | %.2f | (%.0f°, %.0f°) | %s | %s | %s | %s | %s | %s | %s |\n", c.aspect, c.roughness, a.theta_o,
                   a.phi_o, number(expectation).c_str(), number(one_eval).c_str(), number(four_evals).c_str(),
-                  number(cycles).c_str(),
-                  number(one_eval / cycles).c_str());
+                  number(baked_f).c_str(), number(cycles).c_str(), number(one_eval / cycles).c_str(),
+                  number(baked_f / cycles).c_str());
         }
     }
     print("\n");
@@ -808,10 +822,155 @@ void section_time() {
 
 }  // namespace
 
+// ---------------------------------------------------------------------------------------------
+
+// The baked f against the expectation at a finer rule, over random views and a jittered grid of
+// ω_i: R (analytic in the tabulated fiber) and the interpolated TT + TRT + TRRT+.
+struct BakedFError {
+    double r_max = 0;            // largest |R error| / R's peak in the view
+    double l1 = 0, integral = 0;  // Σ|Δ| / Σ f and Σ f_baked / Σ f − 1 (TT + TRT + TRRT+)
+    double max_relative = 0;     // largest |Δ| / f where f ≥ 5% of the view's peak
+    double p99_relative = 0;     // its 99th percentile
+};
+
+BakedFError baked_f_error(const HuangFiber &fiber, const HairShading &baked, int views, int grid) {
+    HuangQuadrature reference;
+    reference.first_order = 8;
+    reference.second_order = 6;
+    std::mt19937_64 rng(99);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    struct View {
+        FiberHit hit;
+        std::vector<Vec3> wi;
+    };
+    std::vector<View> all(static_cast<size_t>(views));
+    for (View &v : all) {
+        v.hit = hit_at(std::asin(2 * u(rng) - 1) * 180 / kPi, 360 * (u(rng) - 0.5));
+        for (int i = 0; i < grid; ++i)
+            for (int j = 0; j < 2 * grid; ++j)
+                v.wi.push_back(direction_of(float(std::asin(-1 + 2 * (i + u(rng)) / grid)),
+                                            float(-kPi + kPi * (j + u(rng)) / grid)));
+    }
+    struct Sums {
+        double r_max = 0, abs = 0, ref = 0, tab = 0;
+        std::vector<double> relative;
+    };
+    std::vector<Sums> sums(all.size());
+    tbb::parallel_for(0, views, [&](int k) {
+        const View &v = all[size_t(k)];
+        ScratchBuffer scratch;
+        const HuangPoint point = fiber.at(v.hit);
+        const HuangExpectation e = fiber.expectation(point.huang_hit(), reference);
+        const HairBsdf bsdf = baked.at(v.hit, scratch);
+        std::vector<double> want, got;
+        double r_peak = 0, r_err = 0, peak = 0;
+        for (const Vec3 &wi : v.wi) {
+            const std::array<Rgb, 4> lobes = e.lobes(point.to_huang(wi));
+            const double r_ref = luminance(lobes[0]), r_got = luminance(point.f_reflection(wi));
+            r_peak = std::max(r_peak, r_ref);
+            r_err = std::max(r_err, std::fabs(r_got - r_ref));
+            want.push_back(luminance(lobes[1] + lobes[2] + lobes[3]));
+            got.push_back(luminance(bsdf.f(wi)) - r_got);
+            peak = std::max(peak, want.back());
+        }
+        Sums &out = sums[size_t(k)];
+        out.r_max = r_peak > 0 ? r_err / r_peak : 0;
+        for (size_t n = 0; n < want.size(); ++n) {
+            out.abs += std::fabs(got[n] - want[n]);
+            out.ref += want[n];
+            out.tab += got[n];
+            if (want[n] >= 0.05 * peak && want[n] > 0) out.relative.push_back(std::fabs(got[n] - want[n]) / want[n]);
+        }
+    });
+    BakedFError e;
+    double abs = 0, ref = 0, tab = 0;
+    std::vector<double> relative;
+    for (const Sums &x : sums) {
+        e.r_max = std::max(e.r_max, x.r_max);
+        abs += x.abs;
+        ref += x.ref;
+        tab += x.tab;
+        relative.insert(relative.end(), x.relative.begin(), x.relative.end());
+    }
+    e.l1 = abs / ref;
+    e.integral = tab / ref - 1;
+    std::sort(relative.begin(), relative.end());
+    if (!relative.empty()) {
+        e.max_relative = relative.back();
+        e.p99_relative = relative[size_t(0.99 * double(relative.size() - 1))];
+    }
+    return e;
+}
+
+// Median time of one f evaluation (ns), one thread: the baked f and one Cycles eval at the same
+// random (hit, ω_i) pairs, interleaved pass by pass.
+std::pair<double, double> f_time(const HuangFiber &fiber, const HairShading &baked) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    constexpr int n = 2000;
+    std::vector<FiberHit> hits;
+    std::vector<Vec3> wi;
+    for (int k = 0; k < n; ++k) {
+        hits.push_back(hit_at(180.0 * (u(rng) - 0.5), 360.0 * (u(rng) - 0.5)));
+        wi.push_back(direction_of(float(std::asin(2 * u(rng) - 1)), float(kPi * (2 * u(rng) - 1))));
+    }
+    std::vector<double> t_baked, t_cycles;
+    volatile float sink = 0;
+    ScratchBuffer scratch;
+    for (int pass = 0; pass < 5; ++pass) {
+        // Both include preparing the point at the hit, once per evaluation.
+        auto t0 = std::chrono::steady_clock::now();
+        for (int k = 0; k < n; ++k) {
+            scratch.reset();
+            sink = sink + baked.at(hits[size_t(k)], scratch).f(wi[size_t(k)]).r;
+        }
+        t_baked.push_back(seconds_since(t0) / n * 1e9);
+        t0 = std::chrono::steady_clock::now();
+        for (int k = 0; k < n; ++k) sink = sink + fiber.at(hits[size_t(k)]).f(wi[size_t(k)]).r;
+        t_cycles.push_back(seconds_since(t0) / n * 1e9);
+    }
+    std::sort(t_baked.begin(), t_baked.end());
+    std::sort(t_cycles.begin(), t_cycles.end());
+    return {t_baked[2], t_cycles[2]};
+}
+
+void section_baked_f() {
+    const int views = quick ? 6 : 48, grid = quick ? 16 : 32;
+    print("## 9. The baked f against the expectation\n\n"
+          "Renders shade Huang hair with R exactly (Cycles' R is deterministic) and TT + TRT + TRRT+ interpolated from the "
+          "expectation baked beside the sampling table (the default bake: f part at the rule (%d,%d)). Against the "
+          "expectation at the rule (8,6), over %d random far-field views × a jittered %d × %d grid of ω_i, in luminance: "
+          "R's largest error over its peak; for TT + TRT + TRRT+ the L1 error Σ|Δ|/Σ f (the error light from every "
+          "direction sees), the error of the integral Σ f_baked/Σ f − 1, and the largest and 99th-percentile relative "
+          "error where f is at least 5%% of the view's peak (a narrow lobe's sides). Bake: wall seconds on 2 threads of the "
+          "default Huang bake (sampling and f parts, no multiple part); memory: the sampling table and the f part. Time: "
+          "one f at a hit (preparing the point included), one thread, median of 5 interleaved passes.\n\n"
+          "| aspect | roughness | bake (s) | memory (MB) | R max error | L1 | integral | max relative | 99%% relative | "
+          "baked f (ns) | Cycles eval (ns) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+          HuangBakeOptions{}.f_first_order, HuangBakeOptions{}.f_second_order, views, grid, 2 * grid);
+    const FiberCase cases[] = {{0.85f, 0.3f}, {0.5f, 0.25f}, {1.0f, 0.3f}, {0.85f, 0.1f}, {0.5f, 0.1f},
+                               {1.0f, 0.1f},  {0.85f, 0.8f}, {0.5f, 0.8f}};
+    for (const FiberCase &c : cases) {
+        if (quick && c.roughness == 0.8f) continue;
+        const auto fiber = make_fiber(params_of(c.aspect, c.roughness));
+        HuangBakeOptions o;
+        o.threads = 2;
+        const TableStrategy t = bake(*fiber, o);
+        const HairShading baked = baked_f_shading(fiber, t.table);
+        const BakedFError e = baked_f_error(*fiber, baked, views, grid);
+        const auto [ns_baked, ns_cycles] = f_time(*fiber, baked);
+        const double mb = double(t.table.table->memory_bytes() + t.table.f->memory_bytes()) / 1e6;
+        print("| %.2f | %.2f | %.1f | %.1f | %s | %.2f%% | %+.2f%% | %.0f%% | %.1f%% | %.0f | %.0f |\n", c.aspect,
+              c.roughness, t.bake_seconds, mb, number(e.r_max).c_str(), 100 * e.l1, 100 * e.integral,
+              100 * e.max_relative, 100 * e.p99_relative, ns_baked, ns_cycles);
+    }
+    print("\n");
+}
+
 int main(int argc, char **argv) {
     const std::string folder = argc > 1 ? argv[1] : "";
     quick = argc > 2 && std::string(argv[2]) == "quick";
-    const std::string sections = argc > 3 ? argv[3] : "12345678";
+    const std::string sections = argc > 3 ? argv[3] : "123456789";
     auto run = [&](char section) { return sections.find(section) != std::string::npos; };
     tbb::task_arena arena(2);
     arena.execute([&] {
@@ -832,6 +991,7 @@ int main(int argc, char **argv) {
         if (run('6')) section_renderer_f();
         if (run('7')) section_tails();
         if (run('8')) section_eval_noise();
+        if (run('9')) section_baked_f();
         print("Total study time %.0f s.\n", seconds_since(t0));
     });
     if (!folder.empty()) {

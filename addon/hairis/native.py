@@ -89,6 +89,7 @@ PROTOTYPES = {
     "hairis_sampler_destroy": (_VOID, [c_void_p]),
     "hairis_sample": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F, _F]),
     "hairis_pdf": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F]),
+    "hairis_sampler_eval": (c_int, [c_void_p, c_size_t, _F, _F, _F, _F]),
     # hairis_render.h
     "hairis_scene_create": (c_void_p, []),
     "hairis_scene_destroy": (_VOID, [c_void_p]),

@@ -37,10 +37,9 @@ HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name
     }
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
-    Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
-    if (!made) refuse(code_of(made.error().kind), name + made.error().message);
-    Expected<HairShading> shading = HairShading::create(hair.huang, std::move(made).value());
-    if (!shading) refuse(HAIRIS_ERROR_INTERNAL, name + shading.error().message);
+    // TABLE shades with the table's baked f where the table has one.
+    Expected<HairShading> shading = make_hair_shading(kind, inputs, hair.huang);
+    if (!shading) refuse(code_of(shading.error().kind), name + shading.error().message);
     return std::move(shading).value();
 }
 

@@ -45,11 +45,16 @@ HAIRIS_API hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, cons
             if (!fiber->chiang)
                 invalid("fiber must be a chiang2016 fiber for strategy=analytic (got " + fiber->model_name + ")");
         }
-        if (kind == StrategyKind::Table && fiber && fiber->huang)
-            invalid("fiber: strategy=table for a huang2022 fiber samples its Huang table in the renderer "
-                    "(hairis_scene_add_hair_material); a sampler for it takes strategy=uniform or gaussian");
         if (kind == StrategyKind::Table && !tables)
             refuse(HAIRIS_ERROR_INVALID_TABLE, "tables must not be NULL for strategy=table");
+        if (kind == StrategyKind::Table && fiber && fiber->huang) {
+            // A Huang fiber's table sampler reads its points: it needs the fiber.
+            inputs.huang = fiber->huang;
+            inputs.tables = &tables->sampling;
+            Expected<HairShading> shading = make_hair_shading(kind, inputs, fiber->huang);
+            if (!shading) refuse(code_of(shading.error().kind), "sampler options: " + shading.error().message);
+            return new hairis_sampler{std::move(shading).value()};
+        }
         if (kind == StrategyKind::Analytic || kind == StrategyKind::Table) inputs.chiang = fiber ? fiber->chiang : nullptr;
         if (tables) inputs.tables = &tables->sampling;  // make_sampler copies the shared_ptrs
         Expected<std::shared_ptr<const Sampler>> made = make_sampler(kind, inputs);
@@ -112,6 +117,30 @@ HAIRIS_API int hairis_pdf(const hairis_sampler *sampler, size_t n, const float *
         }
         for_each_item(n, [&](size_t i) {
             pdf_out[i] = bsdf_at(*sampler, wo, h, i).pdf({wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]});
+        });
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API int hairis_sampler_eval(const hairis_sampler *sampler, size_t n, const float *wi,
+                                   const float *wo, const float *h, float *rgb_out) {
+    return guard_status("hairis_sampler_eval", [&] {
+        require(sampler, "sampler");
+        if (!sampler->shading.model())
+            invalid("sampler: it was created without a fiber, so it has no f; create it with a fiber");
+        require_batch_size(n, 3, "n");
+        require_array(wi, n, "wi");
+        require_array(wo, n, "wo");
+        require_array(rgb_out, n, "rgb_out");
+        for (size_t i = 0; i < n; ++i) {
+            require_unit_direction(wi, "wi", i);
+            check_view(wo, h, i);
+        }
+        for_each_item(n, [&](size_t i) {
+            const Rgb f = bsdf_at(*sampler, wo, h, i).f({wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]});
+            rgb_out[3 * i] = f.r;
+            rgb_out[3 * i + 1] = f.g;
+            rgb_out[3 * i + 2] = f.b;
         });
         return HAIRIS_OK;
     });

@@ -26,7 +26,8 @@ hairis_tables *make_tables(TableSet set) {
             {"huang_theta_o", std::to_string(h->theta_o_count())},
             {"huang_phi_o", std::to_string(h->phi_o_count())},
             {"huang_theta_i", std::to_string(h->theta_i_count)},
-            {"huang_phi", std::to_string(h->phi_count)}};
+            {"huang_phi", std::to_string(h->phi_count)},
+            {"huang_f", h->has_f() ? "1" : "0"}};
         if (set.has_multiple()) {  // the multiple part (dual scattering)
             info.push_back({"theta_r", std::to_string(set.theta_r_count())});
             info.push_back({"theta_i", std::to_string(set.theta_i_count)});

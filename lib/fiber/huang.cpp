@@ -615,6 +615,15 @@ HuangHit HuangPoint::huang_hit() const {
     return {to_huang(hit().wo), hit().h, hit().pixel_coverage};
 }
 
+Rgb HuangPoint::f_reflection(Vec3 wi) const {
+    const huang::View &p = view_;
+    if (p.empty) return {};
+    const Closure c = closure_of(*fiber_, p);
+    const Vec3d l = to_closure(p, to_huang(wi));
+    if (faces_no_mesonormal(c, l)) return {};
+    return Rgb(float(r_lobe(c, p, l) / p.denominator));
+}
+
 Rgb HuangPoint::f_estimate(Vec3 wi, CyclesLcg &lcg) const {
     const huang::View &p = view_;
     if (p.empty) return {};

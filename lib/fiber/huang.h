@@ -168,6 +168,9 @@ class HuangPoint final : public FiberPoint {
 
     /// One draw of Cycles' eval at wi (renderer's frame) from the point's own LCG.
     Rgb f(Vec3 wi) const override { return f_estimate(wi, lcg_); }
+    /// The R lobe of Cycles' eval at wi (renderer's frame): deterministic, so it is exactly
+    /// the R lobe of the expectation at this hit.
+    Rgb f_reflection(Vec3 wi) const;
     /// One Cycles eval: the Simpson nodes with one microfacet chain per node drawn from `lcg`
     /// exactly as Cycles consumes it (§7). Its mean over draws is the expectation.
     Rgb f_estimate(Vec3 wi, CyclesLcg &lcg) const;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/frame.h"
+#include "sampling/huang_f_table.h"
 #include "sampling/table_set.h"
 
 namespace hairis {
@@ -222,7 +223,17 @@ Status HuangTableSet::validate() const {
     for (const auto &[name, value] : parameters)
         if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
             return Error{"Huang table parameter \"" + name + "\" must have a plain name and a finite value"};
-    return HuangTable::check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values);
+    if (Status s = HuangTable::check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values)) return s;
+    if (f.empty()) return std::nullopt;
+    if (f.size() != 3 * values.size())
+        return Error{"the Huang table's f part must hold 3 values (RGB) per cell, " + std::to_string(3 * values.size()) +
+                     " in all (got " + std::to_string(f.size()) + ")"};
+    for (std::size_t n = 0; n < f.size(); ++n)
+        if (!(std::isfinite(f[n]) && f[n] >= 0.0f))
+            return Error{"the Huang table's f part: entry " + std::to_string(n) + " (cell " + std::to_string(n / 3) +
+                         ", channel " + std::to_string(n % 3) + ") must be finite and >= 0 (got " +
+                         std::to_string(f[n]) + ")"};
+    return std::nullopt;
 }
 
 Expected<HuangSamplingTable> HuangSamplingTable::from(const HuangTableSet &set) {
@@ -231,8 +242,14 @@ Expected<HuangSamplingTable> HuangSamplingTable::from(const HuangTableSet &set) 
     Expected<HuangTable> t =
         HuangTable::create(set.theta_o_nodes, set.phi_o_nodes, set.theta_i_count, set.phi_count, set.values);
     if (!t) return Error{t.error().message, ErrorKind::InvalidTable};
-    return HuangSamplingTable{std::make_shared<const HuangTable>(std::move(t).value()),
-                              canonical_parameters(set.parameters)};
+    HuangSamplingTable out{std::make_shared<const HuangTable>(std::move(t).value()), nullptr,
+                           canonical_parameters(set.parameters)};
+    if (set.has_f()) {
+        Expected<HuangFTable> f = HuangFTable::create(set);
+        if (!f) return Error{f.error().message, ErrorKind::InvalidTable};
+        out.f = std::make_shared<const HuangFTable>(std::move(f).value());
+    }
+    return out;
 }
 
 }  // namespace hairis

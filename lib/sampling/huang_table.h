@@ -143,16 +143,25 @@ struct HuangTableSet {
     std::vector<float> theta_o_nodes, phi_o_nodes;
     int theta_i_count = 0, phi_count = 0;
     std::vector<float> values;  ///< HuangTable::create's layout
+    /// The baked expectation of f·|cos θ_i| of TT, TRT and TRRT+, RGB per cell in values'
+    /// order (huang_f_table.h), or empty: renders then use Cycles' one-sample eval.
+    std::vector<float> f;
 
     int theta_o_count() const { return int(theta_o_nodes.size()); }
     int phi_o_count() const { return int(phi_o_nodes.size()); }
-    /// The model, plain parameter names with finite values, and what HuangTable::check checks.
+    /// The model, plain parameter names with finite values, what HuangTable::check checks,
+    /// and an f part that is empty or 3 finite non-negative values per cell.
     Status validate() const;
+    bool has_f() const { return !f.empty(); }
 };
 
 /// A Huang table ready to sample, and the fiber parameters it was baked for.
+class HuangFTable;
+
 struct HuangSamplingTable {
     std::shared_ptr<const HuangTable> table;
+    /// The baked f (huang_f_table.h), or null when the set has none.
+    std::shared_ptr<const HuangFTable> f;
     std::string parameters;  ///< canonical_parameters(HuangTableSet::parameters)
 
     /// Builds the table (ErrorKind::InvalidTable when the set is not a valid Huang table).

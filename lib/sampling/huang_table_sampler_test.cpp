@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "huang_table_breaks.h"
 #include "core/frame.h"
 #include "fiber/principled_hair.h"
 #include "sampler_at.h"
@@ -130,15 +131,7 @@ TEST_P(HuangTableChi2, SamplesThePdfItReports) {
     const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
     Chi2Options options;
     options.test_count = kFamily;
-    for (const ThetaWarp &w : q.warp)
-        for (int k = 0; k <= table.theta_i_count(); ++k)
-            options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
-    options.theta_breaks.push_back(q.warp[0].anchor);
-    for (int k = 0; k <= table.phi_count(); ++k) {
-        const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
-        const Vec3 edge{0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))};
-        options.phi_breaks.push_back(angles_of(point.from_huang(edge)).phi);
-    }
+    testing::add_huang_table_breaks(options, table, q, point);
     const std::string what = "fiber " + std::to_string(v.fiber) + " at theta_o " + std::to_string(v.theta_o) +
                              ", phi_o " + std::to_string(v.phi_o);
     const auto r = testing::chi2_direction_test(

@@ -35,8 +35,8 @@ Expected<std::shared_ptr<const Sampler>> mixture(Expected<std::shared_ptr<const 
 
 Error table_error(std::string message) { return Error{std::move(message), ErrorKind::InvalidTable}; }
 
-// TABLE for a Huang fiber: its baked table, mixed with the uniform sphere.
-Expected<std::shared_ptr<const Sampler>> huang_table_sampler(const StrategyInputs &in) {
+// The Huang table TABLE samples for `in`, checked against the fiber.
+Expected<std::shared_ptr<const HuangSamplingTable>> huang_table_of(const StrategyInputs &in) {
     if (Status s = check::in_range("huang_uniform_weight", in.huang_uniform_weight, 0.0, 1.0)) return *s;
     if (!(in.huang_uniform_weight < 1.0f))
         return Error{"huang_uniform_weight must be below 1 (got 1): the table would never be sampled"};
@@ -44,20 +44,30 @@ Expected<std::shared_ptr<const Sampler>> huang_table_sampler(const StrategyInput
         return Error{"multiple_weight must be 0 for a Huang fiber (got " + std::to_string(in.multiple_weight) +
                      "): the multiple-scattering table is not part of the single-fiber f a path tracer samples"};
     const std::string parameters = canonical_parameters(huang_parameters(in.huang->params()));
-    const HuangSamplingTable *table = in.huang_table;
+    std::shared_ptr<const HuangSamplingTable> table = in.huang_table;
     if (!table && in.tables) {
         if (!in.tables->huang)
             return table_error("the tables were baked for " + in.tables->model + " \"" + in.tables->parameters +
                                "\", not for " + in.huang->name() + " \"" + parameters + "\"; bake tables for this fiber");
-        table = in.tables->huang.get();
+        table = in.tables->huang;
     }
     if (!table || !table->table)
         return table_error("the table strategy for a Huang fiber needs a baked Huang table (none was given)");
     if (table->parameters != parameters)
         return table_error("the Huang table was baked for \"" + table->parameters + "\", not for " +
                            in.huang->name() + " \"" + parameters + "\"; bake a table for this fiber");
-    return mixture(shared(HuangTableSampler::create(in.huang, table->table)),
-                   std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>()), in.huang_uniform_weight);
+    return table;
+}
+
+// TABLE for a Huang fiber: its baked table, mixed with the uniform sphere; for the points of
+// `tabulated` when given (the fiber shaded with the table's f).
+Expected<std::shared_ptr<const Sampler>> huang_table_sampler(const StrategyInputs &in,
+                                                             std::shared_ptr<const HuangTabulatedFiber> tabulated = nullptr) {
+    Expected<std::shared_ptr<const HuangSamplingTable>> table = huang_table_of(in);
+    if (!table) return table.error();
+    auto uniform = std::shared_ptr<const Sampler>(std::make_shared<const UniformSampler>());
+    if (tabulated) return mixture(shared(HuangTableSampler::create(std::move(tabulated))), uniform, in.huang_uniform_weight);
+    return mixture(shared(HuangTableSampler::create(in.huang, table.value()->table)), uniform, in.huang_uniform_weight);
 }
 
 }  // namespace
@@ -158,6 +168,25 @@ Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const S
         }
     }
     return Error{"strategy must be uniform, analytic, gaussian or table"};
+}
+
+Expected<HairShading> make_hair_shading(StrategyKind kind, const StrategyInputs &inputs,
+                                        std::shared_ptr<const ShadingModel> model) {
+    if (kind == StrategyKind::Table && inputs.huang) {
+        Expected<std::shared_ptr<const HuangSamplingTable>> table = huang_table_of(inputs);
+        if (!table) return table.error();
+        if (table.value()->f) {
+            Expected<HuangTabulatedFiber> tabulated = HuangTabulatedFiber::create(inputs.huang, table.value());
+            if (!tabulated) return tabulated.error();
+            auto shared_model = std::make_shared<const HuangTabulatedFiber>(std::move(tabulated).value());
+            Expected<std::shared_ptr<const Sampler>> sampler = huang_table_sampler(inputs, shared_model);
+            if (!sampler) return sampler.error();
+            return HairShading::create(std::move(shared_model), std::move(sampler).value());
+        }
+    }
+    Expected<std::shared_ptr<const Sampler>> sampler = make_sampler(kind, inputs);
+    if (!sampler) return sampler.error();
+    return HairShading::create(std::move(model), std::move(sampler).value());
 }
 
 }  // namespace hairis

@@ -10,6 +10,7 @@
 #include "fiber/chiang_strands.h"
 #include "fiber/huang.h"
 #include "fiber/seed_pdfs.h"
+#include "sampling/hair_bsdf.h"
 #include "sampling/huang_table.h"
 #include "sampling/near_field_table.h"
 #include "sampling/sampler.h"
@@ -87,7 +88,7 @@ struct StrategyInputs {
     std::shared_ptr<const HuangFiber> huang;
     /// The Huang table (TABLE with `huang`): it must have been baked for `huang`'s parameters.
     /// Null: the Huang part of `tables`, if they have one.
-    const HuangSamplingTable *huang_table = nullptr;
+    std::shared_ptr<const HuangSamplingTable> huang_table;
     /// TABLE with `huang`: the uniform sphere's weight in the mixture, in [0, 1).
     float huang_uniform_weight = kHuangUniformWeight;
 };
@@ -105,5 +106,12 @@ struct StrategyInputs {
 /// Errors name what is missing or out of range; tables baked for another fiber, or without
 /// n_h, are refused with ErrorKind::InvalidTable.
 Expected<std::shared_ptr<const Sampler>> make_sampler(StrategyKind kind, const StrategyInputs &inputs);
+
+/// What a hair material shades with under `kind`: make_sampler's sampler and the fiber model
+/// whose f weights its samples. TABLE for a Huang fiber whose table holds the baked f shades
+/// with that f (HuangTabulatedFiber: Cycles' expectation without its noise); every other case
+/// shades with `model` (the material's fiber, or null for samplers that read none).
+Expected<HairShading> make_hair_shading(StrategyKind kind, const StrategyInputs &inputs,
+                                        std::shared_ptr<const ShadingModel> model);
 
 }  // namespace hairis

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "chi2.h"
+#include "huang_table_breaks.h"
 #include "core/frame.h"
 #include "fiber/fiber_spec.h"
 #include "sampler_at.h"
@@ -323,7 +324,7 @@ const HuangFixture &huang_fixture() {
 StrategyInputs huang_inputs(const HuangSamplingTable *table, float uniform_weight = kHuangUniformWeight) {
     StrategyInputs in;
     in.huang = huang_fixture().fiber;
-    in.huang_table = table;
+    in.huang_table = std::shared_ptr<const HuangSamplingTable>(std::shared_ptr<const HuangSamplingTable>(), table);  // not owned
     in.huang_uniform_weight = uniform_weight;
     return in;
 }
@@ -351,15 +352,7 @@ TEST(HuangStrategy, TableIsExact) {
         const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
         Chi2Options options;
         options.test_count = kHuangFamily;
-        for (const ThetaWarp &w : q.warp)
-            for (int k = 0; k <= table.theta_i_count(); ++k)
-                options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
-        options.theta_breaks.push_back(q.warp[0].anchor);
-        for (int k = 0; k <= table.phi_count(); ++k) {
-            const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
-            options.phi_breaks.push_back(
-                angles_of(point.from_huang({0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))})).phi);
-        }
+        testing::add_huang_table_breaks(options, table, q, point);
         const auto r = testing::chi2_direction_test(
             [&](Sample3 u) -> std::optional<Vec3> {
                 auto d = at.sample(u.u0, u.u1, u.u2);

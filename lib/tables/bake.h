@@ -41,6 +41,9 @@ struct BakeOptions {
     /// A huang2022 fiber's multiple part (theta_r × n_h × theta_i, for dual scattering); 0
     /// bakes its Huang table alone (several seconds faster).
     bool huang_multiple = true;
+    /// A huang2022 fiber's f part (huang_f_table.h): the baked expectation renders shade with;
+    /// 0 leaves renders with Cycles' noisy one-sample eval.
+    bool huang_f = true;
 
     /// Names the first option out of range.
     Status validate() const;
@@ -57,6 +60,7 @@ void describe(Fields &f, BakeOptions &o) {
     f.field("quadrature_points", o.quadrature_points, 1, 16);
     f.field("threads", o.threads, 0, 1024);
     f.field("huang_multiple", o.huang_multiple);
+    f.field("huang_f", o.huang_f);
     f.field("huang_theta_o", o.huang.theta_o, 1, kMaxThetaRNodes);
     f.field("huang_phi_o", o.huang.phi_o, 1, kMaxPhiONodes);
     f.field("huang_theta_i", o.huang.theta_i, 1, kMaxTableAxisCells);

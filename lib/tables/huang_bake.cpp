@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -33,6 +34,7 @@ std::uint32_t cell_seed(std::uint64_t index) {
 struct NodeView {
     std::optional<HuangExpectation> expectation;
     std::optional<HuangPoint> point;  // Huang's frame = this point's frame (normal on y)
+    std::optional<HuangExpectation> f;  // the f part's (HuangBakeOptions::f)
 };
 
 }  // namespace
@@ -46,7 +48,9 @@ Status HuangBakeOptions::validate() const {
                                check::count_in_range("first_order", first_order, 1, 32),
                                check::count_in_range("second_order", second_order, 1, 32),
                                check::count_in_range("estimates", estimates, 1, 1024),
-                               check::count_in_range("threads", threads, 0, 1024)))
+                               check::count_in_range("threads", threads, 0, 1024),
+                               check::count_in_range("f_first_order", f_first_order, 1, 32),
+                               check::count_in_range("f_second_order", f_second_order, 1, 32)))
         return s;
     if (evaluator != "expectation" && evaluator != "estimate")
         return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};
@@ -66,6 +70,8 @@ std::vector<float> huang_phi_o_nodes(int count) {
 
 namespace {
 
+bool p_is_one(const HuangBakeOptions &o) { return o.points == 1; }
+
 // huang_dual_scattering keeps the averages of this many fibers (the oldest goes first).
 constexpr std::size_t kHuangDualCacheSize = 16;
 
@@ -82,6 +88,13 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
     HuangQuadrature rule;
     rule.first_order = o.first_order;
     rule.second_order = o.second_order;
+    HuangQuadrature f_rule;
+    f_rule.first_order = o.f_first_order;
+    f_rule.second_order = o.f_second_order;
+    // The sampling values reuse the f part's evaluations when both use one rule at one point.
+    const bool shared_rule = o.f && expectation && p_is_one(o) && o.f_first_order == o.first_order &&
+                             o.f_second_order == o.second_order;
+    if (o.f) t.f.assign(3 * t.values.size(), 0.0f);
     const int p = o.points;
     std::atomic<bool> bad{false};
 
@@ -94,7 +107,10 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
         tbb::parallel_for(0, n_q, [&](int q) {
             const Vec3 wo = direction_of(theta_o, t.phi_o_nodes[std::size_t(q)]);
             NodeView &v = views[std::size_t(q)];
-            if (expectation) {
+            if (o.f) v.f.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule));
+            if (shared_rule) {
+                v.expectation.reset();
+            } else if (expectation) {
                 v.expectation.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, rule));
             } else {
                 FiberHit hit;
@@ -112,7 +128,22 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
             for (int j = 0; j < n_j; ++j) {
                 CyclesLcg lcg{cell_seed(first + std::size_t(j))};
                 double sum = 0.0;
-                for (int a = 0; a < p; ++a) {
+                if (o.f) {
+                    // The cell's midpoint in sin θ_i and φ (the p = 1 point).
+                    const double theta_i = std::asin(std::clamp(0.5 * (s0 + s1), -1.0, 1.0));
+                    const double phi = -kPi + kTwoPi * (j + 0.5) / n_j;
+                    const std::array<Rgb, 4> lobes = v.f->lobes(direction_of(float(theta_i), float(phi_o + phi)));
+                    const Rgb rest = lobes[1] + lobes[2] + lobes[3];
+                    float *out = &t.f[3 * (first + std::size_t(j))];
+                    out[0] = rest.r;
+                    out[1] = rest.g;
+                    out[2] = rest.b;
+                    if (!(std::isfinite(rest.r) && std::isfinite(rest.g) && std::isfinite(rest.b) && rest.r >= 0.0f &&
+                          rest.g >= 0.0f && rest.b >= 0.0f))
+                        bad = true;
+                    if (shared_rule) sum = luminance(lobes[0] + rest);
+                }
+                for (int a = 0; a < (shared_rule ? 0 : p); ++a) {
                     const double theta_i = std::asin(std::clamp(s0 + (s1 - s0) * (a + 0.5) / p, -1.0, 1.0));
                     for (int b = 0; b < p; ++b) {
                         const double phi = -kPi + kTwoPi * (j + (b + 0.5) / p) / n_j;
@@ -124,7 +155,7 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
                         }
                     }
                 }
-                const double value = sum / (double(p) * p * (expectation ? 1 : o.estimates));
+                const double value = shared_rule ? sum : sum / (double(p) * p * (expectation ? 1 : o.estimates));
                 if (!(std::isfinite(value) && value >= 0.0)) bad = true;
                 t.values[first + std::size_t(j)] = float(value);
             }
@@ -181,9 +212,11 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
     o.theta_i_count = options.huang.theta_i;
     o.phi_count = options.huang.phi;
     o.threads = options.threads;
+    o.f = options.huang_f;
     if (Status s = o.validate()) return Error{"the Huang resolution (huang_theta_o, huang_phi_o, huang_theta_i, huang_phi): " + s->message};
     // The file's image: one row per (φ_o node, θ_o node, θ_i cell), refused before the bake.
-    const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count * o.theta_i_count;
+    const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count *
+                           o.theta_i_count * (o.f ? 2 : 1);  // the f part has as many rows
     const long long multiple_rows = options.huang_multiple ? (long long)options.theta_r_count * options.theta_i_count : 0;
     if (Status s = TableImageSize{std::max<long long>(o.phi_count, (long long)options.n_h_values.size()),
                                   rows + multiple_rows}.validate())

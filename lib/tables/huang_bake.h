@@ -28,6 +28,10 @@ struct HuangBakeOptions {
     int first_order = 4, second_order = 3;  ///< the expectation's rule (HuangQuadrature)
     int estimates = 1;                      ///< Cycles evals per point ("estimate")
     int threads = 0;                        ///< 0: all cores
+    /// Also bake the f part (huang_f_table.h): TT, TRT and TRRT+ of the expectation at the
+    /// rule below, RGB, at each cell's midpoint.
+    bool f = true;
+    int f_first_order = 4, f_second_order = 3;  ///< the f part's rule (HuangQuadrature)
 
     /// Names the first option out of range.
     Status validate() const;

@@ -71,15 +71,17 @@ int band_of_column(int j, int phi_count, int bands) { return int((long long)j * 
 // near-field part's; the width is the widest part's, narrower rows padded with zeros.
 struct Layout {
     int far_rows = 0, near_rows = 0, near_cols = 0;
-    long long huang_rows = 0, multiple_rows = 0;  // huang2022: the Huang part, then the multiple part
+    // huang2022: the Huang part, its f part (as many rows), then the multiple part.
+    long long huang_rows = 0, f_rows = 0, multiple_rows = 0;
     long long width = 0, height = 0;
     static Layout of(const TableSet &t) {
         Layout l;
         if (const HuangTableSet *h = t.huang.get()) {
             l.huang_rows = (long long)h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
+            l.f_rows = h->has_f() ? l.huang_rows : 0;
             l.multiple_rows = t.has_multiple() ? (long long)t.theta_r_count() * t.theta_i_count : 0;
             l.width = std::max<long long>(h->phi_count, t.has_multiple() ? (long long)t.n_h_values.size() : 0);
-            l.height = l.huang_rows + l.multiple_rows;
+            l.height = l.huang_rows + l.f_rows + l.multiple_rows;
             return l;
         }
         l.far_rows = t.theta_r_count() * t.theta_i_count;
@@ -95,8 +97,10 @@ struct Layout {
 
 // The Huang part: row (q·theta_o_count + r)·theta_i_count + i, column j holds R = the value of
 // φ_o node q, θ_o node r, cell (i, j); G = B = 0, A = 1. The values' order is exactly this.
-// The multiple part after it: row huang_rows + r·theta_i_count + i, column k holds G = the
-// multiple table at θ_r node r, n_h value k, θ_i cell i; R = B = 0, A = 1. Padding is 0.
+// The f part after it (when baked): row huang_rows + the Huang part's row, same column, holds
+// R, G, B = the f part's RGB of that cell, A = 1. The multiple part after those: row
+// huang_rows + f_rows + r·theta_i_count + i, column k holds G = the multiple table at θ_r
+// node r, n_h value k, θ_i cell i; R = B = 0, A = 1. Padding is 0.
 std::vector<float> huang_pixels_of(const TableSet &t) {
     const HuangTableSet &h = *t.huang;
     const Layout l = Layout::of(t);
@@ -107,12 +111,16 @@ std::vector<float> huang_pixels_of(const TableSet &t) {
         float *p = &px[((n / huang_width) * width + n % huang_width) * kChannels];
         p[0] = h.values[n];
         p[3] = 1.0f;
+        if (!h.has_f()) continue;
+        float *q = &px[((size_t(l.huang_rows) + n / huang_width) * width + n % huang_width) * kChannels];
+        for (int c = 0; c < 3; ++c) q[c] = h.f[3 * n + size_t(c)];
+        q[3] = 1.0f;
     }
     const int bands = int(t.n_h_values.size());
     for (int r = 0; r < (t.has_multiple() ? t.theta_r_count() : 0); ++r)
         for (int i = 0; i < t.theta_i_count; ++i)
             for (int k = 0; k < bands; ++k) {
-                const size_t row = size_t(l.huang_rows) + size_t(r) * size_t(t.theta_i_count) + size_t(i);
+                const size_t row = size_t(l.huang_rows + l.f_rows) + size_t(r) * size_t(t.theta_i_count) + size_t(i);
                 float *p = &px[(row * width + size_t(k)) * kChannels];
                 p[1] = t.multiple_at(r, k, i);
                 p[3] = 1.0f;
@@ -327,9 +335,10 @@ Expected<std::vector<int>> n_h_values_of(const OIIO::ImageSpec &spec) {
     return values;
 }
 
-// The Huang part (parts "huang") and the multiple part after it ("huang,multiple"): the
-// layout of huang_pixels_of, sizes checked before the pixels are read.
-Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple) {
+// The Huang part (parts "huang"), its f part ("huang,f") and the multiple part after them
+// ("huang,multiple", "huang,f,multiple"): the layout of huang_pixels_of, sizes checked before
+// the pixels are read.
+Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, bool multiple) {
     const OIIO::ImageSpec &spec = in.spec();
     for (const char *far : {"hairis:theta_r_count", "hairis:theta_i_count", "hairis:phi_count", "hairis:near"})
         if (spec.find_attribute(far))
@@ -362,7 +371,21 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple)
         return file_error("hairis:huang claims " + std::to_string(rows * h->phi_count) +
                           " cells; a Huang table has at most " + std::to_string(kMaxTableCells) + " cells and " +
                           std::to_string(kMaxSamplingTableBytes) + " bytes");
-    long long width = h->phi_count, height = rows;
+    const long long f_rows = with_f ? rows : 0;
+    if (with_f != (spec.find_attribute("hairis:huang_f") != nullptr))
+        return file_error(with_f ? "hairis:parts names an f part but there is no string attribute hairis:huang_f "
+                                   "(\"row=...\")"
+                                 : "hairis:parts names no f part, but the file has hairis:huang_f");
+    if (with_f) {
+        Expected<OptionReader> fr = OptionReader::parse(spec.get_string_attribute("hairis:huang_f"), "hairis:huang_f");
+        if (!fr) return file_error(fr.error().message);
+        int f_row = -1;
+        fr.value().field("row", f_row, 0, kMaxTableCells);
+        if (Status e = fr.value().finish()) return file_error(e->message);
+        if (f_row != rows)
+            return file_error("hairis:huang_f must start at row " + std::to_string(rows) + ", after the Huang part");
+    }
+    long long width = h->phi_count, height = rows + f_rows;
     if (multiple) {
         const OIIO::ParamValue *m = spec.find_attribute("hairis:multiple");
         if (!m || m->type() != TypeDesc::STRING)
@@ -375,9 +398,9 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple)
         mr.value().field("theta_r", theta_r, 1, kMaxThetaRNodes);
         mr.value().field("theta_i", t.theta_i_count, 2, kMaxTableAxisCells);
         if (Status e = mr.value().finish()) return file_error(e->message);
-        if (multiple_row != rows || theta_r == 0 || t.theta_i_count == 0)
-            return file_error("hairis:multiple must give theta_r and theta_i and start at row " + std::to_string(rows) +
-                              ", after the Huang part");
+        if (multiple_row != rows + f_rows || theta_r == 0 || t.theta_i_count == 0)
+            return file_error("hairis:multiple must give theta_r and theta_i and start at row " +
+                              std::to_string(rows + f_rows) + (with_f ? ", after the f part" : ", after the Huang part"));
         Expected<std::vector<float>> nodes = float_array(spec, "hairis:theta_r_nodes", theta_r);
         if (!nodes) return nodes.error();
         t.theta_r_nodes = std::move(nodes).value();
@@ -406,13 +429,21 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple)
     if (!px) return px.error();
     const size_t w = size_t(width), huang_width = size_t(h->phi_count), bands = t.n_h_values.size();
     h->values.resize(size_t(rows) * huang_width);
+    if (with_f) h->f.resize(3 * h->values.size());
     t.multiple.assign(size_t(t.theta_r_count()) * bands * size_t(t.theta_i_count), 0.0f);
+    const size_t first_multiple = size_t(rows + f_rows);
     for (size_t y = 0; y < size_t(height); ++y)
         for (size_t x = 0; x < w; ++x) {
             const float *p = &px.value()[(y * w + x) * kChannels];
             const bool in_huang = y < size_t(rows) && x < huang_width;
-            const bool in_multiple = y >= size_t(rows) && x < bands;
-            if (!in_huang && !in_multiple) {
+            const bool in_f = y >= size_t(rows) && y < first_multiple && x < huang_width;
+            const bool in_multiple = y >= first_multiple && x < bands;
+            if (in_f) {
+                if (p[3] != 1.0f)
+                    return file_error("A must be 1 in the f part at " + pixel_name((long long)x, (long long)y));
+                const size_t n = (y - size_t(rows)) * huang_width + x;
+                for (size_t c = 0; c < 3; ++c) h->f[3 * n + c] = p[c];
+            } else if (!in_huang && !in_multiple) {
                 if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
                     return file_error(pixel_name((long long)x, (long long)y) + " lies outside every part and must be 0");
             } else if (in_huang) {
@@ -424,7 +455,7 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool multiple)
                 if (p[0] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
                     return file_error("R and B must be 0 and A must be 1 in the multiple part at " +
                                       pixel_name((long long)x, (long long)y));
-                const size_t r = (y - size_t(rows)) / size_t(t.theta_i_count), i = (y - size_t(rows)) % size_t(t.theta_i_count);
+                const size_t r = (y - first_multiple) / size_t(t.theta_i_count), i = (y - first_multiple) % size_t(t.theta_i_count);
                 t.multiple[(r * bands + x) * size_t(t.theta_i_count) + i] = p[1];
             }
         }
@@ -456,9 +487,11 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.attribute("hairis:source", t.source);
     spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
     if (const HuangTableSet *h = t.huang.get()) {
-        spec.attribute("hairis:parts", t.has_multiple() ? "huang,multiple" : "huang");
+        spec.attribute("hairis:parts", std::string("huang") + (h->has_f() ? ",f" : "") +
+                                           (t.has_multiple() ? ",multiple" : ""));
+        if (h->has_f()) spec.attribute("hairis:huang_f", format_options({{"row", std::to_string(layout.huang_rows)}}));
         if (t.has_multiple()) {
-            spec.attribute("hairis:multiple", format_options({{"row", std::to_string(layout.huang_rows)},
+            spec.attribute("hairis:multiple", format_options({{"row", std::to_string(layout.huang_rows + layout.f_rows)},
                                                               {"theta_r", std::to_string(t.theta_r_count())},
                                                               {"theta_i", std::to_string(t.theta_i_count)}}));
             spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
@@ -538,13 +571,15 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
         t.parameters.emplace_back(item.substr(0, eq), v);
     }
     const std::string parts = spec.get_string_attribute("hairis:parts");
-    if (parts == "huang" || parts == "huang,multiple") {
+    if (parts == "huang" || parts == "huang,f" || parts == "huang,multiple" || parts == "huang,f,multiple") {
         if (t.model != "huang2022")
             return file_error("hairis:parts \"" + parts + "\" is for model huang2022 (got \"" + t.model + "\")");
-        return decode_huang(*in, std::move(t), parts == "huang,multiple");
+        return decode_huang(*in, std::move(t), parts.rfind("huang,f", 0) == 0,
+                            parts.size() >= 9 && parts.compare(parts.size() - 9, 9, ",multiple") == 0);
     }
     if (t.model == "huang2022")
-        return file_error("huang2022 tables have hairis:parts \"huang\" or \"huang,multiple\" (got \"" + parts + "\")");
+        return file_error("huang2022 tables have hairis:parts \"huang\", \"huang,f\", \"huang,multiple\" or "
+                          "\"huang,f,multiple\" (got \"" + parts + "\")");
     const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
     t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
     t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
@@ -552,7 +587,8 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
         return file_error(s->message);
     if (parts != "far" && parts != "far,near")
-        return file_error("hairis:parts must be \"far\", \"far,near\", \"huang\" or \"huang,multiple\" (got \"" +
+        return file_error("hairis:parts must be \"far\", \"far,near\", \"huang\", \"huang,f\", \"huang,multiple\" or "
+                          "\"huang,f,multiple\" (got \"" +
                           parts + "\")");
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;

@@ -22,15 +22,20 @@
 //        (HuangTable::create's values in their order, sampling/huang_table.h):
 //        R  the cell's value (∝ luminance(f·cos θ_i) there);  G, B  0;  A  1.
 //        This is what the TABLE strategy samples a Huang fiber from.
-//  multiple (huang2022 files baked for dual scattering, after the Huang part) rows
-//        y = huang_rows + r·theta_i_count + i for θ_r node r and θ_i cell i, columns k for
+//  f     (huang2022 files baked with f, after the Huang part) row huang_rows + the Huang
+//        part's row, same column:  R, G, B  the expectation of Cycles' f·cos θ_i of TT, TRT and
+//        TRRT+ at the cell's midpoint (huang_f_table.h);  A  1. This is what renders shade
+//        Huang hair with.
+//  multiple (huang2022 files baked for dual scattering, after the Huang and f parts) rows
+//        y = huang_rows + f_rows + r·theta_i_count + i for θ_r node r and θ_i cell i, columns k for
 //        n_h_values[k]:  G  S_multiple(θ_i | θ_r, n_h) per steradian;  R, B  0;  A  1.
 // Metadata (EXR header attributes): hairis:format_version (2), hairis:model (string),
 // hairis:source ("exact" or "gaussian"), hairis:parameters ("name=value;..."),
 // hairis:theta_r_count, hairis:theta_i_count, hairis:phi_count (the far part), hairis:theta_r_nodes
 // (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far", "far,near",
-// "huang" or "huang,multiple"), hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:huang
-// ("row=0;theta_o=...;phi_o=...;theta_i=...;phi=..."), hairis:huang_theta_o_nodes and
+// "huang", "huang,f", "huang,multiple" or "huang,f,multiple"), hairis:near
+// ("row=...;theta_o=...;theta_i=..."), hairis:huang ("row=0;theta_o=...;phi_o=...;theta_i=...;
+// phi=..."), hairis:huang_f ("row=..."), hairis:huang_theta_o_nodes and
 // hairis:huang_phi_o_nodes (float arrays, radians), hairis:multiple ("row=...;theta_r=...;
 // theta_i=..."; with it a huang file has hairis:theta_r_nodes and hairis:n_h_values, and never
 // the far part's counts), hairis:pixel_sha1 (hex SHA-1 of the float

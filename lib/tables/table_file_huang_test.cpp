@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "chi2.h"
+#include "huang_table_breaks.h"
 #include "core/frame.h"
 #include "fiber/principled_hair.h"
 #include "sampling/huang_table_sampler.h"
@@ -162,6 +163,16 @@ void expect_same_huang_part(const TableSet &b, const TableSet &t) {
     EXPECT_EQ(b.n_h_values, t.n_h_values);
     ASSERT_EQ(b.multiple.size(), t.multiple.size());
     EXPECT_TRUE(same_bits(b.multiple, t.multiple));
+    ASSERT_EQ(b.huang->f.size(), t.huang->f.size());
+    EXPECT_TRUE(same_bits(b.huang->f, t.huang->f));
+}
+
+// `t` with an f part of distinct values (a zero among them).
+TableSet with_distinct_f(TableSet t) {
+    auto h = std::make_shared<HuangTableSet>(*t.huang);
+    for (std::size_t n = 0; n < 3 * h->values.size(); ++n) h->f.push_back(n == 4 ? 0.0f : 3.0f + 0.001f * float(n));
+    t.huang = std::move(h);
+    return t;
 }
 
 TEST(HuangTableFile, RoundTripIsBitExact) {
@@ -236,6 +247,50 @@ TEST(HuangTableFile, TheMultiplePartRoundTripsWhereTheFormatSays) {
     EXPECT_EQ(narrow.at(1, 2, 3), 1.0f);
 }
 
+// The f part (parts "huang,f" and "huang,f,multiple"): round-trips bit for bit, lies after the
+// Huang part with RGB = the cell's f in the Huang part's column and row order, pushes the
+// multiple part down by its rows, and the sampling tables built from it have the f table.
+TEST(HuangTableFile, TheFPartRoundTripsWhereTheFormatSays) {
+    for (const TableSet &t : {with_distinct_f(distinct_tables()), with_distinct_f(distinct_with_multiple()),
+                              with_distinct_f(distinct_tables(1, 1, 2, 1)), baked()}) {
+        ASSERT_TRUE(t.huang->has_f());
+        const std::vector<unsigned char> bytes = encode(t);
+        const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
+        ASSERT_TRUE(back.ok()) << back.error().message;
+        expect_same_huang_part(back.value(), t);
+        const Expected<SamplingTables> sampling = SamplingTables::from(back.value());
+        ASSERT_TRUE(sampling.ok()) << sampling.error().message;
+        EXPECT_TRUE(sampling.value().huang->f);
+    }
+    const TableSet t = with_distinct_f(distinct_with_multiple());
+    Image image = read_image(encode(t));
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:parts"), "huang,f,multiple");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:huang_f"), "row=24");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:multiple"), "row=48;theta_r=3;theta_i=4");
+    ASSERT_EQ(image.spec.height, 24 + 24 + 3 * 4);
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 5; ++x) {
+            const std::size_t n = std::size_t(y) * 5 + std::size_t(x);
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(image.at(x, 24 + y, c), t.huang->f[3 * n + std::size_t(c)]) << x << y;
+            EXPECT_EQ(image.at(x, 24 + y, 3), 1.0f);
+        }
+    EXPECT_EQ(image.at(0, 48, 1), t.multiple[0]);
+    EXPECT_EQ(read_image(encode(with_distinct_f(distinct_tables()))).spec.get_string_attribute("hairis:parts"), "huang,f");
+}
+
+TEST(HuangTableFile, RefusesADamagedFPart) {
+    const TableSet t = with_distinct_f(distinct_with_multiple());
+    expect_refused(tamper(t, [](Image &im) { im.at(1, 25, 3) = 0.5f; }), "A must be 1 in the f part");
+    expect_refused(tamper(t, [](Image &im) { im.at(2, 30, 1) = -1.0f; }), "f part");
+    expect_refused(tamper(t, [](Image &im) { im.at(2, 30, 0) = std::numeric_limits<float>::quiet_NaN(); }), "NaN or infinity");
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:huang_f", "row=23"); }), "start at row 24");
+    expect_refused(tamper(t, [](Image &im) { im.spec.erase_attribute("hairis:huang_f"); }),
+                   "no string attribute hairis:huang_f");
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,multiple"); }),
+                   "names no f part");
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,f"); }), "which has no multiple part");
+}
+
 TEST(HuangTableFile, RefusesADamagedMultiplePart) {
     expect_refused(tamper(distinct_with_multiple(), [](Image &im) { im.at(1, 25, 0) = 0.5f; }),
                    "R and B must be 0 and A must be 1 in the multiple part");
@@ -294,15 +349,7 @@ void expect_table_strategy_exact(const SamplingTables &tables, const char *what)
         const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
         Chi2Options options;
         options.test_count = 2 * int(std::size(views));
-        for (const ThetaWarp &w : q.warp)
-            for (int k = 0; k <= table.theta_i_count(); ++k)
-                options.theta_breaks.push_back(w.from_node(-kHalfPi + kPi * k / table.theta_i_count()));
-        options.theta_breaks.push_back(q.warp[0].anchor);
-        for (int k = 0; k <= table.phi_count(); ++k) {
-            const double a = std::atan2(q.sin_phi_o, q.cos_phi_o) - kPi + kTwoPi * k / table.phi_count();
-            options.phi_breaks.push_back(
-                angles_of(point.from_huang({0.0f, q.sign_y * float(std::cos(a)), q.sign_z * float(std::sin(a))})).phi);
-        }
+        testing::add_huang_table_breaks(options, table, q, point);
         const auto r = testing::chi2_direction_test(
             [&](Sample3 u) -> std::optional<Vec3> {
                 auto d = at.sample(u.u0, u.u1, u.u2);

@@ -521,6 +521,16 @@ const char *hairis_fiber_parameters(const hairis_fiber *fiber)
     return fiber->parameters;
 }
 
+/* The fake's f·|cos θ_i|: grey, 0.1 cos θ_i, fading with |h|. */
+static void fake_f(size_t n, const float *wi, const float *h, float *rgb_out)
+{
+    for (size_t i = 0; i < n; ++i) {
+        float cos_theta = sqrtf(fmaxf(0.0f, 1.0f - wi[3 * i] * wi[3 * i]));
+        float value = 0.1f * cos_theta * (h ? 1.0f - fabsf(h[i]) : 1.0f);
+        rgb_out[3 * i] = rgb_out[3 * i + 1] = rgb_out[3 * i + 2] = value;
+    }
+}
+
 int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, const float *wo,
                       const float *h, float *rgb_out)
 {
@@ -529,11 +539,7 @@ int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const float *wi, cons
     if (h && !fiber->chiang)
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "h must be NULL for a %s fiber", fiber->model);
     /* (Huang's frame has the ellipse's major axis as y: the fake ignores it.) */
-    for (size_t i = 0; i < n; ++i) {
-        float cos_theta = sqrtf(fmaxf(0.0f, 1.0f - wi[3 * i] * wi[3 * i]));
-        float value = 0.1f * cos_theta * (h ? 1.0f - fabsf(h[i]) : 1.0f);
-        rgb_out[3 * i] = rgb_out[3 * i + 1] = rgb_out[3 * i + 2] = value;
-    }
+    fake_f(n, wi, h, rgb_out);
     clear_error();
     return HAIRIS_OK;
 }
@@ -813,6 +819,17 @@ int hairis_pdf(const hairis_sampler *s, size_t n, const float *wi, const float *
     if (!s || (n && (!wi || !pdf_out)))
         return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "sampler, wi, pdf_out: NULL");
     for (size_t i = 0; i < n; ++i) pdf_out[i] = 0.0795774715f;
+    clear_error();
+    return HAIRIS_OK;
+}
+
+int hairis_sampler_eval(const hairis_sampler *s, size_t n, const float *wi, const float *wo,
+                        const float *h, float *rgb_out)
+{
+    (void)wo;
+    if (!s || (n && (!wi || !rgb_out)))
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "sampler, wi, rgb_out: NULL");
+    fake_f(n, wi, h, rgb_out);  /* the fake fiber's, at h */
     clear_error();
     return HAIRIS_OK;
 }

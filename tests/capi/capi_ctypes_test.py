@@ -77,6 +77,7 @@ PROTOTYPES = {
     "hairis_sampler_destroy": (None, [c_void_p]),
     "hairis_sample": (c_int, [c_void_p, c_size_t, F, F, F, F, F]),
     "hairis_pdf": (c_int, [c_void_p, c_size_t, F, F, F, F]),
+    "hairis_sampler_eval": (c_int, [c_void_p, c_size_t, F, F, F, F]),
     "hairis_scene_create": (c_void_p, []),
     "hairis_scene_destroy": (None, [c_void_p]),
     "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
@@ -849,7 +850,7 @@ class TestRender(unittest.TestCase):
         self.assertEqual(lib().hairis_tables_model(tables), b"huang2022")
         self.assertEqual(items(lib().hairis_tables_info(tables).decode()),
                          {"source": "exact", "huang_theta_o": "6", "huang_phi_o": "3",
-                          "huang_theta_i": "12", "huang_phi": "16"})
+                          "huang_theta_i": "12", "huang_phi": "16", "huang_f": "1"})
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "huang.exr")
             self.assertEqual(lib().hairis_tables_write(tables, path.encode()), OK, last_error())

@@ -1119,6 +1119,23 @@ static void test_sampling(void)
     char text[TEXT];
     hairis_sampler *by_default = hairis_sampler_create(chiang, g_tables, NULL);
     CHECK(by_default != NULL, "NULL options: the default TABLE sampler");
+    /* A Chiang sampler's f is the fiber's near field at h (NULL: h = 0). */
+    {
+        enum { M = 32 };
+        float wi[3 * M], wo[3 * M], h[M], zero[M], f[3 * M], g[3 * M];
+        for (int i = 0; i < M; ++i) {
+            random_direction(wi + 3 * i);
+            random_direction(wo + 3 * i);
+            h[i] = 2.0f * uniform() - 1.0f;
+            zero[i] = 0.0f;
+        }
+        CHECK(hairis_sampler_eval(by_default, M, wi, wo, h, f) == HAIRIS_OK &&
+                  hairis_fiber_eval(chiang, M, wi, wo, h, g) == HAIRIS_OK && memcmp(f, g, sizeof f) == 0,
+              "a Chiang sampler's f is the fiber's at h");
+        CHECK(hairis_sampler_eval(by_default, M, wi, wo, NULL, f) == HAIRIS_OK &&
+                  hairis_fiber_eval(chiang, M, wi, wo, zero, g) == HAIRIS_OK && memcmp(f, g, sizeof f) == 0,
+              "and at h = 0 without h");
+    }
 
     /* A TABLE sampler stays valid after its tables handle is destroyed. */
     hairis_sampler *orphan = NULL;
@@ -1800,14 +1817,20 @@ static void test_huang(void)
     CHECK(huang_tables && strcmp(hairis_tables_model(huang_tables), "huang2022") == 0, "model huang2022");
     CHECK(huang_tables && strcmp(hairis_tables_info(huang_tables),
                                  "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;"
-                                 "theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
+                                 "huang_f=1;theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
           "info \"%s\" (with the multiple part)", huang_tables ? hairis_tables_info(huang_tables) : "");
     char table_only_options[TEXT];
     snprintf(table_only_options, TEXT, "%s;huang_multiple=0", small);
     hairis_tables *table_only = hairis_tables_bake(huang, table_only_options, NULL, NULL);
     CHECK(table_only && strcmp(hairis_tables_info(table_only),
-                               "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24") == 0,
+                               "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;huang_f=1") == 0,
           "huang_multiple=0: the Huang table alone, \"%s\"", table_only ? hairis_tables_info(table_only) : "");
+    char no_f_options[TEXT];
+    snprintf(no_f_options, TEXT, "%s;huang_multiple=0;huang_f=0", small);
+    hairis_tables *no_f = hairis_tables_bake(huang, no_f_options, NULL, NULL);
+    CHECK(no_f && strstr(hairis_tables_info(no_f), "huang_f=0") != NULL, "huang_f=0: no baked f, \"%s\"",
+          no_f ? hairis_tables_info(no_f) : "");
+    hairis_tables_destroy(no_f);
     CHECK(hairis_tables_match_fiber(huang_tables, huang) == 1, "they match their fiber");
     hairis_fiber *rounder = hairis_fiber_create("model=huang;aspect_ratio=0.6;transmission=0.5");
     hairis_fiber *dimmer = hairis_fiber_create("model=huang;aspect_ratio=0.5;transmission=0.4");
@@ -1820,10 +1843,65 @@ static void test_huang(void)
     CHECK(hairis_tables_bake(huang, small, cancel_at_once, NULL) == NULL &&
               strcmp(hairis_last_error(), "cancelled") == 0,
           "a Huang bake cancels");
+    /* The sampler API samples a Huang fiber from its table, the density it reports. */
     hairis_sampler *huang_sampler = hairis_sampler_create(huang, huang_tables, "strategy=table");
-    CHECK(huang_sampler == NULL, "the sampler API takes no Huang table");
-    CHECK_ERROR_MENTIONS("huang2022");
+    CHECK(huang_sampler != NULL, "the sampler API samples a Huang fiber from its table");
+    CHECK_NO_ERROR();
+    if (huang_sampler) check_sample_pdf_consistency(huang_sampler, "huang table", 1);
     hairis_sampler_destroy(huang_sampler);
+    CHECK(hairis_sampler_create(huang, NULL, "strategy=table") == NULL, "a Huang table sampler needs tables");
+    CHECK_ERROR_MENTIONS("tables");
+    /* Its f is the tables' baked f: deterministic and close to the fiber's expectation. */
+    huang_sampler = hairis_sampler_create(huang, huang_tables, "strategy=table");
+    {
+        float baked[3 * N], again[3 * N];
+        CHECK(hairis_fiber_eval(huang, N, wi, wo, NULL, f) == HAIRIS_OK, "eval: %s", hairis_last_error());
+        CHECK(hairis_sampler_eval(huang_sampler, N, wi, wo, NULL, baked) == HAIRIS_OK, "sampler eval: %s",
+              hairis_last_error());
+        CHECK(hairis_sampler_eval(huang_sampler, N, wi, wo, NULL, again) == HAIRIS_OK &&
+                  memcmp(baked, again, sizeof baked) == 0,
+              "the baked f is deterministic");
+        double l1 = 0, total = 0, baked_total = 0;
+        for (int i = 0; i < 3 * N; ++i) {
+            l1 += fabs((double)baked[i] - f[i]);
+            total += f[i];
+            baked_total += baked[i];
+        }
+        printf("   huang baked f against the expectation: L1 %.3f, sums %.4f vs %.4f\n", l1 / total, baked_total,
+               total);
+        CHECK(l1 < 0.35 * total && fabs(baked_total / total - 1.0) < 0.1,
+              "the baked f is near the expectation (L1 %.3f, sums %.4f vs %.4f)", l1 / total, baked_total, total);
+    }
+    hairis_sampler_destroy(huang_sampler);
+    /* R alone is analytic in the baked f: equal to the fiber's eval pair by pair, so a
+     * swapped wi and wo (R is not symmetric in them for an elliptic fiber) shows. */
+    {
+        hairis_fiber *r_only = hairis_fiber_create("model=huang;transmission=0;secondary_reflection=0");
+        hairis_tables *r_tables = hairis_tables_bake(r_only, small, NULL, NULL);
+        hairis_sampler *r_sampler = hairis_sampler_create(r_only, r_tables, "strategy=table");
+        float baked[3 * N], swapped[3 * N];
+        CHECK(r_sampler != NULL, "an R-only Huang sampler: %s", hairis_last_error());
+        CHECK(hairis_fiber_eval(r_only, N, wi, wo, NULL, f) == HAIRIS_OK, "R-only eval");
+        CHECK(hairis_sampler_eval(r_sampler, N, wi, wo, NULL, baked) == HAIRIS_OK, "R-only sampler eval");
+        CHECK(hairis_sampler_eval(r_sampler, N, wo, wi, NULL, swapped) == HAIRIS_OK, "R-only sampler eval, swapped");
+        int same = 0, swapped_same = 0;
+        for (int i = 0; i < 3 * N; ++i) {
+            same += fabsf(baked[i] - f[i]) <= 1e-5f * (f[i] + 1e-6f) + 1e-7f;
+            swapped_same += fabsf(swapped[i] - f[i]) <= 1e-5f * (f[i] + 1e-6f) + 1e-7f;
+        }
+        CHECK(same == 3 * N, "R-only: the baked f equals the fiber's R for %d of %d values", same, 3 * N);
+        CHECK(swapped_same < 3 * N, "R-only: a swapped wi and wo differs (%d of %d equal)", swapped_same, 3 * N);
+        hairis_sampler_destroy(r_sampler);
+        hairis_tables_destroy(r_tables);
+        hairis_fiber_destroy(r_only);
+    }
+    {
+        hairis_sampler *uniform = hairis_sampler_create(NULL, NULL, "strategy=uniform");
+        CHECK(hairis_sampler_eval(uniform, N, wi, wo, NULL, f) == HAIRIS_ERROR_INVALID_ARGUMENT,
+              "a sampler without a fiber has no f");
+        CHECK_ERROR_MENTIONS("without a fiber");
+        hairis_sampler_destroy(uniform);
+    }
 
     /* A scene of Huang hair: renders with uniform (and gaussian), refuses analytic and table
      * naming the material. */

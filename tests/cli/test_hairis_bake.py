@@ -108,10 +108,20 @@ class HairisBakeTest(unittest.TestCase):
         for text in ["huang2022", "aspect_ratio", "secondary_reflection",
                      "theta_o nodes:   6", "phi_o nodes:     3 (0.00 .. 90.00 deg)",
                      "huang  rows 0-215: 3 phi_o nodes x 6 theta_o nodes x 12 theta_i cells",
-                     "cells:           3456", "image:           16 x 216", "valid:           yes"]:
+                     "f  rows 216-431: the same cells", "cells:           6912",
+                     "image:           16 x 432", "valid:           yes"]:
             self.assertIn(text, r.stdout)
         self.assertNotIn("far    rows", r.stdout)
         self.assertIn("(no multiple part", r.stdout)
+        # Without the f part: renders fall back to Cycles' eval, and inspect says so.
+        no_f = self.path("hnf.exr")
+        r = run("bake", "--set", "model=huang", *small, "--no-huang-multiple", "--no-huang-f",
+                "-q", "-o", no_f)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = run("inspect", no_f)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for text in ["(no f part", "cells:           3456", "image:           16 x 216"]:
+            self.assertIn(text, r.stdout)
         # With the multiple part (the default): after the Huang part, one column per n_h.
         multiple = self.path("hm.exr")
         r = run("bake", "--set", "model=huang", *small, "--theta-r", "4", "--theta-i", "8",
@@ -120,9 +130,9 @@ class HairisBakeTest(unittest.TestCase):
         self.assertIn("12 x 16 cells, multiple part 4 x 8", r.stderr)
         r = run("inspect", multiple)
         self.assertEqual(r.returncode, 0, r.stderr)
-        for text in ["multiple  rows 216-247: 4 theta_r nodes (-67.50 .. 67.50 deg) x 8 theta_i "
-                     "cells, columns n_h = 1 4", "cells:           3520",
-                     "image:           16 x 248", "valid:           yes"]:
+        for text in ["multiple  rows 432-463: 4 theta_r nodes (-67.50 .. 67.50 deg) x 8 theta_i "
+                     "cells, columns n_h = 1 4", "cells:           6976",
+                     "image:           16 x 464", "valid:           yes"]:
             self.assertIn(text, r.stdout)
         r = run("bake", "--set", "model=huang", "--source", "gaussian", "-q", "-o", again)
         self.assertNotEqual(r.returncode, 0)

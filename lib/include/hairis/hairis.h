@@ -116,7 +116,8 @@ HAIRIS_API int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const floa
  * source (exact | gaussian), quadrature_points, threads (0: all cores); a huang2022 fiber's
  * tables are its Huang table alone, of huang_theta_o × huang_phi_o view nodes and
  * huang_theta_i × huang_phi cells (the options above but source = exact and threads do not
- * apply to it). `progress` (may be NULL) is called on the calling thread; non-zero cancels
+ * apply to it), with its baked f unless huang_f = 0 and its multiple part unless
+ * huang_multiple = 0. `progress` (may be NULL) is called on the calling thread; non-zero cancels
  * within one θ_r (Huang: θ_o) slice.
  */
 HAIRIS_API hairis_tables *hairis_tables_bake(const hairis_fiber *fiber, const char *options,
@@ -133,8 +134,9 @@ HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables);
 /** The fiber parameters the tables were baked for, "name=value;...". */
 HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables);
 /** What the tables hold, as options: source, theta_r, theta_i, phi, n_h; for huang2022 tables
- * source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi and, when they hold the
- * multiple part that integrator=dual_scattering needs, theta_r, theta_i, n_h. */
+ * source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi, huang_f (1 when they hold the
+ * baked f that renders shade with) and, when they hold the multiple part that
+ * integrator=dual_scattering needs, theta_r, theta_i, n_h. */
 HAIRIS_API const char *hairis_tables_info(const hairis_tables *tables);
 /** 1 when the tables were baked for exactly this fiber's parameters, else 0 (also for NULL
  * arguments, with the last error set). */
@@ -149,8 +151,9 @@ HAIRIS_API int hairis_tables_match_fiber(const hairis_tables *tables, const hair
  * one the tables hold for TABLE, 1, 2, 4, 8 or 16 for GAUSSIAN). `fiber` is needed for
  * ANALYTIC; `tables` for TABLE, where a Chiang `fiber` (optional) makes the single-scattering
  * part follow its near field at h, and the tables must then have been baked for it
- * (HAIRIS_ERROR_INVALID_TABLE otherwise). huang2022 tables are sampled by the renderer only
- * (TABLE here refuses them and huang2022 fibers). The sampler keeps what it samples from.
+ * (HAIRIS_ERROR_INVALID_TABLE otherwise). For a huang2022 `fiber` TABLE samples the tables'
+ * Huang table (baked for that fiber), with the frame of hairis_fiber_eval. The sampler keeps
+ * what it samples from.
  */
 HAIRIS_API hairis_sampler *hairis_sampler_create(const hairis_fiber *fiber, const hairis_tables *tables,
                                                  const char *options);
@@ -163,6 +166,13 @@ HAIRIS_API int hairis_sample(const hairis_sampler *sampler, size_t n, const floa
 /** The solid-angle density with which hairis_sample produces each wi (h may be NULL: h = 0). */
 HAIRIS_API int hairis_pdf(const hairis_sampler *sampler, size_t n, const float *wi,
                           const float *wo, const float *h, float *pdf_out);
+/** f(ω_i, ω_o)·|cos θ_i| (RGB) with which a renderer weights this sampler's directions: the
+ * fiber's f at offset h (h may be NULL: h = 0, as hairis_sample). For a huang2022 fiber under
+ * TABLE with tables that hold the baked f it is that f: Cycles' R exactly and the other lobes
+ * interpolated from their baked expectation, deterministic, in the far field. Refuses a
+ * sampler created without a fiber. */
+HAIRIS_API int hairis_sampler_eval(const hairis_sampler *sampler, size_t n, const float *wi,
+                                   const float *wo, const float *h, float *rgb_out);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,60 @@
+// Huang hair as a renderer shades it from its baked table: Cycles' expectation of f without
+// Cycles' noise. R is Cycles' own (deterministic: a Simpson rule over h); TT, TRT and TRRT+,
+// which Cycles estimates with one random microfacet chain per node, are read from the baked
+// expectation (huang_f_table.h). Near-field hits (camera rays on hair wider than the pixel)
+// keep Cycles' one-sample eval: the table holds the far field only.
+#pragma once
+
+#include <memory>
+
+#include "core/expected.h"
+#include "fiber/huang.h"
+#include "sampling/huang_f_table.h"
+#include "sampling/huang_table.h"
+
+namespace hairis {
+
+class HuangTabulatedFiber;
+
+/// The tabulated fiber at one hit; also hands the table's located view to the table sampler.
+class HuangTabulatedPoint final : public FiberPoint {
+  public:
+    HuangTabulatedPoint(const HuangTabulatedFiber &model, const FiberHit &hit);
+    Rgb f(Vec3 wi) const override;
+    bool transparent() const override { return point_.transparent(); }
+    /// Cycles' closure at the hit (its frame, R, the near-field eval).
+    const HuangPoint &huang() const { return point_; }
+    /// The view located in the table (HuangTable::locate of ω_o in Huang's frame).
+    const HuangTableQuery &query() const { return query_; }
+
+  private:
+    HuangPoint point_;
+    HuangTableQuery query_;
+    const HuangFTable *f_;
+};
+
+/// A Huang fiber shaded with its baked f (HuangSamplingTable::f).
+class HuangTabulatedFiber final : public ShadingModel {
+  public:
+    /// Refuses a null fiber, a table without its f part, and a table baked for other parameters.
+    static Expected<HuangTabulatedFiber> create(std::shared_ptr<const HuangFiber> fiber,
+                                                std::shared_ptr<const HuangSamplingTable> table);
+    const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
+        return scratch.make<HuangTabulatedPoint>(*this, hit);
+    }
+    bool reads_orientation() const override { return true; }
+    /// The fiber it tabulates: a renderer that samples Huang with Cycles' own sampler shades
+    /// with the fiber's Cycles eval instead.
+    const HuangFiber *as_huang() const override { return fiber_.get(); }
+    const HuangFiber &fiber() const { return *fiber_; }
+    const HuangTable &table() const { return *table_->table; }
+    const HuangFTable &f_table() const { return *table_->f; }
+
+  private:
+    HuangTabulatedFiber(std::shared_ptr<const HuangFiber> fiber, std::shared_ptr<const HuangSamplingTable> table)
+        : fiber_(std::move(fiber)), table_(std::move(table)) {}
+    std::shared_ptr<const HuangFiber> fiber_;
+    std::shared_ptr<const HuangSamplingTable> table_;
+};
+
+}  // namespace hairis
