@@ -3,17 +3,18 @@
 
 Usage (CTest passes every option):
     capi_ctypes_test.py --library libhairis.so --header hairis.h --header hairis_render.h
-                        [--nm nm] [--addon-native addon/hairis/native.py] [--version X.Y.Z]
+                        [--nm nm] [--addon-native addon/hairis/native.py]
+                        [--fake-library libhairis_fake.so] [--version X.Y.Z]
                         [unittest options]
 
-PROTOTYPES below declares, independently of the headers, the ctypes prototype of every C API
-function; the library is called through it. TestPrototypes parses the headers' HAIRIS_API
-prototypes (a small strict parser for their regular style, parse_prototypes) into ctypes
-types and fails, naming the function, when one is missing from a PROTOTYPES dict, extra in
-it, or declared otherwise; it checks this file's dict and, once it has one, the add-on's
-``PROTOTYPES`` in addon/hairis/native.py. It also checks that libhairis.so exports exactly
-the headers' functions (``nm -D --defined-only``). Exits non-zero on a failure; 77 (skip)
-when numpy is missing.
+The library is called through the add-on's ctypes prototypes (``PROTOTYPES`` in
+addon/hairis/native.py, the one copy; --addon-native, by default found from this file).
+TestPrototypes parses the headers' HAIRIS_API prototypes (a small strict parser for their
+regular style, parse_prototypes) into ctypes types and fails, naming the function, when one
+is missing from PROTOTYPES, extra in it, or declared otherwise. It also checks that
+libhairis.so, and the add-on tests' stand-in libhairis_fake.so (--fake-library), define
+exactly the headers' functions (``nm -D --defined-only``). Exits non-zero on a failure; 77
+(skip) when numpy is missing.
 """
 
 import argparse
@@ -47,57 +48,24 @@ KINDS = ("chiang", "huang", "marschner", "bake", "sampler", "diffuse", "principl
          "emission", "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
          "curve_inputs")
 
-# ---- The prototypes, written here by hand ---------------------------------------------------
+# ---- The prototypes: the add-on's table, loaded by main() ----------------------------------
 
-PROGRESS_FN = CFUNCTYPE(c_int, c_void_p, c_float)
+# addon/hairis/native.py (imports no bpy): its PROTOTYPES and PROGRESS_FN are the ones the
+# library is called through here, so the binding Blender uses is the one these tests exercise.
+PROTOTYPES = None
+PROGRESS_FN = None
+
 F = POINTER(c_float)
 U32 = POINTER(c_uint32)
-I32 = POINTER(c_int32)
 
-PROTOTYPES = {
-    "hairis_api_version": (c_int, []),
-    "hairis_version_string": (c_char_p, []),
-    "hairis_last_error": (c_char_p, []),
-    "hairis_defaults": (c_char_p, [c_char_p]),
-    "hairis_fiber_create": (c_void_p, [c_char_p]),
-    "hairis_fiber_destroy": (None, [c_void_p]),
-    "hairis_fiber_model": (c_char_p, [c_void_p]),
-    "hairis_fiber_parameters": (c_char_p, [c_void_p]),
-    "hairis_fiber_eval": (c_int, [c_void_p, c_size_t, F, F, F, F]),
-    "hairis_tables_bake": (c_void_p, [c_void_p, c_char_p, PROGRESS_FN, c_void_p]),
-    "hairis_tables_write": (c_int, [c_void_p, c_char_p]),
-    "hairis_tables_load_file": (c_void_p, [c_char_p]),
-    "hairis_tables_load_memory": (c_void_p, [c_void_p, c_size_t]),
-    "hairis_tables_destroy": (None, [c_void_p]),
-    "hairis_tables_model": (c_char_p, [c_void_p]),
-    "hairis_tables_parameters": (c_char_p, [c_void_p]),
-    "hairis_tables_info": (c_char_p, [c_void_p]),
-    "hairis_tables_match_fiber": (c_int, [c_void_p, c_void_p]),
-    "hairis_sampler_create": (c_void_p, [c_void_p, c_void_p, c_char_p]),
-    "hairis_sampler_destroy": (None, [c_void_p]),
-    "hairis_sample": (c_int, [c_void_p, c_size_t, F, F, F, F, F]),
-    "hairis_pdf": (c_int, [c_void_p, c_size_t, F, F, F, F]),
-    "hairis_sampler_eval": (c_int, [c_void_p, c_size_t, F, F, F, F]),
-    "hairis_scene_create": (c_void_p, []),
-    "hairis_scene_destroy": (None, [c_void_p]),
-    "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
-    "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
-    "hairis_scene_add_texture": (c_int, [c_void_p, c_char_p]),
-    "hairis_scene_add_texture_pixels": (c_int, [c_void_p, c_char_p, F, c_size_t, c_size_t, c_int]),
-    "hairis_scene_add_curves": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F]),
-    "hairis_scene_add_curves_with_inputs": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
-                                                    c_char_p, c_size_t, F]),
-    "hairis_scene_add_curves_with_normals": (c_int, [c_void_p, c_int, c_size_t, U32, c_size_t, F, F,
-                                                     F, c_char_p]),
-    "hairis_scene_add_mesh": (c_int, [c_void_p, c_size_t, F, c_size_t, U32, I32]),
-    "hairis_scene_set_mesh_attribute": (c_int, [c_void_p, c_char_p, F, c_size_t]),
-    "hairis_scene_add_light": (c_int, [c_void_p, c_char_p]),
-    "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
-    "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, F, c_size_t, c_size_t, c_int]),
-    "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
-    "hairis_render": (c_int, [c_void_p, c_char_p, F, PROGRESS_FN, c_void_p]),
-    "hairis_last_render_stats": (c_char_p, []),
-}
+
+def load_native(path):
+    """The add-on's native.py as a module of its own (its package's __init__ imports bpy)."""
+    spec = importlib.util.spec_from_file_location("hairis_addon_native", path)
+    native = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(native)
+    return native
+
 
 # ---- The headers' prototypes as ctypes types --------------------------------------------------
 
@@ -352,8 +320,8 @@ class TestPrototypes(unittest.TestCase):
             raise unittest.SkipTest("no --header")
         cls.expected = header_prototypes()
 
-    def test_this_files_prototypes_match_the_headers(self):
-        problems = prototype_problems(self.expected, PROTOTYPES, "capi_ctypes_test.py")
+    def test_native_prototypes_match_the_headers(self):
+        problems = prototype_problems(self.expected, PROTOTYPES, "addon/hairis/native.py")
         self.assertEqual(problems, [], "\n".join(problems))
 
     def test_the_check_names_each_kind_of_difference(self):
@@ -419,34 +387,32 @@ class TestPrototypes(unittest.TestCase):
                 with self.assertRaises(HeaderError):
                     parse_prototypes([bad])
 
-    def test_addon_prototypes_match_the_headers(self):
-        if not OPTIONS.addon_native or not os.path.exists(OPTIONS.addon_native):
-            self.skipTest("no --addon-native")
-        spec = importlib.util.spec_from_file_location("hairis_addon_native", OPTIONS.addon_native)
-        native = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(native)
-        if not hasattr(native, "PROTOTYPES"):
-            self.skipTest("%s defines no PROTOTYPES yet (the add-on's binding is not ported to "
-                          "the option-string API)" % OPTIONS.addon_native)
-        problems = prototype_problems(self.expected, native.PROTOTYPES, "addon/hairis/native.py")
-        self.assertEqual(problems, [], "\n".join(problems))
-
-    def test_library_exports_exactly_the_headers_functions(self):
+    def assert_exports_exactly_the_headers_functions(self, library):
         nm = OPTIONS.nm or "nm"
-        output = subprocess.run([nm, "-D", "--defined-only", OPTIONS.library], check=True,
+        output = subprocess.run([nm, "-D", "--defined-only", library], check=True,
                                 capture_output=True, text=True).stdout
         exported = set()
         for line in output.splitlines():
             parts = line.split()
             if len(parts) >= 3:
                 exported.add(parts[2].split("@")[0])
-        self.assertTrue(exported, "nm found no symbols in %s" % OPTIONS.library)
+        self.assertTrue(exported, "nm found no symbols in %s" % library)
         others = sorted(name for name in exported if not name.startswith("hairis_"))
-        self.assertEqual(others, [], "libhairis.so exports only hairis_* symbols")
+        self.assertEqual(others, [], "%s exports only hairis_* symbols" % library)
         self.assertEqual(sorted(exported - set(self.expected)), [],
-                         "exported hairis_* symbols the headers do not declare")
+                         "hairis_* symbols of %s the headers do not declare" % library)
         self.assertEqual(sorted(set(self.expected) - exported), [],
-                         "header functions the library does not export")
+                         "header functions %s does not define" % library)
+
+    def test_library_exports_exactly_the_headers_functions(self):
+        self.assert_exports_exactly_the_headers_functions(OPTIONS.library)
+
+    def test_fake_library_defines_exactly_the_headers_functions(self):
+        """The add-on tests' stand-in (tests/blender/fake_hairis.c) defines every header
+        function; it includes the headers, so the compiler has checked each signature."""
+        if not OPTIONS.fake_library:
+            self.skipTest("no --fake-library (the Blender add-on tests are not configured)")
+        self.assert_exports_exactly_the_headers_functions(OPTIONS.fake_library)
 
 
 class TestLibrary(unittest.TestCase):
@@ -1141,18 +1107,24 @@ class TestSurfaces(unittest.TestCase):
 
 
 def main():
-    global OPTIONS
+    global OPTIONS, PROTOTYPES, PROGRESS_FN
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--library", required=True, help="libhairis.so")
     parser.add_argument("--header", action="append", default=[],
                         help="a public header (hairis.h, hairis_render.h); repeat for each")
     parser.add_argument("--nm", help="the nm program (default: nm on PATH)")
-    parser.add_argument("--addon-native", help="addon/hairis/native.py")
+    parser.add_argument("--addon-native", default=os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", "addon", "hairis", "native.py"),
+        help="addon/hairis/native.py, whose PROTOTYPES the library is called through")
+    parser.add_argument("--fake-library", help="tests/blender's libhairis_fake.so")
     parser.add_argument("--version", help="the project's version")
     OPTIONS, rest = parser.parse_known_args()
     if np is None:
         print("SKIP: numpy is not installed for %s" % sys.executable)
         return 77
+    native = load_native(OPTIONS.addon_native)
+    PROTOTYPES = native.PROTOTYPES
+    PROGRESS_FN = native.PROGRESS_FN
     program = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2)
     result = program.result
     failed = len(result.failures) + len(result.errors)
