@@ -116,6 +116,11 @@ def check_material(library, material, fiber, need_multiple=False):
         tables.close()
         return TableStatus("STALE", "material %r: its tables were baked for other hair "
                            "parameters" % material.name)
+    if tables.info.get("huang_f") == "0":
+        tables.close()
+        return TableStatus("STALE", "material %r: its Huang tables have no baked f, which "
+                           "renders shade Huang hair with (baked with huang_f=0 or by an "
+                           "earlier hairis); bake them again" % material.name)
     if need_multiple and not tables.n_h_values:
         tables.close()
         return TableStatus("STALE", "material %r: its tables have no multiple-scattering part, "

@@ -160,7 +160,11 @@ def use_library(path):
 
 
 def run(tests):
-    """Runs test functions in order; prints PASS/FAIL and exits 1 if any failed."""
+    """Runs test functions in order; prints PASS/FAIL and exits 1 if any failed.
+    HAIRIS_TEST_ONLY (comma-separated function names) runs only those, for development."""
+    only = [name for name in os.environ.get("HAIRIS_TEST_ONLY", "").split(",") if name]
+    if only:
+        tests = [test for test in tests if test.__name__ in only]
     failed, skipped = [], []
     for test in tests:
         start = time.monotonic()

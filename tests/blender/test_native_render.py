@@ -361,6 +361,39 @@ def test_packed_tables_render_without_their_file():
         "max difference %g" % float(np.abs(from_file - from_packed).max())
 
 
+def test_huang_tables_without_their_f_are_stale():
+    """Blender 4.0+: Huang tables that hold no baked f (an earlier hairis, or huang_f=0) are
+    stale, so that auto-bake replaces them; with the f part the same bake is current."""
+    helpers.skip_without_huang()
+    material = bpy.data.materials["Hair"]
+    node = next(n for n in material.node_tree.nodes
+                if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
+    node.model = "HUANG"
+    saved = material.hairis.table_image
+    lib = library()
+    small = {"huang_theta_o": 4, "huang_phi_o": 2, "huang_theta_i": 8, "huang_phi": 8,
+             "huang_multiple": 0}
+    try:
+        params = tables.material_parameters(material)
+        with lib.fiber_principled(tables.principled_struct(lib, params)) as fiber:
+            states = {}
+            for huang_f in (0, 1):
+                path = os.path.join(ARGS.workdir, "huang_f%d.exr" % huang_f)
+                with lib.bake_tables(fiber, dict(small, huang_f=huang_f)) as baked:
+                    assert baked.info["huang_f"] == str(huang_f), baked.info
+                    baked.write(path)
+                material.hairis.table_image = bpy.data.images.load(path, check_existing=False)
+                status = tables.check_material(lib, material, fiber)
+                states[huang_f] = (status.state, status.message)
+                if status.tables is not None:
+                    status.tables.close()
+        assert states[0][0] == "STALE" and "no baked f" in states[0][1], states
+        assert states[1][0] == "OK", states
+    finally:
+        node.model = "CHIANG"
+        material.hairis.table_image = saved
+
+
 helpers.run([
     test_library_loads,
     test_bake_operator,
@@ -371,4 +404,5 @@ helpers.run([
     test_convergence,
     test_cancel_within_one_second,
     test_packed_tables_render_without_their_file,
+    test_huang_tables_without_their_f_are_stale,
 ])
