@@ -56,8 +56,8 @@ Expected<FigureFiber> make_figure_fiber(const FiberSpec &spec, const std::string
     DualScatteringParams params;
     double lobe_width = 0;
     if (const auto *huang = dynamic_cast<const HuangFiber *>(model.value().get())) {
-        // R's GGX lobe is about α/√2 wide (13° at α = 0.3). At α ≥ 0.2 half the default
-        // panels change the averages by under 0.2% (measured at Blender's default node).
+        // R's GGX lobe is about α/√2 wide (13° at α = 0.3). At α ≥ 0.2 the lobe spans several
+        // panels even at half the default, which then leaves the averages unchanged.
         const double alpha = huang->roughness();
         if (alpha >= 0.2) {
             params.theta_panels = 12;
@@ -77,8 +77,8 @@ Expected<FigureFiber> make_figure_fiber(const FiberSpec &spec, const std::string
 
 int FigureFiber::grid_points(int theta_count, int phi_count) const {
     if (!(lobe_width > 0)) return 3;
-    // One point per cell where a cell is under a third of the lobe's width (Figure 1 within
-    // 0.4% L1 of 3 points for Blender's default Huang node on 2° cells), up to 3 at a lobe's width.
+    // One point per cell where a cell is under a third of the lobe's width (there more points
+    // no longer change the figure), up to 3 at a lobe's width.
     const double cell = std::max(kPi / theta_count, kTwoPi / phi_count);
     return std::clamp(int(std::ceil(3.0 * cell / lobe_width)), 1, 3);
 }

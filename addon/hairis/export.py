@@ -1208,7 +1208,7 @@ def particle_hair_points(obj, psys, first_particle, curve_count, key_count):
     hair space, and ``foreach_get("co")`` on evaluated keys crashes 3.4), and the Curves
     conversion is an operator that edits ``bpy.data``. So this is the one per-point call:
     ``co_hair`` streamed by a generator straight into ``np.fromiter`` (no Python list or
-    Vector per point is kept; about 1–3 µs per point). Everything after it is numpy.
+    Vector per point is kept). Everything after it is numpy.
     """
     co_hair = psys.co_hair
     stream = (c for particle in range(first_particle, first_particle + curve_count)

@@ -106,7 +106,7 @@ LongitudinalConstants longitudinal_constants(double v) {
 }
 
 namespace {
-// Boost computes in double (its default promotes doubles to long double, ~2× slower).
+// Boost computes in double (its default promotes doubles to long double, which is slower).
 constexpr auto kDoublePolicy = boost::math::policies::policy<boost::math::policies::promote_double<false>>();
 }  // namespace
 

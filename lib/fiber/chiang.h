@@ -24,8 +24,8 @@
 // and, with 4.2's semantics, proportional to luminance(f) up to the lobe weights.
 //
 // Deviation from Cycles' floating-point code, on purpose: M_p is evaluated to double precision
-// (Boost's I0, in log space where a factor would overflow), where Cycles' Bessel I0
-// approximation underestimates it by up to ~2% where cos θ_i cos θ_o / v ≈ 12.
+// (Boost's I0, in log space where a factor would overflow), where Cycles' truncated Bessel I0
+// series underestimates it near its switch to the asymptotic form.
 #pragma once
 
 #include <array>

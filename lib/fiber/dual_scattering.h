@@ -64,8 +64,8 @@
 // ā_f for light across the fiber (the paper's), ā_f + ā_b along it, where forward and backward
 // azimuths head the same way. DECISION: sin²θ, the axial share of the direction's energy, is
 // the simplest weight with both limits; on hair standing straight off a sphere (the light
-// travels along the strands to the points below) the paper's ā_f left DUAL 4–10% dark, this
-// within 5%, and hair lying or leaning at random moved by 1–3% (bench/results/dual_density.md).
+// travels along the strands to the points below) the paper's ā_f left DUAL dark and this does
+// not, while it barely moves hair lying or leaning at random.
 // The distributions and the baked multiple-scattering tables keep the paper's T_f = d_f ā_f^n_h
 // (the seed's S_multiple): with a(θ) their many-strand rows would all peak at grazing θ_i,
 // where light runs along the fibers; they only shape where the renderer's samples go.
@@ -89,7 +89,7 @@
 //         Single scattering f_s here is an energy-conserving fiber (Chiang) and f_s^scatter is
 //         normalised like it (N_p^G below), so f_back is too: half the printed value, which
 //         keeps the paper's balance between f_back and f_s (its d_b = 0.7 was chosen with both
-//         in Marschner's normalisation). bench/results/dual_scattering.md measures the bias left.
+//         in Marschner's normalisation). The bias left is measured in the dual-scattering docs.
 //   f_s^scatter    = Σ_p g(θ_h − α_p; β_p² + σ_f²) N_p^G(θ_d) / cos²θ_d      (M_p^G N_p^G)
 //   n_h ≥ 1: F = T_f d_f (f_s^scatter + π d_b f_back^scatter)          (F_direct = 0)
 //   n_h = 0: F = d_b f_back^direct (the local multiple scattering; single scattering f_s is

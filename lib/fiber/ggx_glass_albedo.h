@@ -16,8 +16,8 @@
 // that z = sqrt(|η − 1|/(η + 1)) for both tables. Values are clamped to [0, 1].
 //
 // We compute the tables ourselves by deterministic quadrature, node by node at first use
-// (about 0.5 ms per node; a fiber touches a few dozen), so the tree holds no generated or
-// copied data. Nodes are accurate to about 1e-3 absolute at worst (1e-4 typical), checked by
+// (cheap next to a bake, as a fiber touches a few dozen nodes), so the tree holds no generated
+// or copied data. Nodes are accurate to about 1e-3 absolute at worst (1e-4 typical), checked by
 // the tests against an independent integral over outgoing directions; Cycles' committed
 // table, made by Monte Carlo in June 2023, agrees with the exact integral to about 5e-4.
 //

@@ -3,10 +3,8 @@
 //   f_ds = f_ds^L(θ_i) · f_ds^A(φ)   direct scattering
 //     f_ds^L: a Gaussian in θ_i centred at −θ_r with σ_L. The seed's text says 0.22, its
 //             formula 0.44; fitted to our direct distributions (hairis-bake fits,
-//             docs/fits/fits.md) σ_L is 0.17–0.26 for both models away from grazing, and the
-//             shape error of 0.22 is less than half that of 0.44 (21% against 56% at θ_r = 0
-//             for Cycles' default fiber, 49% against 64% for the seed's Marschner blonde), so
-//             the default is 0.22.
+//             the fits docs) σ_L is 0.17–0.26 for both models away from grazing, and 0.22
+//             fits their shape better than 0.44, so the default is 0.22.
 //     f_ds^A: a Gaussian in the relative azimuth φ = φ_i − φ_r centred on the TT lobe at
 //             ±π (the seed's "φ_i + φ_r = ±2π" is a slip for ±π in its mirrored φ_r),
 //             σ_A = 0.52 + (θ_r/π)²;

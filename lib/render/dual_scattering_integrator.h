@@ -55,9 +55,8 @@
 // n ≥ 1 strands, its weight is the global term of the sampled direction (T_f and σ_f² of the
 // strands it crossed, the vertex's depth) over the sampler's density instead of f_s over it,
 // and only light the mesh reflects counts (its emission, lamps crossed after the first strand
-// and the world beyond hair are M's, above). On the study's blonde hair over a diffuse head the
-// unbounded series were too red, and the cut series alone too dark; both together are within
-// 6% of path tracing (bench/results/dual_scattering.md).
+// and the world beyond hair are M's, above). On blonde hair over a diffuse head the unbounded
+// series were too red and the cut series alone too dark, so both are kept together.
 //
 // Exact bounces (RenderSettings::dual_exact_bounces, N): the vertices of depth < N are
 // path-traced as integrator=path traces them (their light from other strands is found by
@@ -65,8 +64,8 @@
 // the path. N = 0 is the paper's dual scattering at the first hair hit. What the paper's
 // straight-line T_f gets wrong in a thin layer (light crossing it on grazing paths mostly
 // leaves it, instead of arriving) is then only the part of the light that scattered N times:
-// on the study's blonde hair the regional bias falls with every exact bounce while the noise
-// per sample stays below path tracing's (bench/results/dual_scattering.md).
+// so the bias falls with every exact bounce while the noise per sample stays below path
+// tracing's.
 //
 // Bounce limit (RenderSettings::dual_bounce_limit). The paper's M adds every order of
 // scattering; the path tracer, like Cycles, ends a path after Max Bounces (and Max
@@ -77,9 +76,7 @@
 // continuation's mesh counts the strands it crossed as the path tracer's bounces. Rays that
 // let hair through stop once they know of more strands than their light may cross
 // (Scene::trace_through_hair_within). On light hair the orders past the limit are a large
-// share: on the demo head's blonde hair at 8 bounces DUAL was +14% red with every order and
-// the path tracer with 64 bounces +14% too (bench/results/dual_head/). None keeps the paper's
-// every order.
+// share, which is why the limit follows the path tracer's. None keeps the paper's every order.
 //
 // What dual scattering covers: light from lamps, suns, emissive triangles and the world that
 // reaches hair directly or through other strands. What is still traced: everything that

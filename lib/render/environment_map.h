@@ -87,8 +87,8 @@ struct EnvironmentDesc {
     /// image's own but at least kMinAutoMapWidth × kMinAutoMapHeight, as Cycles' Auto for a
     /// world without a single Nishita sun (cycles@v3.4.0…v5.0.0 scene/light.cpp,
     /// device_update_background), and at most kMaxAutoMapWidth × kMaxAutoMapHeight: finer
-    /// cells follow the bilinear radiance within a texel (a small HDRI's 2 × 2 sun: 5× less
-    /// variance on a diffuse floor at 32 spp). Otherwise Manual: width
+    /// cells follow the bilinear radiance within a texel, which lowers the variance of a small
+    /// HDRI's few-texel sun. Otherwise Manual: width
     /// map_width in [1, kMaxMapWidth] and height map_height in [1, kMaxMapHeight], or
     /// map_width / 2 (at least 1) when map_height is 0, as Cycles' Map Resolution.
     int map_width = 0;

@@ -108,7 +108,7 @@ struct RenderSettings {
     /// hair vertex at a depth >= this is shaded by dual scattering, which closes the path there
     /// (its light from other strands is the dual estimate's). In [0, 1024]; 0 is Zinke et al.'s
     /// dual scattering at the first hair hit. Each exact bounce leaves less of the light to the
-    /// approximation: less bias, more noise (bench/results/dual_scattering.md measures both).
+    /// approximation: less bias, more noise.
     int dual_exact_bounces = 3;
     /// A DualBounceLimit for integrator=dual_scattering: "bounces" or "none".
     int dual_bounce_limit = int(DualBounceLimit::Bounces);

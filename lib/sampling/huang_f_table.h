@@ -12,7 +12,7 @@
 // specular cone θ_i = −θ_o, so slices are read at aligned θ_i, as the sampler reads them) and
 // linearly across φ_o nodes. Between nodes the result is therefore an interpolation of the
 // expectation, not the expectation: its error is a bias, measured against HuangExpectation in
-// the tests and in docs/huang-tabulated-f.md.
+// the tests.
 #pragma once
 
 #include <cstddef>

@@ -149,13 +149,13 @@ Expected<NearFieldTable> NearFieldTable::create(std::shared_ptr<const ChiangFibe
     // over its interval by Simpson's rule on t ∈ {0, ¼, ½} (symmetric about ½ to first
     // order): the table is exact at a node and least accurate halfway. Every interval is
     // probed, as the better choice can flip within a few nodes (probing every 4th chose the
-    // cone for TT at θ_o = 70°, roughness 0.2, with 15× the rows' variance).
+    // cone for TT at θ_o = 70°, roughness 0.2, where the rows are far better).
     // Without probing: a lobe wider than kWideCells cells is followed by the table to ~10⁻⁶
     // while the cone still misplaces it by its tilt. (The residual is not tilted: the cone
     // samples exactly Cycles' M_p there, and is taken wherever the row is not good enough.)
     constexpr double kWideCells = 8.0;
-    // A lobe's relative variance under 10⁻³ is lost next to the ~0.03 that the offset h alone
-    // contributes (bench/strategy_study.cpp): there the row is kept even if the cone would be
+    // A lobe's relative variance under 10⁻³ is lost next to the variance that the offset h
+    // alone contributes: there the row is kept even if the cone would be
     // closer, as the cone costs time (M_p evaluated at every pdf) for nothing a render sees.
     constexpr double kGoodEnough = 1e-3;
     std::array<bool, 4> probe{};

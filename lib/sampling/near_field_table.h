@@ -3,8 +3,8 @@
 //
 // A renderer (like Cycles) shades the near field f(ω_i, ω_o, h), whose azimuthal lobes move
 // with the offset h: R sits at Φ = −2γ_o, and over h ∈ [−1, 1] it sweeps all of [−π, π].
-// Tables averaged over h spread every lobe over that whole sweep, and sample a fixed h about
-// 80× worse than Chiang's own analytic sampler (bench/results/strategy_study.md). A 4D table over
+// Tables averaged over h spread every lobe over that whole sweep, and sample a fixed h far
+// worse than Chiang's own analytic sampler. A 4D table over
 // (θ_o, h, θ_i, φ) would be large. It is not needed, because the model factors per lobe:
 //
 //   f_p·|cos θ_i| = A_p(θ_o, h) · M_p(θ_i | θ_o) · N_p(φ − Φ_p(h)).
@@ -20,9 +20,9 @@
 // lower or upper node stochastically, so the density is the exact blend of the two nodes'.
 //
 // The density is then proportional to luminance(f·cos) up to the cells' resolution and the
-// blend between nodes: relative variance ~10⁻⁵ against the analytic sampler's ~10⁻² (whose
-// M_p is tilted on θ_o instead of θ_i). The blend dominates, so the defaults spend memory on
-// nodes rather than cells (bench/results/strategy_study.md, section 4a).
+// blend between nodes, far below the analytic sampler's variance (whose M_p is tilted on θ_o
+// instead of θ_i). The blend dominates, so the defaults spend memory on nodes rather than
+// cells.
 //
 // Smooth fibers (roughness below ~0.1) have lobes narrower than the cells and the node
 // spacing, which a table in (θ_o, θ_i) cannot follow; the fiber's own cone sampler
@@ -33,13 +33,12 @@
 // its divergence is already below 10⁻³ (every lobe of a fiber rougher than ~0.15), since the
 // cone costs an M_p evaluation at every pdf. The lobe is still chosen with the table's
 // weights, and its density enters the same mixture. At roughness 0.02–0.1 this takes the
-// variance from 4–60× the analytic sampler's (rows alone) to 0.02–0.13× of it
-// (bench/results/strategy_study.md, section 5).
+// variance from above the analytic sampler's (rows alone) to a fraction of it.
 //
 // A material whose inputs vary per strand (chiang_strands.h) keeps the tables of its node's
 // own values; at a strand's hit the lobe weights take the strand's A_p, φ the strand's N_p,
 // and a lobe whose M_p is not the table's draws θ_i from the strand's own cone, never from
-// rows baked for another roughness (bench/results/strand_study.md measures both).
+// rows baked for another roughness.
 #pragma once
 
 #include <array>
@@ -60,8 +59,8 @@ namespace hairis {
 /// Where a lobe of the near-field table draws θ_i from (NearFieldTableOptions::lobe_sampling).
 enum class LobeSampling { Auto, Table, Cone };
 
-/// Resolution and lobe sources of a NearFieldTable (resolution chosen in the sweep of
-/// bench/results/strategy_study.md, section 4a).
+/// Resolution and lobe sources of a NearFieldTable (the resolution spends memory on θ_o nodes,
+/// whose blend dominates the variance).
 struct NearFieldTableOptions {
     int theta_o_nodes = 121;  ///< nodes over [−π/2, π/2], ends included (1.5° apart)
     int theta_i_cells = 90;   ///< equal θ_i cells over [−π/2, π/2] (2° wide)

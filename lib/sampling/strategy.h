@@ -45,7 +45,7 @@ struct SamplingTables {
 struct SamplerOptions {
     int strategy = int(StrategyKind::Table);  ///< a StrategyKind
     /// Weight of the multiple-scattering part (TABLE, GAUSSIAN). 0: in a path tracer the
-    /// multiple-scattering part only adds variance (bench/results/mixture_weight.md).
+    /// multiple-scattering part only adds variance.
     float multiple_weight = 0.0f;
     int n_h = 2;
 };
@@ -59,7 +59,7 @@ void describe(Fields &f, SamplerOptions &o) {
 }
 
 /// The weight of the uniform sphere in TABLE's mixture for a Huang fiber: it keeps the density
-/// positive wherever f is, also in cells the bake saw as zero (bench/results/huang_study.md).
+/// positive wherever f is, also in cells the bake saw as zero.
 inline constexpr float kHuangUniformWeight = 0.01f;
 
 /// What a strategy may need.

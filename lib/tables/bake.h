@@ -39,7 +39,7 @@ struct BakeOptions {
     /// resolution (source must be "exact", phi and quadrature_points are unused).
     HuangResolution huang;
     /// A huang2022 fiber's multiple part (theta_r × n_h × theta_i, for dual scattering); 0
-    /// bakes its Huang table alone (several seconds faster).
+    /// bakes its Huang table alone (faster, as the multiple part is the bake's longest step).
     bool huang_multiple = true;
     /// A huang2022 fiber's f part (huang_f_table.h): the baked expectation renders shade with;
     /// 0 leaves renders with Cycles' noisy one-sample eval.

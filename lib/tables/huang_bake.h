@@ -3,7 +3,7 @@
 // density (its pdf is exact whatever its values), so f is evaluated cheaply: the expectation
 // of Cycles' eval by a low-order rule, or Cycles' one-sample eval with fixed per-cell seeds
 // (both deterministic; the second unbiased per cell). The resolution and evaluator defaults
-// come from the sweep in bench/results/huang_study.md.
+// are the cheapest whose sampling variance a finer table no longer lowers.
 #pragma once
 
 #include <string>
@@ -48,9 +48,8 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
 /// The dual-scattering averages of a Huang fiber (fiber/dual_scattering.h), as its tables'
 /// multiple part and integrator=dual_scattering use them: f by the bake's expectation rule
 /// (4, 3) and a coarser quadrature than DualScatteringParams' default (16 θ nodes, 8 θ and 4 φ
-/// panels), which agrees with the default one to 0.1% in ā_f, ā_b and Ā_b on Blender's default
-/// node at a tenth of the cost (about 12 s on 2 cores for an elliptic fiber, a quarter of that
-/// for a circular one). Runs on the calling thread's arena. Kept for the process by the
+/// panels), the coarsest whose averages the default quadrature no longer changes visibly, as
+/// the default one costs too long per fiber. Runs on the calling thread's arena. Kept for the process by the
 /// fiber's parameters (the last 16 fibers), so that a bake and the renders after it in one
 /// process (the add-on's) compute them once.
 Expected<std::shared_ptr<const DualScattering>> huang_dual_scattering(const HuangFiber &fiber);
