@@ -164,6 +164,13 @@ std::string pixel_name(long long x, long long y) { return "pixel (" + std::to_st
 
 Error file_error(const std::string &what) { return Error{"hairis table: " + what, ErrorKind::InvalidTable}; }
 
+// A padding pixel: outside every part, so all four channels must be 0.
+Status check_padding(const float *p, size_t x, size_t y) {
+    if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
+        return file_error(pixel_name((long long)x, (long long)y) + " lies outside every part and must be 0");
+    return std::nullopt;
+}
+
 // The size OpenEXR reads for an attribute of a fixed-size type whatever its size field says
 // (0: a variable-size or unknown type, read as `size` bytes).
 int fixed_attribute_size(const std::string &type) {
@@ -444,8 +451,7 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, b
                 const size_t n = (y - size_t(rows)) * huang_width + x;
                 for (size_t c = 0; c < 3; ++c) h->f[3 * n + c] = p[c];
             } else if (!in_huang && !in_multiple) {
-                if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
-                    return file_error(pixel_name((long long)x, (long long)y) + " lies outside every part and must be 0");
+                if (Status s = check_padding(p, x, y)) return *s;
             } else if (in_huang) {
                 if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
                     return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
@@ -527,6 +533,126 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     return write_exr(spec, px);
 }
 
+namespace {
+
+// The steps of decode_table_exr, in its order.
+
+// The format version, the channels and the pixel type of an opened table file.
+Status check_table_spec(const OIIO::ImageSpec &spec) {
+    const int version = spec.get_int_attribute("hairis:format_version", -1);
+    if (version == -1) return file_error("no hairis:format_version attribute: not a hairis table file");
+    if (version == 1)
+        return file_error("format version 1 (baked by hairis 0.1) lacks what this build samples (the near-field "
+                          "tables); re-bake the tables (the Bake button, or hairis-bake bake)");
+    if (version != kTableFormatVersion)
+        return file_error("format version " + std::to_string(version) + " is not supported (this build reads version " +
+                          std::to_string(kTableFormatVersion) + ")");
+    if (spec.nchannels != kChannels || spec.channelnames != std::vector<std::string>{"R", "G", "B", "A"})
+        return file_error("expected 4 channels R, G, B, A (got " + std::to_string(spec.nchannels) + ")");
+    if (spec.format != TypeDesc::FLOAT)
+        return file_error("pixels must be 32-bit float (got " + std::string(spec.format.c_str()) + ")");
+    return std::nullopt;
+}
+
+// hairis:parameters ("name=value;...") into t.parameters.
+Status read_parameters(const OIIO::ImageSpec &spec, TableSet &t) {
+    std::stringstream param_text(spec.get_string_attribute("hairis:parameters"));
+    std::string item;
+    while (std::getline(param_text, item, ';')) {
+        const size_t eq = item.find('=');
+        char *end = nullptr;
+        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
+        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
+            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
+        t.parameters.emplace_back(item.substr(0, eq), v);
+    }
+    return std::nullopt;
+}
+
+// The near part's resolution from hairis:near, which must start right after the far part.
+Status read_near_header(const OIIO::ImageSpec &spec, long long far_rows, NearFieldData &near) {
+    const OIIO::ParamValue *near_attribute = spec.find_attribute("hairis:near");
+    if (!near_attribute) return file_error("hairis:parts is \"far,near\" but there is no hairis:near attribute");
+    if (near_attribute->type() != TypeDesc::STRING)
+        return file_error("hairis:near must be a string \"row=...;theta_o=...;theta_i=...\" (got a " +
+                          std::string(near_attribute->type().c_str()) + ")");
+    Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:near"), "hairis:near");
+    if (!reader) return file_error(reader.error().message);
+    int row = -1;
+    reader.value().field("row", row, 0, kMaxTableCells);
+    reader.value().field("theta_o", near.theta_o_nodes, 2, kMaxThetaRNodes);
+    reader.value().field("theta_i", near.theta_i_cells, 4, kMaxTableAxisCells);
+    if (Status e = reader.value().finish()) return file_error(e->message);
+    if (row != far_rows || near.theta_o_nodes == 0 || near.theta_i_cells == 0)
+        return file_error("hairis:near must give theta_o and theta_i and start at row " + std::to_string(far_rows) +
+                          ", after the far part");
+    return std::nullopt;
+}
+
+// The far part: R direct, G the n_h bands, B = 0, A = 1; zero padding beyond phi_count.
+Status read_far_part(const std::vector<float> &px, size_t width, long long far_rows, TableSet &t) {
+    const int bands = int(t.n_h_values.size());
+    if (bands > t.phi_count) return file_error("more n_h values than phi columns");
+    t.direct.resize(size_t(t.theta_r_count()) * t.theta_i_count * t.phi_count);
+    t.multiple.assign(size_t(t.theta_r_count()) * bands * t.theta_i_count, 0.0f);
+    for (size_t row = 0; row < size_t(far_rows); ++row) {
+        const int r = int(row / size_t(t.theta_i_count)), i = int(row % size_t(t.theta_i_count));
+        for (size_t j = 0; j < width; ++j) {
+            const float *p = &px[(row * width + j) * kChannels];
+            if (j >= size_t(t.phi_count)) {
+                if (Status s = check_padding(p, j, row)) return s;
+                continue;
+            }
+            t.direct[row * size_t(t.phi_count) + j] = p[0];
+            if (bands) {
+                const int k = band_of_column(int(j), t.phi_count, bands);
+                float &m = t.multiple[(size_t(r) * bands + k) * t.theta_i_count + i];
+                const bool band_start = j == 0 || band_of_column(int(j) - 1, t.phi_count, bands) != k;
+                if (band_start) m = p[1];
+                else if (p[1] != m)
+                    return file_error("G channel differs inside the n_h band at " + pixel_name((long long)j, (long long)row));
+            }
+            if (p[2] != 0.0f || p[3] != 1.0f)
+                return file_error("B must be 0 and A must be 1 at " + pixel_name((long long)j, (long long)row));
+        }
+    }
+    return std::nullopt;
+}
+
+// The near part: R cell mass, G M_p at the cell's lower edge, B the lobe integral and A the
+// cone flag, both constant along the row; the last column holds only the upper edge.
+Status read_near_part(const std::vector<float> &px, size_t width, long long far_rows, NearFieldData &near) {
+    auto pixel = [&](size_t row, size_t j) { return &px[(row * width + j) * kChannels]; };
+    const size_t cells = size_t(near.theta_i_cells), rows = size_t(near.rows());
+    near.mass.resize(rows * cells);
+    near.edge.resize(rows * (cells + 1));
+    near.integral.resize(rows);
+    near.cone.resize(rows);
+    for (size_t q = 0; q < rows; ++q) {
+        const size_t row = size_t(far_rows) + q;
+        near.integral[q] = pixel(row, 0)[2];
+        const float cone = pixel(row, 0)[3];
+        if (cone != 0.0f && cone != 1.0f)
+            return file_error("A (the cone flag) must be 0 or 1 at " + pixel_name(0, (long long)row));
+        near.cone[q] = cone == 1.0f;
+        for (size_t k = 0; k < width; ++k) {
+            const float *p = pixel(row, k);
+            if (k > cells) {
+                if (Status s = check_padding(p, k, row)) return s;
+                continue;
+            }
+            if (p[2] != near.integral[q] || p[3] != cone)
+                return file_error("B and A must be constant along a near-field row at " + pixel_name((long long)k, (long long)row));
+            if (k < cells) near.mass[q * cells + k] = p[0];
+            else if (p[0] != 0.0f) return file_error("R must be 0 in the near part's last column at " + pixel_name((long long)k, (long long)row));
+            near.edge[q * (cells + 1) + k] = p[1];
+        }
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (data == nullptr || size == 0) return file_error("the data is empty, not an EXR file");
     if (Status s = check_exr_header(static_cast<const unsigned char *>(data), size)) return *s;
@@ -542,34 +668,12 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
         return file_error("not a readable OpenEXR file" + (why.empty() ? std::string() : ": " + why));
     }
     const OIIO::ImageSpec &spec = in->spec();
-
-    const int version = spec.get_int_attribute("hairis:format_version", -1);
-    if (version == -1) return file_error("no hairis:format_version attribute: not a hairis table file");
-    if (version == 1)
-        return file_error("format version 1 (baked by hairis 0.1) lacks what this build samples (the near-field "
-                          "tables); re-bake the tables (the Bake button, or hairis-bake bake)");
-    if (version != kTableFormatVersion)
-        return file_error("format version " + std::to_string(version) + " is not supported (this build reads version " +
-                          std::to_string(kTableFormatVersion) + ")");
-    if (spec.nchannels != kChannels || spec.channelnames != std::vector<std::string>{"R", "G", "B", "A"})
-        return file_error("expected 4 channels R, G, B, A (got " + std::to_string(spec.nchannels) + ")");
-    if (spec.format != TypeDesc::FLOAT)
-        return file_error("pixels must be 32-bit float (got " + std::string(spec.format.c_str()) + ")");
+    if (Status s = check_table_spec(spec)) return *s;
 
     TableSet t;
     t.model = spec.get_string_attribute("hairis:model");
     t.source = spec.get_string_attribute("hairis:source");
-    const std::string parameters = spec.get_string_attribute("hairis:parameters");
-    std::stringstream param_text(parameters);
-    std::string item;
-    while (std::getline(param_text, item, ';')) {
-        const size_t eq = item.find('=');
-        char *end = nullptr;
-        const double v = eq == std::string::npos ? 0.0 : std::strtod(item.c_str() + eq + 1, &end);
-        if (eq == std::string::npos || eq == 0 || end == item.c_str() + eq + 1 || *end != '\0')
-            return file_error("hairis:parameters entry \"" + item + "\" is not name=value");
-        t.parameters.emplace_back(item.substr(0, eq), v);
-    }
+    if (Status s = read_parameters(spec, t)) return *s;
     const std::string parts = spec.get_string_attribute("hairis:parts");
     if (parts == "huang" || parts == "huang,f" || parts == "huang,multiple" || parts == "huang,f,multiple") {
         if (t.model != "huang2022")
@@ -593,22 +697,7 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;
     if (parts == "far,near") {
-        const OIIO::ParamValue *near_attribute = spec.find_attribute("hairis:near");
-        if (!near_attribute)
-            return file_error("hairis:parts is \"far,near\" but there is no hairis:near attribute");
-        if (near_attribute->type() != TypeDesc::STRING)
-            return file_error("hairis:near must be a string \"row=...;theta_o=...;theta_i=...\" (got a " +
-                              std::string(near_attribute->type().c_str()) + ")");
-        Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:near"), "hairis:near");
-        if (!reader) return file_error(reader.error().message);
-        int row = -1;
-        reader.value().field("row", row, 0, kMaxTableCells);
-        reader.value().field("theta_o", near.theta_o_nodes, 2, kMaxThetaRNodes);
-        reader.value().field("theta_i", near.theta_i_cells, 4, kMaxTableAxisCells);
-        if (Status e = reader.value().finish()) return file_error(e->message);
-        if (row != far_rows || near.theta_o_nodes == 0 || near.theta_i_cells == 0)
-            return file_error("hairis:near must give theta_o and theta_i and start at row " + std::to_string(far_rows) +
-                              ", after the far part");
+        if (Status s = read_near_header(spec, far_rows, near)) return *s;
     }
     const long long expected_width = std::max<long long>(t.phi_count, near.theta_i_cells ? near.theta_i_cells + 1 : 0);
     const long long expected_height = far_rows + near.rows();
@@ -630,66 +719,10 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     Expected<std::vector<float>> read = read_pixels(*in);
     in->close();
     if (!read) return read.error();
-    const std::vector<float> &px = read.value();
     const size_t width = size_t(spec.width);
-
-    const int bands = int(t.n_h_values.size());
-    if (bands > t.phi_count) return file_error("more n_h values than phi columns");
-    auto pixel = [&](size_t row, size_t j) { return &px[(row * width + j) * kChannels]; };
-    // The far part: R direct, G the n_h bands, B = 0, A = 1; zero padding beyond phi_count.
-    t.direct.resize(size_t(theta_r_count) * t.theta_i_count * t.phi_count);
-    t.multiple.assign(size_t(theta_r_count) * bands * t.theta_i_count, 0.0f);
-    for (size_t row = 0; row < size_t(far_rows); ++row) {
-        const int r = int(row / size_t(t.theta_i_count)), i = int(row % size_t(t.theta_i_count));
-        for (size_t j = 0; j < width; ++j) {
-            const float *p = pixel(row, j);
-            if (j >= size_t(t.phi_count)) {
-                if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
-                    return file_error(pixel_name((long long)j, (long long)row) + " lies outside every part and must be 0");
-                continue;
-            }
-            t.direct[row * size_t(t.phi_count) + j] = p[0];
-            if (bands) {
-                const int k = band_of_column(int(j), t.phi_count, bands);
-                float &m = t.multiple[(size_t(r) * bands + k) * t.theta_i_count + i];
-                const bool band_start = j == 0 || band_of_column(int(j) - 1, t.phi_count, bands) != k;
-                if (band_start) m = p[1];
-                else if (p[1] != m)
-                    return file_error("G channel differs inside the n_h band at " + pixel_name((long long)j, (long long)row));
-            }
-            if (p[2] != 0.0f || p[3] != 1.0f)
-                return file_error("B must be 0 and A must be 1 at " + pixel_name((long long)j, (long long)row));
-        }
-    }
-    // The near part: R cell mass, G M_p at the cell's lower edge, B the lobe integral and A the
-    // cone flag, both constant along the row; the last column holds only the upper edge.
+    if (Status s = read_far_part(read.value(), width, far_rows, t)) return *s;
     if (near.theta_i_cells) {
-        const size_t cells = size_t(near.theta_i_cells), rows = size_t(near.rows());
-        near.mass.resize(rows * cells);
-        near.edge.resize(rows * (cells + 1));
-        near.integral.resize(rows);
-        near.cone.resize(rows);
-        for (size_t q = 0; q < rows; ++q) {
-            const size_t row = size_t(far_rows) + q;
-            near.integral[q] = pixel(row, 0)[2];
-            const float cone = pixel(row, 0)[3];
-            if (cone != 0.0f && cone != 1.0f)
-                return file_error("A (the cone flag) must be 0 or 1 at " + pixel_name(0, (long long)row));
-            near.cone[q] = cone == 1.0f;
-            for (size_t k = 0; k < width; ++k) {
-                const float *p = pixel(row, k);
-                if (k > cells) {
-                    if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
-                        return file_error(pixel_name((long long)k, (long long)row) + " lies outside every part and must be 0");
-                    continue;
-                }
-                if (p[2] != near.integral[q] || p[3] != cone)
-                    return file_error("B and A must be constant along a near-field row at " + pixel_name((long long)k, (long long)row));
-                if (k < cells) near.mass[q * cells + k] = p[0];
-                else if (p[0] != 0.0f) return file_error("R must be 0 in the near part's last column at " + pixel_name((long long)k, (long long)row));
-                near.edge[q * (cells + 1) + k] = p[1];
-            }
-        }
+        if (Status s = read_near_part(read.value(), width, far_rows, near)) return *s;
         t.near_field = std::make_shared<const NearFieldData>(std::move(near));
     }
     if (Status s = t.validate()) return *s;
