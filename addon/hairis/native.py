@@ -59,6 +59,10 @@ AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 PROGRESS_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_float)
 """``hairis_progress_fn``: ``int (*)(void *user, float progress)``; non-zero cancels."""
 
+UPDATE_FN = ctypes.CFUNCTYPE(c_int, c_void_p, c_float, c_int, c_int)
+"""``hairis_update_fn``: ``int (*)(void *user, float progress, int samples_done, int final)``;
+non-zero stops the render."""
+
 _F = POINTER(c_float)
 _VOID = None
 
@@ -113,6 +117,7 @@ PROTOTYPES = {
                                               c_int]),
     "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
     "hairis_render": (c_int, [c_void_p, c_char_p, _F, PROGRESS_FN, c_void_p]),
+    "hairis_render_progressive": (c_int, [c_void_p, c_char_p, _F, _F, UPDATE_FN, c_void_p]),
     "hairis_last_render_stats": (c_char_p, []),
 }
 """Every function of the headers: name → (restype, argtypes)."""
@@ -878,6 +883,81 @@ class Scene(_Handle):
             error.stats = stats
             raise error
         return out, stats
+
+    def render_progressive(self, settings, update=None, passes=(), out=None):
+        """Renders refining the whole image (``hairis_render_progressive``); returns (rgba
+        (height, width, 4), {pass: (height, width, channels)}, :class:`RenderStats`), bottom
+        row first.
+
+        ``passes`` names the library's passes (depth 1 channel; normal, denoising_albedo,
+        denoising_normal 3), also set as the ``passes`` option. ``update(progress,
+        samples_done, final, rgba, passes) -> bool`` sees the current average image (valid
+        only during the call); True stops the render, which raises :class:`HairisCancelled`
+        whose ``rgba`` and ``passes`` hold the partial image.
+        """
+        if self.width is None:
+            raise HairisError("hairis_render_progressive",
+                              "the scene has no camera (call set_camera first)")
+        shape = (self.height, self.width, 4)
+        if out is None:
+            out = np.zeros(shape, np.float32)
+        elif out.shape != shape or out.dtype != np.float32 or not out.flags.c_contiguous:
+            raise ValueError("out must be a C-contiguous float32 %s array" % (shape,))
+        passes = list(passes)
+        channels = [PASS_CHANNELS[name] for name in passes]
+        buffer = np.zeros(self.width * self.height * sum(channels), np.float32)
+        images, offset = {}, 0
+        for name, count in zip(passes, channels):
+            size = self.width * self.height * count
+            images[name] = buffer[offset:offset + size].reshape(self.height, self.width, count)
+            offset += size
+        values = parse_options(options(settings)) if not isinstance(settings, dict) \
+            else dict(settings)
+        if passes:
+            values["passes"] = ",".join(passes)
+        adapter = _Update(update, out, images)
+        status = self._library.raw.hairis_render_progressive(
+            self, options(values).encode(), _ptr(out, c_float),
+            _ptr(buffer, c_float) if buffer.size else None, adapter.function, None)
+        stats = RenderStats(_decode(self._library.raw.hairis_last_render_stats()))
+        if status != OK or adapter.error is not None:
+            error = self._library._error("hairis_render_progressive",
+                                         status if status != OK else None, adapter)
+            error.rgba = out
+            error.passes = images
+            error.stats = stats
+            raise error
+        return out, images, stats
+
+
+PASS_CHANNELS = {"depth": 1, "normal": 3, "denoising_albedo": 3, "denoising_normal": 3}
+"""The channels of each pass of ``hairis_render_progressive``."""
+
+
+class _Update(_Progress):
+    """Adapts ``update(progress, samples_done, final, rgba, passes) -> bool`` to
+    ``hairis_update_fn`` (None: no callback); errors are kept as :class:`_Progress` keeps
+    them."""
+
+    def __init__(self, callback, rgba, passes):
+        self.rgba = rgba
+        self.passes = passes
+        self.callback = callback
+        self.cancel_requested = False
+        self.error = None
+        self.function = UPDATE_FN(self._call) if callback is not None else UPDATE_FN()
+
+    def _call(self, _user, progress, samples_done, final):
+        if self.cancel_requested:
+            return 1
+        try:
+            if self.callback(float(progress), int(samples_done), bool(final), self.rgba,
+                             self.passes):
+                self.cancel_requested = True
+        except BaseException as error:  # noqa: B902 - must never propagate into C
+            self.error = error
+            self.cancel_requested = True
+        return 1 if self.cancel_requested else 0
 
 
 # ---- Loading ---------------------------------------------------------------------------------

@@ -128,20 +128,22 @@ void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, 
 using namespace hairis;
 using namespace hairis::capi;
 
-extern "C" {
+namespace {
 
-HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba, hairis_progress_fn progress,
-                             void *user) {
-    return guard_status("hairis_render", [&] {
+// hairis_render and hairis_render_progressive: the scene built with this render's materials,
+// rendered by render/render.h, the statistics kept for hairis_last_render_stats.
+int render_scene(const char *function, hairis_scene *scene, const char *settings, float *rgba, float *passes,
+                 const UpdateFn &update, const RoundSchedule &schedule) {
+    return guard_status(function, [&] {
         const auto start = std::chrono::steady_clock::now();
         require(scene, "scene");
         require(rgba, "rgba");
         RenderOptions o;
         read_options(settings, "render settings", o);
-        if (!scene->has_camera) invalid("scene has no camera: call hairis_scene_set_camera before hairis_render");
+        if (!scene->has_camera) invalid("scene has no camera: call hairis_scene_set_camera before " + std::string(function));
         if (scene->curve_count == 0 && scene->triangle_count == 0)
-            invalid("scene is empty: add curves (hairis_scene_add_curves) or a mesh (hairis_scene_add_mesh) before "
-                    "hairis_render");
+            invalid("scene is empty: add curves (hairis_scene_add_curves) or a mesh (hairis_scene_add_mesh) before " +
+                    std::string(function));
 
         // The scene description with this render's materials. The handle keeps its own copy
         // of the geometry so that it can be rendered again with other settings.
@@ -163,12 +165,8 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
         Expected<Scene> built = Scene::build(std::move(desc));
         if (!built) invalid("scene: " + built.error().message);
 
-        // Called on this thread only (render.h). Whether the render stopped early is what
-        // RenderStats::cancelled says: a non-zero return after the last pass changes nothing.
-        std::function<bool(float)> report;
-        if (progress) report = [&](float fraction) { return progress(user, fraction) == 0; };
         RenderStats stats;
-        const Status status = render(built.value(), o.render, rgba, report, &stats);
+        const Status status = render_progressive(built.value(), o.render, rgba, passes, update, &stats, schedule);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         t_last_stats = format_options({{"seconds", format_number(seconds)},
                                        {"camera_rays", std::to_string(stats.camera_rays)},
@@ -177,15 +175,44 @@ HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *r
                                        {"dropped_samples", std::to_string(stats.dropped_samples)},
                                        {"peak_memory_bytes", std::to_string(stats.peak_memory_bytes + scene->geometry_bytes)},
                                        {"threads", std::to_string(stats.threads)},
-                                       {"cancelled", stats.cancelled ? "1" : "0"}});
+                                       {"cancelled", stats.cancelled ? "1" : "0"},
+                                       {"samples", std::to_string(stats.samples)},
+                                       {"converged_pixels", std::to_string(stats.converged_pixels)}});
         if (stats.cancelled)
-            refuse(HAIRIS_ERROR_CANCELLED, status ? status->message : std::string("cancelled by the progress callback"));
+            refuse(HAIRIS_ERROR_CANCELLED, status ? status->message : std::string("cancelled by the callback"));
         if (status) {
             const bool failure = status->message.rfind("render failed", 0) == 0 || status->message.rfind("render: ", 0) == 0;
             refuse(failure ? HAIRIS_ERROR_INTERNAL : HAIRIS_ERROR_INVALID_ARGUMENT, status->message);
         }
         return HAIRIS_OK;
     });
+}
+
+}  // namespace
+
+extern "C" {
+
+HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba, hairis_progress_fn progress,
+                             void *user) {
+    // Whether the render stopped early is what RenderStats::cancelled says: a non-zero return
+    // at the last call changes nothing.
+    UpdateFn report;
+    if (progress) report = [&](float fraction, int, bool) { return progress(user, fraction) == 0; };
+    // render()'s schedule: progress every 50 ms, no call after a cancel.
+    RoundSchedule schedule;
+    schedule.heartbeat_seconds = 0.05;
+    schedule.final_update_when_cancelled = false;
+    return render_scene("hairis_render", scene, settings, rgba, nullptr, report, schedule);
+}
+
+HAIRIS_API int hairis_render_progressive(hairis_scene *scene, const char *settings, float *rgba, float *passes,
+                                         hairis_update_fn update, void *user) {
+    UpdateFn report;
+    if (update)
+        report = [&](float fraction, int samples_done, bool final) {
+            return update(user, fraction, samples_done, final ? 1 : 0) == 0;
+        };
+    return render_scene("hairis_render_progressive", scene, settings, rgba, passes, report, RoundSchedule{});
 }
 
 HAIRIS_API const char *hairis_last_render_stats(void) { return t_last_stats.c_str(); }

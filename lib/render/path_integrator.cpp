@@ -17,8 +17,19 @@ PathIntegrator::PathIntegrator(const Scene &scene, const RenderSettings &setting
       transparent_crossings_(transparent_crossings(TransparentLimit(settings.transparent_limit),
                                                    settings.max_transparent_bounces)) {}
 
+namespace {
+
+// Cycles' Normal pass at a surface: its shading normal turned towards the viewer, as Cycles
+// turns N at a back-facing hit.
+Vec3 first_hit_normal(const SurfacePoint &sp, Vec3 wo) {
+    const Vec3 n = sp.is_curve ? sp.normal : sp.shading_normal;
+    return dot(sp.normal, wo) < 0.0f ? -n : n;
+}
+
+}  // namespace
+
 Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCounters &counters,
-                       ScratchBuffer &scratch) const {
+                       ScratchBuffer &scratch, FirstHit *first) const {
     const Camera &camera = scene_.camera();
     const LightSet &lights = scene_.lights();
     const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x);
@@ -97,6 +108,7 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
             ray.skip = sp.self;
             continue;
         }
+        if (first && path.vertex == 0) *first = FirstHit{true, sp.position, first_hit_normal(sp, wo), Rgb{0.0f}};
         if (bsdf.black()) break;
 
         // Light a mesh reflects onto the dual vertex the ray left.

@@ -115,6 +115,15 @@ struct PathState {
     }
 };
 
+/// What the data passes read where a camera path first meets a surface that is not
+/// transparent (Huang hair the ray passes is not that surface), as Cycles writes them there.
+struct FirstHit {
+    bool found = false;  ///< false: the camera ray met no such surface
+    Vec3 position;
+    Vec3 normal;  ///< the shading normal in world space, on the side of the ray's origin
+    Rgb albedo;   ///< Cycles' denoising albedo
+};
+
 /// The path tracer of one render (settings validated by render()).
 class PathIntegrator {
   public:
@@ -122,8 +131,9 @@ class PathIntegrator {
 
     /// The radiance of camera sample `sample` through pixel (x, y) (pbrt's Li); alpha receives
     /// the sample's coverage. `scratch` holds each vertex's BSDF.
+    /// `first` (may be null) receives the data passes' first surface.
     Rgb li(int x, int y, std::uint64_t sample, float &alpha, PathCounters &counters,
-           ScratchBuffer &scratch) const;
+           ScratchBuffer &scratch, FirstHit *first = nullptr) const;
 
   private:
     const Scene &scene_;

@@ -40,6 +40,33 @@ namespace hairis {
 Status render(const Scene &scene, const RenderSettings &settings, float *rgba,
               const std::function<bool(float progress)> &progress, RenderStats *stats);
 
+/// What render_progressive reports on the calling thread: the fraction done, the samples every
+/// pixel still being refined has, and whether this is the last call; returning false stops
+/// the render.
+using UpdateFn = std::function<bool(float progress, int samples_done, bool final)>;
+
+/// render() refining the whole image in rounds: after each round `update` (may be empty) is
+/// called with rgba (and `passes`, may be null without passes) holding every pixel's average
+/// so far (hairis_render_progressive in hairis_render.h says what the settings add).
+/// How render_progressive cuts the samples into rounds and calls back (the image does not
+/// depend on it).
+struct RoundSchedule {
+    /// Each round renders 1, 1, 2, 4, ... samples per pixel, fewer when the last round's pace
+    /// says it would take longer than this.
+    double round_seconds = 0.5;
+    /// At most this many samples per round (0: no limit).
+    int max_round_samples = 0;
+    /// All samples in one round (the non-progressive render).
+    bool one_round = false;
+    /// The longest time without an update call.
+    double heartbeat_seconds = 0.5;
+    /// Whether the final update call comes after a cancel too.
+    bool final_update_when_cancelled = true;
+};
+
+Status render_progressive(const Scene &scene, const RenderSettings &settings, float *rgba, float *passes,
+                          const UpdateFn &update, RenderStats *stats, const RoundSchedule &schedule = {});
+
 /// The radiance estimate of one camera sample (for tests and debugging): the path of sample
 /// `sample` through raster position (x + u, y + v) where (u, v) are the sample's own jitter.
 /// `alpha` receives the sample's alpha when not null.

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace hairis {
 
@@ -112,6 +114,16 @@ struct RenderSettings {
     int dual_exact_bounces = 3;
     /// A DualBounceLimit for integrator=dual_scattering: "bounces" or "none".
     int dual_bounce_limit = int(DualBounceLimit::Bounces);
+    /// Seconds after which a progressive render stops at the end of its round; 0: none.
+    double time_limit = 0;
+    /// Cycles' Noise Threshold of adaptive sampling, in [0, 1]; 0: off (render/render.h).
+    float adaptive_threshold = 0;
+    /// Samples no pixel stops before, in [0, 2^24]; 0: Cycles' automatic count.
+    int adaptive_min_samples = 0;
+    /// The pixels rendered, x0,y0,x1,y1 half-open with row 0 the bottom one; 0,0,0,0: all.
+    std::vector<int> region{0, 0, 0, 0};
+    /// The passes render_progressive writes beside rgba, names separated by ',' (render.h).
+    std::string passes;
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -134,6 +146,11 @@ void describe(Fields &f, RenderSettings &s) {
     f.choice("dual_hair_volume", s.dual_hair_volume, {"layer", "unbounded"});
     f.field("dual_exact_bounces", s.dual_exact_bounces, 0, 1024);
     f.choice("dual_bounce_limit", s.dual_bounce_limit, {"bounces", "none"});
+    f.field("time_limit", s.time_limit, 0.0, 3.4e38);
+    f.field("adaptive_threshold", s.adaptive_threshold, 0.0, 1.0);
+    f.field("adaptive_min_samples", s.adaptive_min_samples, 0, 1 << 24);
+    f.field("region", s.region, 4, 0, 65536);
+    f.field("passes", s.passes);
 }
 
 /// What a render did.
@@ -148,6 +165,8 @@ struct RenderStats {
     float progress = 0;                   ///< fraction of the work done when render() returned
     std::uint64_t peak_memory_bytes = 0;  ///< scene estimate + render buffers
     int threads = 0;                      ///< threads actually allowed
+    int samples = 0;                      ///< the most samples a pixel got
+    std::uint64_t converged_pixels = 0;   ///< pixels adaptive sampling stopped early
 };
 
 }  // namespace hairis

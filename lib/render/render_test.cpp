@@ -1196,6 +1196,239 @@ TEST(Render, CancelStopsPromptlyAndSaysSo) {
     EXPECT_GT(sum, 0.0);  // finished samples were written
 }
 
+// ---- Progressive rendering -------------------------------------------------------------------
+
+// The image as a non-progressive renderer makes it: each pixel's samples 0..n-1 summed in
+// double in sample order, times 1/n.
+std::vector<float> per_sample_reference(const Scene &scene, const RenderSettings &s) {
+    const int w = scene.camera().width(), h = scene.camera().height();
+    std::vector<float> rgba(std::size_t(w) * std::size_t(h) * 4);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double sum[4] = {0, 0, 0, 0};
+            for (int k = 0; k < s.samples; ++k) {
+                float alpha = 1.0f;
+                const Rgb l = render_sample(scene, s, x, y, std::uint64_t(k), &alpha);
+                sum[0] += l.r;
+                sum[1] += l.g;
+                sum[2] += l.b;
+                sum[3] += alpha;
+            }
+            const double inv = 1.0 / double(s.samples);
+            for (int c = 0; c < 4; ++c) rgba[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 4 + std::size_t(c)] = float(sum[c] * inv);
+        }
+    return rgba;
+}
+
+std::vector<float> render_rounds(const Scene &scene, const RenderSettings &s, const RoundSchedule &schedule,
+                                 const UpdateFn &update = {}, RenderStats *stats = nullptr) {
+    std::vector<float> rgba(std::size_t(scene.camera().width()) * scene.camera().height() * 4, -1.0f);
+    const Status st = render_progressive(scene, s, rgba.data(), nullptr, update, stats, schedule);
+    EXPECT_FALSE(st.has_value()) << (st ? st->message : "");
+    return rgba;
+}
+
+TEST(Progressive, RoundsGiveTheOneRoundImageBitForBit) {
+    const Scene scene = hair_tuft_scene(12, 10);
+    RenderSettings s;
+    s.samples = 5;
+    s.seed = 77;
+    s.threads = 2;
+    s.tile_size = 4;
+    const auto reference = per_sample_reference(scene, s);
+    RoundSchedule one;
+    one.one_round = true;
+    EXPECT_TRUE(same_bits(render_rounds(scene, s, one), reference));
+    RoundSchedule each;
+    each.max_round_samples = 1;
+    std::vector<int> seen;
+    int finals = 0;
+    const auto rounds = render_rounds(scene, s, each, [&](float, int done, bool final) {
+        if (final) ++finals;
+        else if (seen.empty() || seen.back() != done) seen.push_back(done);
+        return true;
+    });
+    EXPECT_TRUE(same_bits(rounds, reference));
+    EXPECT_EQ(finals, 1);
+    // Every round but the last is shown (and 0 when a call came before the first round ended).
+    if (!seen.empty() && seen.front() == 0) seen.erase(seen.begin());
+    const std::vector<int> want{1, 2, 3, 4};
+    EXPECT_EQ(seen, want);
+    s.samples = 6;  // another image: the comparison can fail
+    EXPECT_FALSE(same_bits(render_rounds(scene, s, one), reference));
+}
+
+TEST(Progressive, UpdateShowsTheAverageOfTheSamplesDone) {
+    const Scene scene = hair_tuft_scene(10, 8);
+    RenderSettings s;
+    s.samples = 4;
+    RoundSchedule each;
+    each.max_round_samples = 1;
+    std::vector<float> rgba(10 * 8 * 4), after_two;
+    const Status st = render_progressive(scene, s, rgba.data(), nullptr, [&](float, int done, bool) {
+        if (done == 2 && after_two.empty()) after_two = rgba;
+        return true;
+    }, nullptr, each);
+    ASSERT_FALSE(st.has_value());
+    s.samples = 2;
+    EXPECT_TRUE(same_bits(after_two, per_sample_reference(scene, s)));
+    EXPECT_FALSE(same_bits(after_two, rgba));
+}
+
+TEST(Progressive, CancelFromUpdateKeepsTheRoundsDone) {
+    const Scene scene = hair_tuft_scene(10, 8);
+    RenderSettings s;
+    s.samples = 1 << 20;
+    RoundSchedule each;
+    each.max_round_samples = 1;
+    std::vector<float> rgba(10 * 8 * 4);
+    RenderStats stats;
+    int finals = 0;
+    const Status st = render_progressive(scene, s, rgba.data(), nullptr, [&](float, int done, bool final) {
+        finals += final;
+        return done < 3;
+    }, &stats, each);
+    ASSERT_TRUE(st.has_value());
+    EXPECT_TRUE(stats.cancelled);
+    EXPECT_EQ(finals, 1);
+    EXPECT_GE(stats.samples, 3);
+    EXPECT_LT(stats.samples, 100);
+    s.samples = 3;
+    const auto three = per_sample_reference(scene, s);
+    // Pixels with exactly three samples are the 3-sample image's.
+    EXPECT_EQ(stats.camera_rays, std::uint64_t(3 * 80)) << "cancelled between rounds";
+    EXPECT_TRUE(same_bits(rgba, three));
+}
+
+TEST(Progressive, RegionPixelsAreTheFullRendersAndTheRestIsZero) {
+    const Scene scene = hair_tuft_scene(14, 11);
+    RenderSettings s;
+    s.samples = 3;
+    s.tile_size = 4;
+    const auto full = render_ok(scene, s);
+    s.region = {3, 2, 10, 7};
+    RenderStats stats;
+    const auto part = render_ok(scene, s, &stats);
+    EXPECT_EQ(stats.camera_rays, std::uint64_t(7 * 5 * 3));
+    for (int y = 0; y < 11; ++y)
+        for (int x = 0; x < 14; ++x)
+            for (int c = 0; c < 4; ++c) {
+                const bool inside = x >= 3 && x < 10 && y >= 2 && y < 7;
+                const float want = inside ? at(full, 14, x, y, c) : 0.0f;
+                ASSERT_TRUE(same_bits(std::vector<float>{at(part, 14, x, y, c)}, std::vector<float>{want}))
+                    << x << "," << y << "," << c;
+            }
+    std::vector<float> rgba(14 * 11 * 4);
+    for (const std::vector<int> &bad : {std::vector<int>{3, 2, 3, 7}, {0, 0, 15, 11}, {1, 2, 3}}) {
+        s.region = bad;
+        const Status st = render(scene, s, rgba.data(), {}, nullptr);
+        ASSERT_TRUE(st.has_value());
+        EXPECT_NE(st->message.find("region"), std::string::npos) << st->message;
+    }
+}
+
+// A scene that is the constant world everywhere: every sample of a pixel is the same.
+Scene world_only(int w, int h) {
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}};
+    d.meshes = {quad(0.1f, 0.0f, 0)};
+    for (Vec3 &p : d.meshes[0].positions) p = p + Vec3{100, 0, 0};  // out of view
+    d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
+    d.camera = ortho_down(1, 1, w, h);
+    return build(std::move(d));
+}
+
+TEST(Progressive, AdaptiveSamplingChecksAsCyclesSchedules) {
+    const Scene scene = world_only(6, 5);
+    RenderSettings s;
+    s.samples = 500;
+    s.adaptive_threshold = 0.01f;
+    RenderStats stats;
+    render_ok(scene, s, &stats);
+    // Cycles' automatic minimum for 0.01 is 64; the first check follows sample index
+    // (64 + 1) | 15 = 79, where every pixel (no noise) stops.
+    EXPECT_EQ(stats.samples, 80);
+    EXPECT_EQ(stats.converged_pixels, 30u);
+    EXPECT_EQ(stats.camera_rays, std::uint64_t(30 * 80));
+    s.adaptive_min_samples = 20;  // first check after index (20 + 1) | 15 = 31
+    render_ok(scene, s, &stats);
+    EXPECT_EQ(stats.samples, 32);
+    s.adaptive_threshold = 0;
+    s.samples = 40;
+    render_ok(scene, s, &stats);
+    EXPECT_EQ(stats.samples, 40);
+    EXPECT_EQ(stats.converged_pixels, 0u);
+}
+
+TEST(Progressive, AdaptiveSamplingStopsQuietPixelsFirstAndIsDeterministic) {
+    const Scene scene = hair_tuft_scene(16, 12);
+    RenderSettings s;
+    s.samples = 256;
+    s.adaptive_threshold = 0.05f;
+    s.adaptive_min_samples = 16;
+    s.threads = 1;
+    RenderStats one_stats, two_stats;
+    const auto one = render_ok(scene, s, &one_stats);
+    s.threads = 2;
+    s.tile_size = 5;
+    const auto two = render_ok(scene, s, &two_stats);
+    EXPECT_TRUE(same_bits(one, two));
+    EXPECT_EQ(one_stats.camera_rays, two_stats.camera_rays);
+    EXPECT_GT(one_stats.converged_pixels, 0u);
+    EXPECT_LT(one_stats.camera_rays, std::uint64_t(16 * 12 * 256));
+    s.adaptive_threshold = 0.0f;
+    RenderStats full;
+    render_ok(scene, s, &full);
+    EXPECT_GT(full.camera_rays, one_stats.camera_rays);
+}
+
+TEST(Progressive, TimeLimitStopsAfterTheRoundThatPassesIt) {
+    const Scene scene = hair_tuft_scene(16, 12);
+    RenderSettings s;
+    s.samples = 1 << 24;
+    s.time_limit = 0.2;
+    RenderStats stats;
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto img = render_ok(scene, s, &stats);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_FALSE(stats.cancelled);
+    EXPECT_GE(seconds, 0.2);
+    EXPECT_LT(seconds, 2.0);
+    EXPECT_GT(stats.samples, 0);
+    EXPECT_LT(stats.samples, 1 << 24);
+    EXPECT_EQ(stats.camera_rays, std::uint64_t(16 * 12) * std::uint64_t(stats.samples));
+}
+
+TEST(Progressive, DepthAndNormalPassesAsCyclesWritesThem) {
+    // A quad facing up at z = 0.5 seen from z = 5 covers the middle of the image.
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{}};
+    d.meshes = {quad(0.5f, 0.5f, 0)};
+    d.world = {Rgb(0.2f), 1.0f};
+    d.camera = ortho_down(1, 1, 8, 8);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 2;
+    s.passes = "normal,depth";
+    std::vector<float> rgba(8 * 8 * 4), passes(8 * 8 * 4, -1.0f);
+    ASSERT_FALSE(render_progressive(scene, s, rgba.data(), passes.data(), {}, nullptr).has_value());
+    const float *normal = passes.data(), *depth = passes.data() + 8 * 8 * 3;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const std::size_t p = std::size_t(y) * 8 + std::size_t(x);
+            const bool hit = x >= 2 && x < 6 && y >= 2 && y < 6;
+            EXPECT_FLOAT_EQ(depth[p], hit ? 4.5f : 1e10f) << x << "," << y;
+            EXPECT_FLOAT_EQ(normal[p * 3 + 2], hit ? 1.0f : 0.0f) << x << "," << y;
+            EXPECT_FLOAT_EQ(normal[p * 3 + 0], 0.0f);
+        }
+    s.passes = "depth,nonsense";
+    const Status st = render_progressive(scene, s, rgba.data(), passes.data(), {}, nullptr);
+    ASSERT_TRUE(st.has_value());
+    EXPECT_NE(st->message.find("nonsense"), std::string::npos);
+    s.passes = "depth";
+    EXPECT_TRUE(render_progressive(scene, s, rgba.data(), nullptr, {}, nullptr).has_value());
+}
+
 class NanPoint final : public SamplerPoint {
   public:
     std::optional<DirectionSample> sample(float u0, float u1, float) const override {

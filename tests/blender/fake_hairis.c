@@ -11,7 +11,8 @@
  *
  * Test hooks (environment variables):
  *   HAIRIS_FAKE_API_VERSION   value returned by hairis_api_version (default HAIRIS_API_VERSION)
- *   HAIRIS_FAKE_ROW_DELAY_MS  sleep per rendered row (to test cancelling)
+ *   HAIRIS_FAKE_ROW_DELAY_MS  sleep per rendered row (to test cancelling; hairis_render_progressive
+ *                             calls its update before every row, with samples_done 0 until the end)
  *   HAIRIS_FAKE_SUMMARY       hairis_render appends a summary of the scene to this file
  *   HAIRIS_FAKE_NOISE         relative noise of the rendered pixels (default 0: exact)
  */
@@ -110,7 +111,8 @@ static const char *const kinds[][2] = {
                "max_transmission_bounces=12;max_transparent_bounces=8;transparent_limit=plus_one;"
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "huang_sampling=strategy;dual_hair_volume=layer;dual_exact_bounces=3;"
-               "dual_bounce_limit=bounces;strategy=table;"
+               "dual_bounce_limit=bounces;time_limit=0;adaptive_threshold=0;"
+               "adaptive_min_samples=0;region=0,0,0,0;passes=;strategy=table;"
                "multiple_weight=0;n_h=2;"
                "curve_backfaces=ignore"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -1353,8 +1355,35 @@ typedef struct render_settings {
     unsigned long long seed;
     int integrator, strategy, film_transparent, curve_backfaces, huang_sampling, transparent_limit,
         dual_hair_volume, dual_bounce_limit;
-    double multiple_weight;
+    double multiple_weight, time_limit, adaptive_threshold;
+    long long adaptive_min_samples;
+    double region[4];
+    /* The passes asked for (0 depth, 1 normal, 2 denoising_albedo, 3 denoising_normal). */
+    int pass_count, pass_kind[16];
 } render_settings;
+
+static const char *const pass_names[4] = {"depth", "normal", "denoising_albedo", "denoising_normal"};
+
+/* "name,name,..." of pass_names into r->pass_kind. */
+static int read_passes(const char *text, render_settings *r)
+{
+    r->pass_count = 0;
+    while (*text) {
+        const char *end = strchr(text, ',');
+        size_t n = end ? (size_t)(end - text) : strlen(text);
+        int kind = -1;
+        for (int k = 0; k < 4; ++k)
+            if (strlen(pass_names[k]) == n && strncmp(text, pass_names[k], n) == 0) kind = k;
+        if (kind < 0 || r->pass_count == 16)
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                        "render settings: passes must be names among depth, normal, "
+                        "denoising_albedo, denoising_normal separated by ',' (got \"%.*s\")",
+                        (int)n, text);
+        r->pass_kind[r->pass_count++] = kind;
+        text += n + (end ? 1 : 0);
+    }
+    return HAIRIS_OK;
+}
 
 static int read_render_settings(const char *text, render_settings *r)
 {
@@ -1384,6 +1413,11 @@ static int read_render_settings(const char *text, render_settings *r)
         word(&o, "dual_hair_volume", volumes, 2, &r->dual_hair_volume) != HAIRIS_OK ||
         integer_in(&o, "dual_exact_bounces", 0, 1024, &r->dual_exact_bounces) != HAIRIS_OK ||
         word(&o, "dual_bounce_limit", bounce_limits, 2, &r->dual_bounce_limit) != HAIRIS_OK ||
+        number_in(&o, "time_limit", 0.0, 3.4e38, &r->time_limit) != HAIRIS_OK ||
+        number_in(&o, "adaptive_threshold", 0.0, 1.0, &r->adaptive_threshold) != HAIRIS_OK ||
+        integer_in(&o, "adaptive_min_samples", 0, 1 << 24, &r->adaptive_min_samples) != HAIRIS_OK ||
+        numbers(&o, "region", r->region, 4) != HAIRIS_OK ||
+        read_passes(value_of(&o, "passes"), r) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
     r->film_transparent %= 2;
@@ -1439,17 +1473,18 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
 }
 
 static void set_stats(double seconds, unsigned long long camera_rays, long long threads,
-                      int cancelled)
+                      int cancelled, unsigned long long samples)
 {
     snprintf(render_stats, sizeof render_stats,
              "seconds=%.17g;camera_rays=%llu;rays=%llu;shadow_rays=0;dropped_samples=0;"
-             "peak_memory_bytes=%zu;threads=%lld;cancelled=%d",
+             "peak_memory_bytes=%zu;threads=%lld;cancelled=%d;samples=%llu;converged_pixels=0",
              seconds, camera_rays, camera_rays, sizeof(hairis_scene), threads > 0 ? threads : 1,
-             cancelled);
+             cancelled, samples);
 }
 
-int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_progress_fn progress,
-                  void *user)
+/* hairis_render (update NULL) and hairis_render_progressive (progress NULL). */
+static int render_common(hairis_scene *s, const char *settings, float *rgba, float *passes,
+                         hairis_progress_fn progress, hairis_update_fn update, void *user)
 {
     if (!s || !rgba) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene and rgba must not be NULL");
     render_settings r;
@@ -1489,6 +1524,21 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
                 return fail(HAIRIS_ERROR_INVALID_TABLE,
                             "material %d (hair): the tables were baked for other parameters", i);
         }
+    /* The region: whole numbers, inside the image; 0,0,0,0 is the whole image. */
+    int x0 = 0, y0 = 0, x1 = s->width, y1 = s->height;
+    if (r.region[0] != 0 || r.region[1] != 0 || r.region[2] != 0 || r.region[3] != 0) {
+        for (int k = 0; k < 4; ++k)
+            if (r.region[k] != floor(r.region[k]))
+                return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "render settings: region must be 4 integers");
+        x0 = (int)r.region[0], y0 = (int)r.region[1], x1 = (int)r.region[2], y1 = (int)r.region[3];
+        if (x0 < 0 || y0 < 0 || x1 > s->width || y1 > s->height || x0 >= x1 || y0 >= y1)
+            return fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                        "render settings: region must be x0,y0,x1,y1 with 0 <= x0 < x1 <= %d and "
+                        "0 <= y0 < y1 <= %d",
+                        s->width, s->height);
+    }
+    if (r.pass_count > 0 && !passes)
+        return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "passes must not be NULL when settings ask for passes");
     write_summary(s, &r);
     double start = now_seconds();
     const char *delay_text = getenv("HAIRIS_FAKE_ROW_DELAY_MS");
@@ -1498,14 +1548,28 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
     const char *noise_text = getenv("HAIRIS_FAKE_NOISE");
     float noise = noise_text ? (float)atof(noise_text) : 0.0f;
     int width = s->width, height = s->height;
-    for (int y = 0; y < height; ++y) {
-        if (progress && progress(user, (float)y / (float)height)) {
-            set_stats(now_seconds() - start, (unsigned long long)y * (unsigned long long)width *
+    memset(rgba, 0, sizeof(float) * 4 * (size_t)width * (size_t)height);
+    /* Every camera ray misses: depth 1e10 (Cycles' "nothing"), the other passes 0. */
+    float *pass = passes;
+    for (int k = 0; k < r.pass_count; ++k) {
+        const size_t n = (size_t)width * (size_t)height * (r.pass_kind[k] == 0 ? 1 : 3);
+        for (size_t i = 0; i < n; ++i) pass[i] = 0.0f;
+        if (r.pass_kind[k] == 0)
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) pass[(size_t)y * (size_t)width + (size_t)x] = 1e10f;
+        pass += n;
+    }
+    for (int y = y0; y < y1; ++y) {
+        const float fraction = (float)(y - y0) / (float)(y1 - y0);
+        if ((progress && progress(user, fraction)) ||
+            (update && update(user, fraction, 0, 0))) {
+            set_stats(now_seconds() - start, (unsigned long long)(y - y0) *
+                                                 (unsigned long long)(x1 - x0) *
                                                  (unsigned long long)r.samples,
-                      r.threads, 1);
+                      r.threads, 1, 0);
             return fail(HAIRIS_ERROR_CANCELLED, "render cancelled at row %d of %d", y, height);
         }
-        for (int x = 0; x < width; ++x) {
+        for (int x = x0; x < x1; ++x) {
             float *p = rgba + 4 * ((size_t)y * (size_t)width + (size_t)x);
             float factor = 1.0f;
             if (noise > 0.0f) {
@@ -1527,11 +1591,25 @@ int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_pro
         sleep_ms(delay);
     }
     if (progress) progress(user, 1.0f);
+    if (update) update(user, 1.0f, (int)r.samples, 1);
     set_stats(now_seconds() - start,
-              (unsigned long long)width * (unsigned long long)height * (unsigned long long)r.samples,
-              r.threads, 0);
+              (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) *
+                  (unsigned long long)r.samples,
+              r.threads, 0, (unsigned long long)r.samples);
     clear_error();
     return HAIRIS_OK;
+}
+
+int hairis_render(hairis_scene *s, const char *settings, float *rgba, hairis_progress_fn progress,
+                  void *user)
+{
+    return render_common(s, settings, rgba, NULL, progress, NULL, user);
+}
+
+int hairis_render_progressive(hairis_scene *s, const char *settings, float *rgba, float *passes,
+                              hairis_update_fn update, void *user)
+{
+    return render_common(s, settings, rgba, passes, NULL, update, user);
 }
 
 const char *hairis_last_render_stats(void) { return render_stats; }

@@ -54,6 +54,7 @@ KINDS = ("chiang", "huang", "marschner", "bake", "sampler", "diffuse", "principl
 # library is called through here, so the binding Blender uses is the one these tests exercise.
 PROTOTYPES = None
 PROGRESS_FN = None
+UPDATE_FN = None
 
 F = POINTER(c_float)
 U32 = POINTER(c_uint32)
@@ -776,6 +777,41 @@ class TestRender(unittest.TestCase):
                 self.assertTrue(0 < float(stats["seconds"]) < 600)
         lib().hairis_scene_destroy(scene)
 
+    def test_progressive_render_matches_hairis_render(self):
+        # hairis_render_progressive through the add-on's UPDATE_FN: the same image as
+        # hairis_render, updates on this thread with the samples done, passes where asked,
+        # and a non-zero return stops it.
+        scene = self.make_scene(None)
+        settings = self.settings("analytic", 6)
+        plain = np.full((self.H, self.W, 4), -1, np.float32)
+        self.assertEqual(lib().hairis_render(scene, settings, ptr(plain), PROGRESS_FN(), None),
+                         OK, last_error())
+        rgba = np.full((self.H, self.W, 4), -1, np.float32)
+        passes = np.full((self.H, self.W, 4), -1, np.float32)
+        calls = []
+        callback = UPDATE_FN(lambda user, progress, done, final: calls.append((done, final)) or 0)
+        status = lib().hairis_render_progressive(scene, settings + b";passes=depth,normal",
+                                                 ptr(rgba), ptr(passes), callback, None)
+        self.assertEqual(status, OK, last_error())
+        self.assertTrue(np.array_equal(rgba.view(np.uint32), plain.view(np.uint32)))
+        self.assertEqual(calls[-1], (6, 1))
+        self.assertEqual([c for c in calls if c[1]], [(6, 1)])
+        depth = passes.reshape(-1)[:self.W * self.H]
+        self.assertTrue(np.all(depth > 0))
+        self.assertTrue(np.any(depth < 1e10))  # the hair and the mesh are seen
+        stats = items(lib().hairis_last_render_stats().decode())
+        self.assertEqual(int(stats["samples"]), 6)
+        self.assertEqual(int(stats["converged_pixels"]), 0)
+        stop = UPDATE_FN(lambda user, progress, done, final: 1)
+        status = lib().hairis_render_progressive(scene, self.settings("analytic", 1 << 20),
+                                                 ptr(rgba), None, stop, None)
+        self.assertEqual(status, ERROR_CANCELLED)
+        status = lib().hairis_render_progressive(scene, settings + b";passes=depth", ptr(rgba),
+                                                 None, UPDATE_FN(), None)
+        self.assertEqual(status, ERROR_INVALID_ARGUMENT)
+        self.assertIn("passes", last_error())
+        lib().hairis_scene_destroy(scene)
+
     def test_huang_hair_on_oriented_curves(self):
         # A Huang material renders with the uniform strategy; curves may carry normals, which
         # are checked (and their options refused by name) like every other array.
@@ -1107,7 +1143,7 @@ class TestSurfaces(unittest.TestCase):
 
 
 def main():
-    global OPTIONS, PROTOTYPES, PROGRESS_FN
+    global OPTIONS, PROTOTYPES, PROGRESS_FN, UPDATE_FN
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--library", required=True, help="libhairis.so")
     parser.add_argument("--header", action="append", default=[],
@@ -1125,6 +1161,7 @@ def main():
     native = load_native(OPTIONS.addon_native)
     PROTOTYPES = native.PROTOTYPES
     PROGRESS_FN = native.PROGRESS_FN
+    UPDATE_FN = native.UPDATE_FN
     program = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2)
     result = program.result
     failed = len(result.failures) + len(result.errors)

@@ -204,8 +204,55 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
                              hairis_progress_fn progress, void *user);
-/** What the calling thread's last hairis_render did, as options: seconds, camera_rays, rays,
- * shadow_rays, dropped_samples, peak_memory_bytes, threads; "" before any render. */
+/**
+ * Called by hairis_render_progressive on the calling thread: progress in [0, 1], samples_done
+ * the samples every pixel still being refined has (it grows exactly when rgba changed), final
+ * 1 on the last call. Return non-zero to stop the render, keeping what it has.
+ */
+typedef int (*hairis_update_fn)(void *user, float progress, int samples_done, int final);
+/**
+ * Renders as hairis_render, refining the whole image: the samples are rendered in rounds over
+ * every pixel (1, 1, 2, 4, ... samples per pixel, each round short enough for a prompt
+ * update), and after each round rgba (and passes) hold, for every pixel, the average of the
+ * samples it has so far. Each pixel sums its samples in sample order, so the finished image
+ * is bit for bit hairis_render's with the same settings, for any thread count and tile size.
+ * `update` (may be NULL) is called on the calling thread after every round and at least every
+ * half second in between (rgba unchanged then), and once at the end with final = 1; between
+ * calls the caller must not read rgba or passes. Non-zero from it stops the render promptly
+ * (each tile in flight finishes its current sample) and returns HAIRIS_ERROR_CANCELLED, rgba
+ * and passes holding each pixel's average of the samples it got. Settings are hairis_render's
+ * and these (which hairis_render takes too, all but passes):
+ *  - time_limit (seconds, >= 0; default 0 = none): as Cycles' Time Limit, the render stops
+ *    after the round in which the limit is passed (HAIRIS_OK, the image of the samples done);
+ *  - adaptive_threshold (in [0, 1]; default 0 = off): Cycles' Noise Threshold. From the sample
+ *    after adaptive_min_samples on, every 16 samples, a pixel whose error estimate is below
+ *    the threshold stops: the estimate is Cycles' |average - average of every other
+ *    sample| summed over R, G, B, divided by sqrt(R + G + B) below 1 and by R + G + B
+ *    above, against 5 × the threshold; a converged pixel whose neighbour along a row or
+ *    column has not converged is sampled on, as Cycles' filter does. Decisions depend only
+ *    on the pixels' samples, so the image is the same for a given seed whatever the threads;
+ *  - adaptive_min_samples (in [0, 2^24]; default 0 = automatic as Cycles: max(4,
+ *    ceil(16 / threshold^0.3))): no pixel stops before it has more samples than this;
+ *  - region = "x0,y0,x1,y1" (pixels, half-open, rows counted as in rgba: bottom row 0;
+ *    default "0,0,0,0" = the whole image): only these pixels are rendered, the others are 0
+ *    in rgba and passes; a region's pixels equal the full render's bit for bit;
+ *  - passes = a comma list of depth and normal (default "": none), as Cycles writes them at
+ *    the first surface that is not transparent (Huang hair the ray passes is not it): depth
+ *    (1 channel) the distance from the camera along its view axis of sample 0's surface,
+ *    1e10 where it found none, not averaged (Cycles' Z pass); normal (3) the shading normal
+ *    in world space turned towards the viewer, 0 where the ray found nothing, averaged over
+ *    the pixel's samples as rgba. The names denoising_albedo and denoising_normal are
+ *    reserved for Cycles' denoising passes and refused for now.
+ * `passes` (may be NULL when passes is empty) holds width·height·K floats, K the sum of the
+ * channels of the passes in the order given: all pixels of the first pass (each pixel's
+ * channels together, bottom row first), then of the next. hairis_last_render_stats adds
+ * samples (the most any pixel got) and converged_pixels (pixels adaptive sampling stopped).
+ */
+HAIRIS_API int hairis_render_progressive(hairis_scene *scene, const char *settings, float *rgba,
+                                         float *passes, hairis_update_fn update, void *user);
+/** What the calling thread's last hairis_render or hairis_render_progressive did, as options:
+ * seconds, camera_rays, rays, shadow_rays, dropped_samples, peak_memory_bytes, threads,
+ * cancelled, samples, converged_pixels; "" before any render. */
 HAIRIS_API const char *hairis_last_render_stats(void);
 
 #ifdef __cplusplus
