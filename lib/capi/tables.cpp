@@ -1,6 +1,9 @@
 // C API: sampling tables — bake, write, load (file or memory), metadata and fiber matching.
 #include <algorithm>
 #include <cerrno>
+#include <list>
+#include <memory>
+#include <mutex>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -46,6 +49,42 @@ hairis_tables *make_tables(TableSet set) {
     tables->sampling = std::move(sampling).value();
     tables->set = std::move(set);
     return tables.release();
+}
+
+// Decoded table files by the SHA-1 of their bytes: a renderer that loads the same file for every
+// render (the add-on does) decodes and validates it once. A changed byte is a new key, so a
+// damaged file is decoded, and refused, like any other.
+class DecodedCache {
+  public:
+    hairis_tables *load(const void *data, size_t size, const std::string &where) {
+        const std::string key = std::to_string(size) + ":" + table_file_digest(data, size);
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            for (auto it = entries_.begin(); it != entries_.end(); ++it)
+                if (it->first == key) {
+                    entries_.splice(entries_.begin(), entries_, it);  // most recent first
+                    return new hairis_tables(*it->second);
+                }
+        }
+        Expected<TableSet> set = decode_table_exr(data, size);
+        if (!set) refuse(HAIRIS_ERROR_INVALID_TABLE, set.error().message + " (in " + where + ")");
+        std::unique_ptr<hairis_tables> made(make_tables(std::move(set).value()));
+        auto shared = std::make_shared<const hairis_tables>(*made);
+        std::lock_guard<std::mutex> lock(mutex_);
+        entries_.emplace_front(key, std::move(shared));
+        if (entries_.size() > kEntries) entries_.pop_back();
+        return made.release();
+    }
+
+  private:
+    static constexpr size_t kEntries = 8;
+    std::mutex mutex_;
+    std::list<std::pair<std::string, std::shared_ptr<const hairis_tables>>> entries_;
+};
+
+DecodedCache &decoded_cache() {
+    static DecodedCache cache;
+    return cache;
 }
 
 // Reads a whole file; the error names the file and the system's reason.
@@ -118,11 +157,7 @@ HAIRIS_API hairis_tables *hairis_tables_load_file(const char *path) {
         require(path, "path");
         if (*path == '\0') invalid("path must not be empty");
         const std::vector<unsigned char> bytes = read_file(path);
-        Expected<TableSet> set = decode_table_exr(bytes.data(), bytes.size());
-        if (!set)
-            refuse(HAIRIS_ERROR_INVALID_TABLE,
-                   set.error().message + " (in \"" + std::string(path) + "\")");
-        return make_tables(std::move(set).value());
+        return decoded_cache().load(bytes.data(), bytes.size(), "\"" + std::string(path) + "\"");
     });
 }
 
@@ -130,9 +165,7 @@ HAIRIS_API hairis_tables *hairis_tables_load_memory(const void *data, size_t siz
     return guard_handle<hairis_tables>("hairis_tables_load_memory", [&] {
         require(data, "data");
         if (size == 0) invalid("size must be > 0 (an empty buffer is not a table file)");
-        Expected<TableSet> set = decode_table_exr(data, size);
-        if (!set) refuse(HAIRIS_ERROR_INVALID_TABLE, set.error().message + " (in the buffer)");
-        return make_tables(std::move(set).value());
+        return decoded_cache().load(data, size, "the buffer");
     });
 }
 

@@ -473,6 +473,11 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, b
 
 }  // namespace
 
+std::string table_file_digest(const void *data, size_t size) {
+    OIIO::SHA1 sha(data, size);
+    return sha.digest();
+}
+
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     if (Status s = t.validate()) return *s;
     const Layout layout = Layout::of(t);
