@@ -13,7 +13,7 @@ what the running Blender has, never from socket indices), so the other modules r
 - ``use_nodes`` of materials and worlds is deprecated from 5.0 (always on; reading it warns):
   :func:`uses_nodes`;
 - the Principled Hair BSDF's ``model`` (4.0+: 'CHIANG' or 'HUANG'; 3.4 has only Chiang);
-- a render pass's ``rect.foreach_set``: (pixels, 4) rows in 3.4, a flat float buffer in 4.5+:
+- a render pass's ``rect.foreach_set``: (pixels, channels) rows in 3.4, a flat float buffer in 4.5+:
   :func:`set_pass_pixels`;
 - how Cycles converts lights (``hairis_scene_add_light``'s ``cycles`` option): as 3.4 before
   4.0, as 4.5 from 4.0 on (area lights 4/π brighter, suns a cone of constant radiance, spots
@@ -104,12 +104,13 @@ def hair_model(node):
 
 
 def set_pass_pixels(render_pass, rgba):
-    """Writes (height, width, 4) float pixels into a RenderPass (whichever layout it takes)."""
+    """Writes (height, width, channels) float pixels into a RenderPass (whichever layout it
+    takes)."""
     pixels = np.ascontiguousarray(rgba, np.float32)
     try:
         render_pass.rect.foreach_set(pixels.reshape(-1))
     except (TypeError, ValueError):
-        render_pass.rect.foreach_set(pixels.reshape(-1, 4))
+        render_pass.rect.foreach_set(pixels.reshape(-1, pixels.shape[-1]))
 
 
 CYCLES_4_SURFACES = (4, 0, 0)

@@ -10,11 +10,12 @@ Blender keeps running.
 import os
 import time
 import traceback
+import weakref
 
 import bpy
 import numpy as np
 
-from . import compat, export, native, tables
+from . import compat, compositor, export, native, tables, viewport
 
 DUMP_ENV = "HAIRIS_EXPORT_DUMP"
 """When set, each render writes its exported scene to this ``.npz`` path (debugging, tests)."""
@@ -97,23 +98,136 @@ def render_settings(settings):
             "curve_backfaces": compat.curve_backfaces()}
 
 
+def adaptive_threshold(settings):
+    """The Noise Threshold the library gets: 0 (off) without adaptive sampling, else the
+    setting, or where that is 0 Cycles' automatic threshold from the sample count."""
+    if not settings.use_adaptive_sampling:
+        return 0.0
+    if settings.adaptive_threshold > 0.0:
+        return float(settings.adaptive_threshold)
+    return max(0.001, 1.0 / max(int(settings.samples), 1))
+
+
+def progressive_settings(settings, region=None, passes=()):
+    """:func:`render_settings` with the final render's Noise Threshold, Min Samples, Time
+    Limit, the Render Region (x0, y0, x1, y1 pixels, bottom row 0) and the library's passes."""
+    values = render_settings(settings)
+    values.update(adaptive_threshold=adaptive_threshold(settings),
+                  adaptive_min_samples=int(settings.adaptive_min_samples),
+                  time_limit=float(settings.time_limit))
+    if region is not None:
+        values["region"] = "%d,%d,%d,%d" % tuple(region)
+    if passes:
+        values["passes"] = ",".join(passes)
+    return values
+
+
+PASSES = (
+    ("depth", "Depth", "Z", "VALUE"),
+    ("normal", "Normal", "XYZ", "VECTOR"),
+    ("denoising_normal", "Denoising Normal", "XYZ", "VECTOR"),
+    ("denoising_albedo", "Denoising Albedo", "RGB", "COLOR"),
+)
+"""The library's passes: its name, Blender's pass name and channels as Cycles registers them."""
+
+
+def enabled_passes(scene, view_layer):
+    """The library names of the passes the view layer asks for, as Cycles reads them: Z and
+    Normal from the view layer, the denoising passes from Cycles' Store Denoising Passes or
+    Hairis' Denoise."""
+    names = []
+    if view_layer.use_pass_z:
+        names.append("depth")
+    if view_layer.use_pass_normal:
+        names.append("normal")
+    cycles = getattr(view_layer, "cycles", None)
+    store = bool(getattr(cycles, "denoising_store_passes", False))
+    if store or (scene.hairis.use_denoising and compositor.denoising_available()):
+        names += ["denoising_normal", "denoising_albedo"]
+    return names
+
+
+def pass_channels(name):
+    """The number of channels of the library's pass ``name``."""
+    for library_name, _blender_name, channels, _kind in PASSES:
+        if library_name == name:
+            return len(channels)
+    raise KeyError(name)
+
+
+def render_region(render, width, height):
+    """The Render Region in pixels (x0, y0, x1, y1, bottom row 0), as Blender rounds it, or
+    None when the whole frame renders."""
+    if not render.use_border:
+        return None
+    x0, x1 = (int(np.float32(v) * np.float32(width))
+              for v in (render.border_min_x, render.border_max_x))
+    y0, y1 = (int(np.float32(v) * np.float32(height))
+              for v in (render.border_min_y, render.border_max_y))
+    return x0, y0, x1, y1
+
+
+def format_seconds(seconds):
+    """A duration as Blender's stats line writes it (mm:ss.ss, or hh:mm:ss.ss)."""
+    seconds = max(float(seconds), 0.0)
+    hours, rest = divmod(seconds, 3600.0)
+    minutes, rest = divmod(rest, 60.0)
+    if hours >= 1.0:
+        return "%02d:%02d:%05.2f" % (hours, minutes, rest)
+    return "%02d:%05.2f" % (minutes, rest)
+
+
+def remaining_seconds(progress, elapsed, time_limit=0.0):
+    """The time left, extrapolated from the progress so far and bounded by the Time Limit;
+    None before any progress."""
+    left = None
+    if progress > 0.0:
+        left = elapsed * (1.0 - progress) / progress
+    if time_limit > 0.0:
+        limit_left = max(time_limit - elapsed, 0.0)
+        left = limit_left if left is None else min(left, limit_left)
+    return left
+
+
+class DisplayUpdater:
+    """The progressive render's update callback for F12: writes the image into the render
+    result whenever it has more samples, puts samples and time left in the stats line and
+    cancels when the engine's ``stop_requested()`` says so."""
+
+    def __init__(self, engine, show, samples, time_limit=0.0, clock=time.monotonic):
+        self.engine = engine
+        self.show = show
+        self.samples = int(samples)
+        self.time_limit = float(time_limit)
+        self.clock = clock
+        self.start = clock()
+        self.shown = 0
+
+    def __call__(self, progress, samples_done, final, rgba, passes):
+        if samples_done > self.shown:
+            self.show(rgba, passes, samples_done, final)
+            self.shown = samples_done
+        progress = min(max(float(progress), 0.0), 1.0)
+        self.engine.update_progress(progress)
+        text = "Sample %d/%d" % (samples_done, self.samples)
+        left = remaining_seconds(progress, self.clock() - self.start, self.time_limit)
+        if left is not None and not final:
+            text += ", Remaining %s" % format_seconds(left)
+        self.engine.update_stats("", text)
+        return bool(self.engine.stop_requested())
+
+
 def dual_scattering_warning(exact_bounces, bounce_limit="BOUNCES"):
-    """What a render with Dual Scattering reports: its bias as the studies measured it."""
-    text = ("Dual Scattering is experimental and biased (README, Dual scattering): with %d "
-            "Exact Bounces" % exact_bounces)
-    if exact_bounces >= 3:
-        text += (" its mean is within about 5% of path tracing on the studies' hair, thin or "
-                 "thick, straight or of varied directions: light straight hair (as on the "
-                 "demo head) up to 5% darker, dense light hair of varied directions up to 5% "
-                 "brighter")
-    else:
-        text += (", fewer than the default 3, its shading is flatter than path tracing's: "
-                 "shaded regions brighter, lit ones darker (at 0, by 15-30% region by "
-                 "region on the study's blonde hair)")
+    """What a render with Dual Scattering reports: that it is biased, and which way the
+    settings push the bias."""
+    text = ("Dual Scattering is experimental and biased: its closed form stands in for the "
+            "light that crosses other strands")
+    if exact_bounces < 3:
+        text += (", and with fewer than 3 Exact Bounces it shades flatter than path tracing "
+                 "(shaded regions brighter, lit ones darker)")
     if bounce_limit == "NONE":
-        text += ("; Bounce Limit None adds every order of scattering, so light hair comes out "
-                 "brighter than path tracing with the same Max Bounces (+14% on the demo "
-                 "head's blonde at 8)")
+        text += (", and Bounce Limit None adds every order of scattering, so light hair comes "
+                 "out brighter than path tracing with the same Max Bounces")
     return text
 
 
@@ -137,7 +251,8 @@ def build_native_scene(library, data, hair_tables):
     """A ``native.Scene`` holding everything in ``data`` (SceneData).
 
     ``hair_tables`` maps a hair material's index in ``data.materials`` to its Tables (or
-    lacks it: no tables). The caller closes the returned scene.
+    lacks it: no tables). Without ``data.camera`` the caller sets the camera. The caller closes
+    the returned scene.
     """
     scene = library.scene()
     try:
@@ -193,11 +308,42 @@ def build_native_scene(library, data, hair_tables):
             scene.set_world_options(dict(environment.options(), image=environment.path))
         else:
             scene.set_world_pixels(environment.options(), environment.pixels)
-        scene.set_camera(camera_options(data.camera))
+        if data.camera is not None:
+            scene.set_camera(camera_options(data.camera))
     except BaseException:
         scene.close()
         raise
     return scene
+
+
+def _needs_export(depsgraph):
+    """True when a depsgraph update changed the scene the viewport renders (geometry,
+    transforms, materials, lights, the world); the scene itself and cameras do not count,
+    since view_draw follows the view and the render settings."""
+    for update in depsgraph.updates:
+        data = update.id
+        if isinstance(data, bpy.types.Object) and data.type == "CAMERA":
+            continue  # the viewport renders the view, not the scene camera
+        if isinstance(data, bpy.types.Scene) and not (
+                update.is_updated_geometry or update.is_updated_transform
+                or update.is_updated_shading):
+            continue  # a setting: view_draw compares the render settings
+        return True
+    return False
+
+
+class _ViewExporter(export._Exporter):
+    """The exporter without the scene camera: the viewport renders the 3D view's."""
+
+    def export_camera(self):
+        """Nothing: the view's camera is set on the native scene."""
+
+
+def _export_view(depsgraph):
+    """The scene of the viewport's depsgraph without a camera."""
+    data = _ViewExporter(depsgraph, None).run()
+    data.camera = None
+    return data
 
 
 class HairisRenderEngine(bpy.types.RenderEngine):
@@ -207,22 +353,28 @@ class HairisRenderEngine(bpy.types.RenderEngine):
     bl_label = "Hairis"
     bl_use_preview = False
     bl_use_shading_nodes_custom = False
-    bl_use_eevee_viewport = True
+    bl_use_eevee_viewport = False
 
     def __init__(self, *args, **kwargs):
         # Blender 4.x+ passes arguments to RenderEngine subclasses; they must reach the base.
         super().__init__(*args, **kwargs)
 
+    display_updates = True
+    """Whether F12 shows the image while it refines (off: the render result is written once,
+    at the end; tests compare the two)."""
+
     def render(self, depsgraph):
-        """Renders one view layer of ``depsgraph`` into the Combined pass."""
+        """Renders one view layer of ``depsgraph`` into the Combined pass (and the passes the
+        view layer asks for), refining the image on screen as samples arrive."""
         width, height = self.resolution_x, self.resolution_y
         result = self.begin_result(0, 0, width, height)
         try:
-            pixels = None
             try:
-                pixels = self._render(depsgraph, width, height)
+                self._render(depsgraph, result, width, height)
             except native.HairisCancelled as cancelled:
-                pixels = getattr(cancelled, "rgba", None)
+                # The partial image is kept: what the last update wrote, and what is left.
+                if getattr(cancelled, "rgba", None) is not None:
+                    self._write(result, cancelled.rgba, getattr(cancelled, "passes", None))
                 self.update_stats("", "Cancelled")
             except (RenderFailed, export.ExportError, tables.TableError,
                     native.HairisError) as error:
@@ -231,13 +383,43 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                 traceback.print_exc()
                 self._fail("Hairis internal error: %s: %s (details in the console)"
                            % (type(error).__name__, error))
-            if pixels is not None:
-                try:
-                    compat.set_pass_pixels(result.layers[0].passes["Combined"], pixels)
-                except Exception as error:  # noqa: BLE001
-                    self._fail("Hairis could not write the render result: %s" % error)
         finally:
             self.end_result(result)
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        """Registers Combined and the passes the view layer enables (as Cycles names them)."""
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        wanted = enabled_passes(scene, renderlayer)
+        for name, blender_name, channels, kind in PASSES:
+            if name in wanted:
+                self.register_pass(scene, renderlayer, blender_name, len(channels), channels,
+                                   kind)
+
+    def _write(self, result, rgba, passes=None, region=None):
+        """Copies the library's image (and passes) into the render result: the Render
+        Region's pixels when one is set (the result covers only the region)."""
+        region = region or getattr(self, "_region", None)
+        x0, y0, x1, y1 = region or (0, 0, rgba.shape[1], rgba.shape[0])
+        layer = result.layers[0]
+        try:
+            compat.set_pass_pixels(layer.passes["Combined"], rgba[y0:y1, x0:x1])
+            for name, values in (passes or {}).items():
+                blender_name = next(p[1] for p in PASSES if p[0] == name)
+                target = layer.passes.get(blender_name)
+                if target is not None:
+                    compat.set_pass_pixels(target, values[y0:y1, x0:x1])
+        except Exception as error:  # noqa: BLE001
+            raise RenderFailed("Hairis could not write the render result: %s" % error) \
+                from error
+
+    def _show(self, result, rgba, passes, samples_done, final):
+        """Writes the current image into the result and tells Blender to redraw it."""
+        self._write(result, rgba, passes)
+        self.update_result(result)
+
+    def stop_requested(self):
+        """True once the user cancelled the render (``test_break``)."""
+        return bool(self.test_break())
 
     def _fail(self, message):
         self.report({"ERROR"}, message)
@@ -247,15 +429,17 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             pass
         self.update_stats("", "Error: " + message)
 
-    def _render(self, depsgraph, width, height):
+    def _render(self, depsgraph, result, width, height):
         problem = compat.version_problem()
         if problem:
             raise RenderFailed(problem)
         scene = depsgraph.scene
         settings = scene.hairis
-        if scene.render.use_border:
-            raise RenderFailed("Render Region is not supported by Hairis: disable Output "
-                               "Properties > Format > Render Region")
+        self._region = render_region(scene.render, width, height)
+        if self._region is not None:
+            # The result covers the region as Blender rounds it: its size is the truth.
+            x0, y0 = self._region[:2]
+            self._region = (x0, y0, x0 + result.resolution_x, y0 + result.resolution_y)
 
         self.update_stats("", "Exporting scene")
         data = export.export_scene(depsgraph, self.camera_override)
@@ -268,34 +452,150 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             raise RenderFailed("render size %d×%d differs from the exported camera's %d×%d"
                                % (width, height, data.camera.width, data.camera.height))
         if self.test_break():
-            return None
+            return
 
         library = native.load_library()
         hair_tables = self._resolve_tables(library, data, settings)
         if settings.integrator == "DUAL_SCATTERING":
             self.report({"WARNING"}, dual_scattering_warning(settings.dual_exact_bounces,
                                                              settings.dual_bounce_limit))
+        passes = [name for name, _b, _c, _k in PASSES
+                  if name in enabled_passes(scene, depsgraph.view_layer)]
+        values = progressive_settings(settings, self._region, passes)
         try:
             with build_native_scene(library, data, hair_tables) as native_scene:
                 self.update_stats("", "Rendering %d samples (%s%s)"
                                   % (settings.samples, settings.strategy.lower(),
                                      ", dual scattering"
                                      if settings.integrator == "DUAL_SCATTERING" else ""))
-                rgba, stats = native_scene.render(render_settings(settings),
-                                                  ProgressReporter(self))
+                update = None
+                if self.display_updates:
+                    update = DisplayUpdater(
+                        self, lambda rgba, images, done, final:
+                        self._show(result, rgba, images, done, final),
+                        settings.samples, settings.time_limit)
+                rgba, images, stats = native_scene.render_progressive(values, update, passes)
         finally:
             for table in hair_tables.values():
                 table.close()
+        self._write(result, rgba, images)
         peak = stats.peak_memory_bytes / (1024.0 * 1024.0)
         self.update_memory_stats(memory_used=peak, memory_peak=peak)
-        self.update_stats("", "Rendered in %.2f s" % stats.seconds)
+        self.update_stats("", "Rendered %d samples in %s"
+                          % (getattr(stats, "samples", settings.samples),
+                             format_seconds(stats.seconds)))
         if stats.dropped_samples:
             self.report({"WARNING"}, "%d samples with NaN or infinite values were dropped"
                         % stats.dropped_samples)
-        return rgba
 
-    def _resolve_tables(self, library, data, settings):
+    # -- viewport --
+
+    def view_update(self, context, depsgraph):
+        """Exports the scene for the viewport when it is new or its data changed (materials,
+        lights, objects, the world); view changes alone are :meth:`view_draw`'s."""
+        render = getattr(self, "_viewport", None)
+        if render is not None and not _needs_export(depsgraph):
+            return
+        try:
+            problem = compat.version_problem()
+            if problem:
+                raise RenderFailed(problem)
+            if render is None:
+                library = native.load_library()
+                # A weak reference: the worker must not keep the engine alive (its __del__
+                # stops the worker).
+                redraw = weakref.WeakMethod(self._tag_redraw)
+                render = self._viewport = viewport.ViewportRender(
+                    library, lambda: redraw() is not None and redraw()())
+                self._display = viewport.Display()
+                self._view_key = None
+            render.set_scene(self._scene_job(render.library, depsgraph))
+            self._viewport_error = None
+        except (RenderFailed, export.ExportError, tables.TableError,
+                native.HairisError) as error:
+            self._viewport_error = str(error)
+        except Exception as error:  # noqa: BLE001 - Blender must keep running
+            traceback.print_exc()
+            self._viewport_error = "Hairis internal error: %s: %s" % (type(error).__name__,
+                                                                      error)
+        self.tag_redraw()
+
+    def view_draw(self, context, depsgraph):
+        """Draws the newest viewport image; a new view (matrix, projection or size) restarts
+        the render with only the camera changed."""
+        region = context.region
+        message = getattr(self, "_viewport_error", None)
+        render = getattr(self, "_viewport", None)
+        if render is not None and message is None:
+            region3d = context.region_data
+            pixel_size = max(int(self.get_preview_pixel_size(depsgraph.scene)), 1)
+            width, height = region.width // pixel_size, region.height // pixel_size
+            view_matrix = np.array(region3d.view_matrix, np.float64)
+            window_matrix = np.array(region3d.window_matrix, np.float64)
+            settings = depsgraph.scene.hairis
+            values = render_settings(settings)
+            key = (view_matrix.tobytes(), window_matrix.tobytes(), width, height,
+                   settings.preview_samples, sorted(values.items()))
+            if key != self._view_key:
+                self._view_key = key
+                camera = viewport.view_camera(view_matrix, window_matrix,
+                                              region3d.is_perspective)
+                render.set_view(viewport.ViewRequest(camera, width, height, values,
+                                                     settings.preview_samples))
+            message = render.error
+            frame = render.frame
+            if frame is not None:
+                self._display.upload(frame)
+                self._display.draw(self, depsgraph.scene, region.width, region.height)
+            self.update_stats("", message or render.status)
+        elif message:
+            self.update_stats("", "Error: " + message)
+
+    def _tag_redraw(self):
+        try:
+            self.tag_redraw()
+        except ReferenceError:  # the engine is being freed
+            pass
+
+    def _scene_job(self, library, depsgraph):
+        """The viewport's :class:`viewport.SceneJob`: the scene exported now (without a
+        camera), current or cached tables, and what the worker must bake."""
+        data = _export_view(depsgraph)
+        settings = depsgraph.scene.hairis
+        bakes = []
+
+        def bake_later(index, material, fiber, _status):
+            cached = tables.cached_tables(
+                library, fiber, need_multiple=settings.integrator == "DUAL_SCATTERING")
+            if cached is not None:
+                return cached
+            bakes.append((index, material.hair.as_dict(),
+                          tables.bake_options(library, n_h=int(settings.n_h),
+                                              threads=settings.threads),
+                          tables.cache_path(fiber.parameters)))
+            return None
+
+        found = self._resolve_tables(library, data, settings, bake_later)
+        return viewport.SceneJob(data, found, bakes)
+
+    def free_viewport(self):
+        """Stops the viewport's worker thread (the view closed or the engine goes)."""
+        render = getattr(self, "_viewport", None)
+        self._viewport = None
+        if render is not None:
+            render.stop()
+
+    def __del__(self):
+        try:
+            self.free_viewport()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+    def _resolve_tables(self, library, data, settings, bake=None):
         """Tables per hair material index: current ones, auto-baked ones, or an error.
+
+        ``bake(index, material, fiber, status)`` stands in for the auto bake (the viewport
+        leaves it to its worker): it returns tables or None (baked later).
 
         Only the TABLE strategy and the Dual Scattering integrator use tables (other settings
         get none). They refuse materials without current tables unless Auto Bake is on, never
@@ -326,6 +626,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                                                     "tables" % material.name)
                     if status.ok:
                         found[index] = status.tables
+                    elif settings.auto_bake and bake is not None:
+                        baked = bake(index, material, fiber, status)
+                        if baked is not None:
+                            found[index] = baked
                     elif settings.auto_bake:
                         try:
                             found[index] = self._auto_bake(library, material, fiber, settings,

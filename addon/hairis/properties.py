@@ -4,6 +4,8 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 from bpy.props import StringProperty
 
+from . import compositor
+
 STRATEGY_ITEMS = (
     ("UNIFORM", "Uniform", "Sample hair scattering uniformly over the sphere", 0),
     ("ANALYTIC", "Analytic",
@@ -18,12 +20,8 @@ INTEGRATOR_ITEMS = (
     ("PATH", "Path Tracing",
      "Unbiased path tracing of every bounce, as Cycles renders hair", 0),
     ("DUAL_SCATTERING", "Dual Scattering (Experimental)",
-     "Path tracing of the first bounces (Exact Bounces), then Zinke et al. 2008's dual "
-     "scattering: light reaching hair through other strands in closed form from shadow rays "
-     "that count the strands, multiple scattering sampled from the baked tables (needs baked "
-     "tables). Experimental: biased (at 3 Exact Bounces within about 5% of path tracing in the "
-     "mean on the studies' hair, thin or thick, straight or of varied directions; flatter "
-     "with fewer)", 1),
+     "Path-traces the first bounces, then approximates light through other strands in closed "
+     "form (Zinke et al. 2008) from the baked tables, which is biased but less noisy", 1),
 )
 """Values match the C API's ``integrator`` (path | dual_scattering)."""
 
@@ -37,10 +35,40 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     """Render settings of the Hairis engine (``scene.hairis``)."""
 
     samples: IntProperty(
-        name="Samples", description="Samples per pixel",
+        name="Samples", description="Number of samples to render for each pixel",
         default=64, min=1, max=1 << 24, soft_max=4096)
+    use_adaptive_sampling: BoolProperty(
+        name="Noise Threshold",
+        description="Stop sampling a pixel once its estimated noise is below the threshold, "
+                    "as Cycles' adaptive sampling does",
+        default=True)
+    adaptive_threshold: FloatProperty(
+        name="Noise Threshold",
+        description="Noise level at which a pixel stops sampling, lower values reduce noise at "
+                    "the cost of render time (zero: set automatically from the samples)",
+        default=0.01, min=0.0, max=1.0, soft_min=0.001, precision=4)
+    adaptive_min_samples: IntProperty(
+        name="Min Samples",
+        description="Samples every pixel gets before adaptive sampling may stop it, so that "
+                    "small noisy features are found (zero: set automatically from the "
+                    "threshold)",
+        default=0, min=0, max=4096)
+    time_limit: FloatProperty(
+        name="Time Limit",
+        description="Stop the render after this time, keeping the samples done (zero: no "
+                    "limit)",
+        default=0.0, min=0.0, step=100.0, unit="TIME_ABSOLUTE")
+    preview_samples: IntProperty(
+        name="Viewport Samples",
+        description="Number of samples to render in the viewport, unlimited if 0",
+        default=1024, min=0, soft_min=1, max=1 << 24)
+    use_denoising: BoolProperty(
+        name="Denoise",
+        description="Denoise the final render with the compositor's Denoise node, guided by "
+                    "Hairis' albedo and normal passes",
+        default=False, update=compositor.denoise_update)
     max_bounces: IntProperty(
-        name="Max Bounces", description="Total maximum number of bounces (as Cycles)",
+        name="Max Bounces", description="Total maximum number of bounces, as in Cycles",
         default=12, min=0, max=1024)
     integrator: EnumProperty(
         name="Integrator", description="How light reaching hair is computed",
@@ -49,70 +77,66 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
         name="Hair Volume",
         description="What Dual Scattering takes the hair around a point to be",
         items=(("LAYER", "Layer",
-                "A layer over what is under it: light scattered back from the strands behind "
-                "the point only, and the head's light reaching hair through strands", 0),
+                "A layer over what is under it, so light comes back only from the strands "
+                "behind the point", 0),
                ("UNBOUNDED", "Unbounded",
-                "Zinke et al.'s semi-infinite hair volume (too bright and too red on light hair "
-                "over a head)", 1)),
+                "Zinke et al.'s semi-infinite hair volume, which makes light hair over a head "
+                "too bright", 1)),
         default="LAYER")
     dual_exact_bounces: IntProperty(
         name="Exact Bounces",
-        description="Bounces path-traced before Dual Scattering closes the path: 0 shades the "
-                    "first hair hit by dual scattering alone (flattest, least noise); each one "
-                    "more leaves less of the light to the approximation (less bias, more noise)",
+        description="Bounces path-traced before Dual Scattering closes the path, since each "
+                    "one more leaves less light to the approximation (less bias, more noise)",
         default=3, min=0, max=1024, soft_max=8)
     dual_bounce_limit: EnumProperty(
         name="Bounce Limit",
         description="Which orders of scattering Dual Scattering adds where it closes a path",
         items=(("BOUNCES", "Max Bounces",
-                "Only those path tracing reaches within Max Bounces, as Cycles renders the "
-                "scene", 0),
+                "Only the orders path tracing reaches within Max Bounces, so the image matches "
+                "Cycles' with the same limit", 0),
                ("NONE", "None",
-                "Every order, as Zinke et al. (light hair comes out brighter than Cycles "
-                "renders it with a low Max Bounces)", 1)),
+                "Every order, as Zinke et al., which makes light hair brighter than Cycles "
+                "renders it with a low Max Bounces", 1)),
         default="BOUNCES")
     max_transparent_bounces: IntProperty(
         name="Transparent Max Bounces",
-        description="Maximum number of transparent crossings (as Cycles): Huang hair lets rays "
-                    "through outside its elliptical cross-section",
+        description="Maximum number of transparent crossings, as in Cycles, where Huang hair "
+                    "lets rays through outside its elliptical cross-section",
         default=8, min=0, max=1024)
     strategy: EnumProperty(
         name="Strategy", description="How hair scattering directions are sampled",
         items=STRATEGY_ITEMS, default="TABLE")
     huang_sampling: EnumProperty(
         name="Huang Sampling",
-        description="How Huang hair is sampled. Cycles (the default) renders what Cycles "
-                    "renders, and at equal time with less noise than the strategy's tables "
-                    "(bench/results/bpy45/render_study_huang.md). Dual Scattering always uses "
-                    "the strategy: its MIS needs the sampler's density",
+        description="How Huang hair is sampled, except under Dual Scattering, whose MIS needs "
+                    "the strategy's density",
         items=(("STRATEGY", "Strategy",
-                "The strategy above, with its exact density (converges to Cycles' Huang eval, "
-                "about 1% from Cycles' image; noisier in renders: Cycles' eval, which weights "
-                "every sample, is itself a noisy estimate)", 0),
+                "The strategy above with its exact density, which converges to Cycles' Huang "
+                "eval rather than to Cycles' image", 0),
                ("CYCLES", "Cycles",
-                "Cycles' own Huang sampler with its weight and pdf 1 for MIS (converges to what "
-                "Cycles renders, which mixes that sampler with its eval)", 1)),
+                "Cycles' own Huang sampler, so the image converges to what Cycles renders", 1)),
         default="CYCLES")
     multiple_weight: FloatProperty(
         name="Multiple Weight",
-        description="One-sample mixture weight of the multiple-scattering distribution "
-                    "(Table and Gaussian strategies). 0 is best for Table in a path tracer "
-                    "(bench/results/mixture_weight.md); Gaussian needs about 0.25",
+        description="Share of samples drawn from the multiple-scattering distribution (Table "
+                    "and Gaussian), best at 0 for Table since a path tracer follows multiple "
+                    "scattering itself",
         default=0.0, min=0.0, max=1.0, subtype="FACTOR")
     n_h: EnumProperty(
         name="Strands (n_h)",
         description="Number of strands light crosses in the multiple-scattering distribution",
         items=N_H_ITEMS, default="2")
     seed: IntProperty(
-        name="Seed", description="Random seed: same seed, same image, whatever the thread count",
+        name="Seed", description="Random seed, which gives the same image whatever the thread "
+                                 "count",
         default=0, min=0)
     threads: IntProperty(
-        name="Threads", description="Render and bake threads (0: all cores)",
+        name="Threads", description="Number of render and bake threads, all cores if 0",
         default=0, min=0, max=1024)
     auto_bake: BoolProperty(
         name="Auto Bake",
-        description="Bake missing or stale sampling tables when rendering (otherwise the Table "
-                    "strategy and Dual Scattering refuse materials without current tables)",
+        description="Bake missing or stale sampling tables when rendering, since the Table "
+                    "strategy and Dual Scattering refuse materials without current tables",
         default=True)
 
     @classmethod

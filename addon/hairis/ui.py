@@ -11,7 +11,7 @@ and users keep editing Cycles' nodes.
 
 import bpy
 
-from . import compat, export, native, tables
+from . import compat, compositor, export, native, tables
 
 ENGINE = "HAIRIS"
 
@@ -142,11 +142,59 @@ class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
         sub.prop(settings, "dual_hair_volume")
         sub.prop(settings, "dual_exact_bounces")
         sub.prop(settings, "dual_bounce_limit")
-        column.prop(settings, "samples")
         column.prop(settings, "seed")
         column.prop(settings, "max_bounces")
         column.prop(settings, "max_transparent_bounces")
         column.prop(settings, "threads")
+
+
+class HAIRIS_RENDER_PT_sampling_render(HairisPanel, bpy.types.Panel):
+    """F12's adaptive sampling, time limit and denoising, with Cycles' names and meanings."""
+
+    bl_label = "Render"
+    bl_context = "render"
+    bl_parent_id = "HAIRIS_RENDER_PT_sampling"
+
+    def draw(self, context):
+        """Draws the panel."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.hairis
+        heading = layout.column(align=True, heading="Noise Threshold")
+        row = heading.row(align=True)
+        row.prop(settings, "use_adaptive_sampling", text="")
+        sub = row.row()
+        sub.active = settings.use_adaptive_sampling
+        sub.prop(settings, "adaptive_threshold", text="")
+        column = layout.column(align=True)
+        column.prop(settings, "samples", text="Max Samples"
+                    if settings.use_adaptive_sampling else "Samples")
+        sub = column.column(align=True)
+        sub.active = settings.use_adaptive_sampling
+        sub.prop(settings, "adaptive_min_samples", text="Min Samples")
+        layout.prop(settings, "time_limit")
+        available = compositor.denoising_available()
+        row = layout.row()
+        row.enabled = available
+        row.prop(settings, "use_denoising")
+        if not available:
+            layout.label(text="This Blender was built without OpenImageDenoise", icon="INFO")
+
+
+class HAIRIS_RENDER_PT_sampling_viewport(HairisPanel, bpy.types.Panel):
+    """The viewport's sample count."""
+
+    bl_label = "Viewport"
+    bl_context = "render"
+    bl_parent_id = "HAIRIS_RENDER_PT_sampling"
+
+    def draw(self, context):
+        """Draws the panel."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.hairis, "preview_samples", text="Max Samples")
 
 
 class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
@@ -348,17 +396,43 @@ class HAIRIS_LIGHT_PT_light(HairisPanel, bpy.types.Panel):
                 sub.prop(light, "size", text="Size X")
                 sub.prop(light, "size_y", text="Y")
         elif light.type == "SPOT":
-            column.label(text="Spot lights are not supported by Hairis", icon="ERROR")
+            column.prop(light, "shadow_soft_size", text="Radius")
+
+
+class HAIRIS_LIGHT_PT_spot(HairisPanel, bpy.types.Panel):
+    """The spot light's cone (as Cycles' Spot Shape panel)."""
+
+    bl_label = "Spot Shape"
+    bl_context = "data"
+    bl_parent_id = "HAIRIS_LIGHT_PT_light"
+
+    @classmethod
+    def poll(cls, context):
+        """Spot lights."""
+        return context.light and context.light.type == "SPOT" and engine_is_hairis(context)
+
+    def draw(self, context):
+        """Draws the cone's size and blend."""
+        layout = self.layout
+        layout.use_property_split = True
+        light = context.light
+        column = layout.column()
+        column.prop(light, "spot_size", text="Beam Size")
+        column.prop(light, "spot_blend", text="Blend")
+        column.prop(light, "show_cone")
 
 
 classes = (
     HAIRIS_RENDER_PT_sampling,
+    HAIRIS_RENDER_PT_sampling_render,
+    HAIRIS_RENDER_PT_sampling_viewport,
     HAIRIS_RENDER_PT_strategy,
     HAIRIS_PT_context_material,
     HAIRIS_MATERIAL_PT_surface,
     HAIRIS_MATERIAL_PT_tables,
     HAIRIS_WORLD_PT_surface,
     HAIRIS_LIGHT_PT_light,
+    HAIRIS_LIGHT_PT_spot,
 )
 
 

@@ -362,10 +362,16 @@ def make_curves(scene, hair_material, location=(0.0, 0.0, 1.0), rotation=(0.0, 0
 
 
 def make_demo_head(resolution=(480, 360), count=1500, children=10,
-                   sun_rotation=(math.radians(50), 0.0, math.radians(30))):
+                   sun_rotation=(math.radians(50), 0.0, math.radians(30)), empty_file=True):
     """The demo scene (scripts/render_demo.py): a head of brown particle hair under a sun and a
-    sky, rendered by Hairis. Returns the scene."""
-    scene = reset()
+    sky, rendered by Hairis. Returns the scene. ``empty_file`` False builds it in the open
+    file, without its objects (a running UI must keep its screen)."""
+    if empty_file:
+        scene = reset()
+    else:
+        scene = bpy.context.scene
+        for obj in list(bpy.data.objects):
+            bpy.data.objects.remove(obj)
     scene.render.engine = "HAIRIS"
     make_camera(scene, location=(0.0, -7.5, 0.3), resolution=resolution, percentage=100)
     make_world(scene, color=(0.35, 0.45, 0.6), strength=1.0)

@@ -155,8 +155,11 @@ def test_preferences_and_panels_draw():
         active_object=bpy.data.objects["Head"], material_slot=None, space_data=None,
         world=scene.world, light=bpy.data.lights["Sun"])
     for panel in ui.classes:
+        context.light = bpy.data.lights["Spot" if panel is ui.HAIRIS_LIGHT_PT_spot else "Sun"]
         assert panel.poll(context), panel.__name__
         helpers.draw_panel(panel, context)
+    context.light = bpy.data.lights["Sun"]
+    assert not ui.HAIRIS_LIGHT_PT_spot.poll(context), "the spot panel is for spot lights"
     layout = helpers.draw_panel(ui.HAIRIS_MATERIAL_PT_tables, context)
     assert ("operator", "hairis.bake_tables") in layout.log
     assert any("not found" in label for label in layout.labels())
