@@ -449,6 +449,8 @@ def match_engines(scene, samples, bounces):
     settings.samples = samples
     settings.max_bounces = bounces
     settings.threads = 0
+    # Cycles renders without adaptive sampling here (match_cycles): every pixel gets every sample.
+    settings.use_adaptive_sampling = False
     bpy.context.view_layer.update()
 
 
