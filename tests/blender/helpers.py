@@ -425,6 +425,8 @@ def match_cycles(scene, samples, bounces):
     cycles.device = "CPU"
     cycles.samples = samples
     cycles.use_adaptive_sampling = False
+    # Neither engine samples adaptively: every pixel of both gets every sample.
+    scene.hairis.use_adaptive_sampling = False
     cycles.use_denoising = False
     for name in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
                  "transparent_max_bounces"):
@@ -449,8 +451,6 @@ def match_engines(scene, samples, bounces):
     settings.samples = samples
     settings.max_bounces = bounces
     settings.threads = 0
-    # Cycles renders without adaptive sampling here (match_cycles): every pixel gets every sample.
-    settings.use_adaptive_sampling = False
     bpy.context.view_layer.update()
 
 
