@@ -85,3 +85,136 @@ def compare(cycles, hairis, block=4):
         % (worst, critical)
     return {"ratio": ratio, "mean_t2": observed, "mean_t2_bound": bound, "max_t": worst,
             "max_t_bound": critical}
+
+
+# ---- Hair pixels: power-sized comparison of their means --------------------------------------
+#
+# The block tests above dilute a bias confined to the hair among the other pixels. Here only
+# the pixels a hair mask marks count: per seed and channel the mean over those pixels, then a
+# Welch t test of Hairis' seed means against Cycles'. Its power is computed, not assumed: from
+# the seed-to-seed variances measured in the same renders, the smallest relative bias the test
+# finds with the asked power at its false-alarm level (the noncentral t, Welch's degrees of
+# freedom) must not exceed the bias the test claims to see.
+
+def _integrate(values, x):
+    """The trapezoidal rule (np.trapz is deprecated from NumPy 2)."""
+    return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(x)))
+
+
+def t_power(shift, dof, critical):
+    """P(|T| > critical) for the noncentral t T = (Z + shift)/sqrt(V/dof), V ~ χ²(dof): the
+    power of a two-sided t test against a true difference of ``shift`` standard errors."""
+    upper = dof + 40.0 * math.sqrt(2.0 * dof) + 40.0
+    v = np.linspace(upper / 40000.0, upper, 40000)
+    half = 0.5 * dof
+    density = np.exp((half - 1.0) * np.log(v) - 0.5 * v - half * math.log(2.0)
+                     - math.lgamma(half))
+    scale = critical * np.sqrt(v / dof)
+    erf = np.vectorize(math.erf)
+    reject = (0.5 * (1.0 + erf((shift - scale) / math.sqrt(2.0)))
+              + 0.5 * (1.0 + erf((-shift - scale) / math.sqrt(2.0))))
+    return _integrate(reject * density, v) / _integrate(density, v)
+
+
+def detectable_shift(dof, alpha, power=0.9):
+    """The true difference, in standard errors, that a two-sided t test at level ``alpha``
+    with ``dof`` degrees of freedom rejects with probability ``power`` (bisection)."""
+    critical = t_critical(alpha, dof)
+    lo, hi = 0.0, 100.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if t_power(mid, dof, critical) < power:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+def welch(hairis, cycles):
+    """Welch's test of the means of two samples along axis 0: (difference, standard error,
+    degrees of freedom), each of the remaining shape."""
+    n_h, n_c = hairis.shape[0], cycles.shape[0]
+    a = hairis.var(axis=0, ddof=1) / n_h
+    b = cycles.var(axis=0, ddof=1) / n_c
+    error = np.sqrt(a + b)
+    dof = (a + b) ** 2 / np.maximum(a * a / (n_h - 1) + b * b / (n_c - 1), 1e-300)
+    return hairis.mean(axis=0) - cycles.mean(axis=0), error, dof
+
+
+def masked_means(images, mask):
+    """(seeds, channels) means of a (seeds, height, width, 3) stack over the pixels ``mask``
+    (height, width) marks."""
+    return images[:, mask, :].mean(axis=1)
+
+
+def hair_statistics(cycles, hairis, masks, alpha_means=0.005, alpha_blocks=0.005, power=0.9,
+                    block=16, min_pixels=32):
+    """The hair comparison's figures, asserting nothing.
+
+    ``masks``: {name: (height, width) bool}, the first the hair as a whole. Per mask and
+    channel: the relative difference of the masked means, its t (Welch), the critical |t| at
+    ``alpha_means`` Šidák-corrected over masks × channels, and the smallest relative bias found
+    with ``power`` at that level. Per ``block``×``block`` block of the first mask with at least
+    ``min_pixels`` hair pixels: t of its hair mean, against a critical |t| at ``alpha_blocks``
+    Šidák-corrected over blocks × channels. ``detected``: whether any mean or block is beyond
+    its critical value.
+    """
+    tests = 3 * len(masks)
+    alpha_mean = 1.0 - (1.0 - alpha_means) ** (1.0 / tests)
+    groups = {}
+    detected = False
+    for name, mask in masks.items():
+        reference = masked_means(cycles, mask)
+        difference, error, dof = welch(masked_means(hairis, mask), reference)
+        level = reference.mean(axis=0)
+        t = difference / error
+        critical = np.array([t_critical(alpha_mean, d) for d in dof])
+        shift = np.array([detectable_shift(d, alpha_mean, power) for d in dof])
+        groups[name] = {"pixels": int(mask.sum()), "relative": difference / level, "t": t,
+                        "dof": dof, "critical": critical,
+                        "detectable": shift * error / level}
+        detected |= bool(np.any(np.abs(t) > critical))
+    hair = next(iter(masks.values()))
+    height, width = hair.shape
+    block_t, block_dof = [], []
+    for y in range(0, height - block + 1, block):
+        for x in range(0, width - block + 1, block):
+            inside = hair[y:y + block, x:x + block]
+            if inside.sum() < min_pixels:
+                continue
+            window = (slice(None), slice(y, y + block), slice(x, x + block))
+            difference, error, dof = welch(masked_means(hairis[window], inside),
+                                           masked_means(cycles[window], inside))
+            block_t.append(difference / error)
+            block_dof.append(dof)
+    block_t, block_dof = np.array(block_t), np.array(block_dof)
+    alpha_block = 1.0 - (1.0 - alpha_blocks) ** (1.0 / max(block_t.size, 1))
+    block_critical = np.array([t_critical(alpha_block, d) for d in block_dof.reshape(-1)])
+    block_excess = np.abs(block_t.reshape(-1)) / block_critical
+    detected |= bool(np.any(block_excess > 1.0))
+    return {"groups": groups, "blocks": block_t.shape[0], "block_t": block_t,
+            "block_excess": float(block_excess.max()), "detected": detected,
+            "alpha_mean": alpha_mean}
+
+
+def print_hair_statistics(figures, label):
+    """Prints :func:`hair_statistics`' figures, one line per mask and one for the blocks."""
+    for name, group in figures["groups"].items():
+        print("%s: %s hair (%d pixels): relative difference %s, t %s (critical %s, dof %s); "
+              "smallest bias found with 90%% power %s"
+              % (label, name, group["pixels"], np.round(group["relative"], 4),
+                 np.round(group["t"], 2), np.round(group["critical"], 2),
+                 np.round(group["dof"], 1), np.round(group["detectable"], 4)))
+    print("%s: %d blocks, max |t| %.2f, max |t|/critical %.2f; %s"
+          % (label, figures["blocks"], float(np.abs(figures["block_t"]).max()),
+             figures["block_excess"], "DIFFERENT" if figures["detected"] else "within the noise"))
+
+
+def assert_hair(figures, largest_bias=0.01):
+    """Asserts :func:`hair_statistics`' figures: the first mask's smallest detectable bias is at
+    most ``largest_bias`` in every channel, and no mean or block differs beyond the noise."""
+    hair = next(iter(figures["groups"].values()))
+    assert np.all(hair["detectable"] <= largest_bias), \
+        "too little power: the smallest bias found with 90%% power is %s > %g" \
+        % (hair["detectable"], largest_bias)
+    assert not figures["detected"], "the hair differs beyond the noise"
