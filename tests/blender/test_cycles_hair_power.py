@@ -15,9 +15,10 @@ seed-to-seed variances it measures, it computes the smallest bias of the hair me
 90% power at the test's false-alarm level, and fails when that exceeds 1% in a channel
 (tests/blender/POWER.md explains the computation).
 
-Negative controls: the Hairis side is rendered again with one deliberate error at a time
-(every light and the world 2% brighter; the other Blender's Chiang tilt convention), and the
-same comparison must find each of them. Blender 3.4 is skipped: one 16×16 block of its hair
+Negative control: the Hairis side is rendered again with a deliberate error (every light and
+the world 2% brighter), and the same comparison must find it. (The other Blender's Chiang tilt
+convention moves this hair's mean by 0.1-0.25%, below what the test is sized for, so it is not
+a control; POWER.md.) Blender 3.4 is skipped: one 16×16 block of its hair
 differs from Cycles 3.4 beyond the noise (tests/allowed_skips.txt).
 """
 
@@ -37,7 +38,7 @@ ARGS = helpers.setup_compare()
 if helpers.VERSION < (4, 0, 0):
     helpers.skip("Blender %s: a block of the hair differs from Cycles beyond the noise "
                  "(under investigation)" % bpy.app.version_string)
-SAMPLES = int(os.environ.get("HAIRIS_POWER_SAMPLES", "128"))
+SAMPLES = int(os.environ.get("HAIRIS_POWER_SAMPLES", "192"))
 SEEDS = int(os.environ.get("HAIRIS_POWER_SEEDS", "16"))
 BOUNCES = 8
 RESOLUTION = (48, 48)
@@ -110,17 +111,7 @@ def brighter_light(scene):
     return undo
 
 
-def other_tilt(scene):
-    """The export tags the hair with the other Blender's Cycles (3.4's tilt in 4.2+, 4.5's in
-    3.4); returns the function that undoes it."""
-    compat = helpers.module("compat")
-    original = compat.cycles_version
-    other = "4.5" if helpers.VERSION < (4, 2, 0) else "3.4"
-    compat.cycles_version = lambda version=None: other
-    return lambda: setattr(compat, "cycles_version", original)
-
-
-CONTROLS = (("light x1.02", brighter_light), ("other tilt convention", other_tilt))
+CONTROLS = (("light x1.02", brighter_light),)
 
 
 def test_hair_matches_cycles_with_power():
