@@ -571,7 +571,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                 return cached
             bakes.append((index, material.hair.as_dict(),
                           tables.bake_options(library, n_h=int(settings.n_h),
-                                              threads=settings.threads),
+                                              threads=settings.threads,
+                                              multiple=settings.integrator == "DUAL_SCATTERING"),
                           tables.cache_path(fiber.parameters)))
             return None
 
@@ -663,7 +664,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                         % status.message)
             return cached
         self.update_stats("", "Baking sampling tables for %s" % material.name)
-        options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads)
+        options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads,
+                                      multiple=settings.integrator == "DUAL_SCATTERING")
         baked = library.bake_tables(fiber, options, ProgressReporter(self))
         tables.write_cache(baked, fiber)
         self.report({"INFO"}, "%s: baked them for this render (Bake Sampling Tables stores them "

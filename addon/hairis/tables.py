@@ -64,9 +64,13 @@ def hair_materials(materials=None):
     return [m for m in materials if export.is_hair_material(m)]
 
 
-def bake_options(library, n_h=None, threads=0):
-    """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``."""
+def bake_options(library, n_h=None, threads=0, multiple=True):
+    """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``.
+
+    ``multiple``: also bake a Huang fiber's multiple-scattering part, which only Dual
+    Scattering reads and which costs several times the rest of the bake."""
     options = library.bake_options_defaults()
+    options["huang_multiple"] = 1 if multiple else 0
     values = {int(v) for v in options["n_h"].split(",")} | set(N_H_CHOICES)
     if n_h is not None:
         values.add(int(n_h))

@@ -391,6 +391,9 @@ def test_huang_tables_without_their_f_are_stale():
                     status.tables.close()
         assert states[0][0] == "STALE" and "no baked f" in states[0][1], states
         assert states[1][0] == "OK", states
+        # Auto-bake leaves the multiple part out unless Dual Scattering reads it.
+        assert tables.bake_options(lib, multiple=False)["huang_multiple"] == 0
+        assert tables.bake_options(lib)["huang_multiple"] == 1
     finally:
         node.model = "CHIANG"
         material.hairis.table_image = saved
