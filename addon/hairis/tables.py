@@ -70,7 +70,8 @@ def bake_options(library, n_h=None, threads=0, multiple=True):
     ``multiple``: also bake a Huang fiber's multiple-scattering part, which only Dual
     Scattering reads and which costs several times the rest of the bake."""
     options = library.bake_options_defaults()
-    options["huang_multiple"] = 1 if multiple else 0
+    if "huang_multiple" in options:  # a library that bakes Huang tables
+        options["huang_multiple"] = 1 if multiple else 0
     values = {int(v) for v in options["n_h"].split(",")} | set(N_H_CHOICES)
     if n_h is not None:
         values.add(int(n_h))
