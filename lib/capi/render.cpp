@@ -141,9 +141,6 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
         RenderOptions o;
         read_options(settings, "render settings", o);
         if (!scene->has_camera) invalid("scene has no camera: call hairis_scene_set_camera before " + std::string(function));
-        if (scene->curve_count == 0 && scene->triangle_count == 0)
-            invalid("scene is empty: add curves (hairis_scene_add_curves) or a mesh (hairis_scene_add_mesh) before " +
-                    std::string(function));
 
         // The scene description with this render's materials. The handle keeps its own copy
         // of the geometry so that it can be rendered again with other settings.

@@ -478,14 +478,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         impl->meshes.push_back(std::move(geo));
     }
 
-    if (stats.curves == 0 && stats.triangles == 0) {
-        std::string why = "scene has no geometry: add at least one hair curve or triangle";
-        if (stats.skipped_curves || stats.skipped_triangles)
-            why += " (" + std::to_string(stats.skipped_curves) + " curve(s) and " +
-                   std::to_string(stats.skipped_triangles) +
-                   " triangle(s) were skipped as degenerate)";
-        return Error{why};
-    }
+    // A scene with no geometry left is legal, as in Cycles: every ray misses and the render
+    // shows the world.
 
     // Embree.
     impl->device = rtcNewDevice(nullptr);

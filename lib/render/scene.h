@@ -29,7 +29,7 @@
 //    material whose model does not vary per strand, mesh indices out of range, material
 //    indices out of range, a hair material on a mesh, a hair material without fiber or
 //    sampler, corner normals or UVs that are not one per triangle corner or not finite,
-//    invalid lights or camera, and a scene with no geometry left (no curve and no triangle).
+//    and invalid lights or camera. A scene with no geometry (left) is legal: every ray misses.
 //
 // Mesh shading data, as Cycles' triangle shader setup: Ng the face normal, N the corner normals
 // interpolated with the hit's barycentrics and normalized (Blender's corner normals: the

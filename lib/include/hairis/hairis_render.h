@@ -198,8 +198,8 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * first hair vertex at that depth or deeper closes the path by dual scattering (0: at the
  * first hair hit, the paper's), and dual_bounce_limit = bounces (default: that vertex adds only
  * the orders of scattering the path tracer would reach within max_bounces and
- * max_transmission_bounces, as Cycles ends its paths) | none (every order, the paper's). A scene without camera or
- * geometry is refused. Each call builds the scene anew, so
+ * max_transmission_bounces, as Cycles ends its paths) | none (every order, the paper's). A scene without camera is
+ * refused; one without geometry renders the world (every ray misses). Each call builds the scene anew, so
  * a scene can be rendered again with other settings, also from several threads at once.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
