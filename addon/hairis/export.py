@@ -1127,6 +1127,13 @@ class _Exporter:
         hair = self.data.materials[material].hair
         if hair is not None and hair.oriented:
             normals = curve_normals(obj, curves, point_count, offsets, self.data)
+        keep = renderable_strands(first, world, radii, kept, "object %r" % obj.name,
+                                  self.data.warn)
+        first, (world, local, radii, normals) = select_strands(first, keep, world, local, radii,
+                                                               normals)
+        kept = kept[keep]
+        if first.size < 2:
+            return
         self.data.curves.append(CurvesData(
             name=obj.name, source="CURVES", material=material, first=first,
             positions=world.astype(np.float32), radii=radii.astype(np.float32),
@@ -1166,18 +1173,65 @@ def curve_normals(obj, curves, point_count, offsets, data):
 
 def _drop_short_curves(offsets, positions, radii):
     """Removes curves with fewer than 2 points; returns (first uint32, positions, radii, n)."""
-    offsets = np.asarray(offsets, dtype=np.int64)
-    counts = np.diff(offsets)
-    keep = counts >= 2
-    dropped = int(np.count_nonzero(~keep))
-    if dropped:
-        point_keep = np.repeat(keep, counts)
-        positions = positions[point_keep]
-        radii = radii[point_keep]
-        counts = counts[keep]
-    first = np.zeros(counts.size + 1, np.uint32)
-    np.cumsum(counts, out=first[1:])
-    return first, positions, radii, dropped
+    keep = np.diff(np.asarray(offsets, dtype=np.int64)) >= 2
+    first, (positions, radii) = select_strands(offsets, keep, positions, radii)
+    return first, positions, radii, int(np.count_nonzero(~keep))
+
+
+def renderable_strands(first, positions, radii, numbers, label, warn):
+    """The strands (curves) hairis renders, as a boolean mask, with a warning naming ``label``
+    and counting the others, which are skipped.
+
+    ``positions`` and ``radii`` are world space; they are judged as the float32 values the
+    library gets. A strand with a NaN or infinite position or radius, or a negative radius, is
+    skipped: Cycles (Embree) drops only the segments around such a point, which no valid
+    strand can reproduce, and a refusal would cost the whole image; the warning names the
+    strands (``numbers``: their indices as the artist counts them). Strands of zero length or
+    zero radius are never hit, in Cycles either.
+    """
+    first = np.asarray(first, np.int64)
+    counts = np.diff(first)
+    positions = np.asarray(positions, np.float32)
+    radii = np.asarray(radii, np.float32).reshape(-1)
+    curve_of_point = np.repeat(np.arange(counts.size), counts)
+    with np.errstate(invalid="ignore", over="ignore"):
+        bad_point = ~np.isfinite(positions).all(axis=1) | ~(radii >= 0.0)
+        invalid = np.zeros(counts.size, bool)
+        invalid[curve_of_point[bad_point]] = True
+        step = np.zeros(radii.size, np.float32)
+        step[1:] = np.sqrt(np.sum(np.square(positions[1:] - positions[:-1]), axis=1))
+        step[first[:-1]] = 0.0  # the step into a curve's first point is from another curve
+        moves = np.maximum.reduceat(step, first[:-1]) > 0.0 if counts.size else invalid
+        thick = np.maximum.reduceat(radii, first[:-1]) > 0.0 if counts.size else invalid
+    zero_length = ~invalid & ~moves
+    zero_radius = ~invalid & moves & ~thick
+    if invalid.any():
+        count = int(np.count_nonzero(invalid))
+        listed = ", ".join(str(int(n)) for n in np.asarray(numbers)[invalid][:8])
+        warn("%s: skipped %d strand(s) with a NaN or infinite position or a negative or NaN "
+             "radius (strand%s %s%s); Cycles leaves out only the segments around such a point"
+             % (label, count, "s" if count > 1 else "", listed, ", ..." if count > 8 else ""))
+    if zero_length.any():
+        warn("%s: skipped %d strand(s) of zero length (all points equal; Cycles shows nothing "
+             "there either)" % (label, np.count_nonzero(zero_length)))
+    if zero_radius.any():
+        warn("%s: skipped %d strand(s) of zero radius (Cycles shows nothing there either)"
+             % (label, np.count_nonzero(zero_radius)))
+    return ~(invalid | zero_length | zero_radius)
+
+
+def select_strands(first, keep, *arrays):
+    """(first, arrays) of the strands ``keep`` selects: ``arrays`` hold one row per point
+    (None passes through)."""
+    first = np.asarray(first, np.int64)
+    if keep.all():
+        return first.astype(np.uint32), arrays
+    counts = np.diff(first)
+    point_keep = np.repeat(keep, counts)
+    selected = tuple(None if a is None else a[point_keep] for a in arrays)
+    kept_first = np.zeros(np.count_nonzero(keep) + 1, np.uint32)
+    np.cumsum(counts[keep], out=kept_first[1:])
+    return kept_first, selected
 
 
 def shape_radius(time, shape, root, tip):
@@ -1285,11 +1339,18 @@ def export_particle_hair(exporter, obj):
         material = exporter.material(exporter.slot_material(obj, settings.material - 1),
                                      for_hair=True)
         first = np.arange(curve_count + 1, dtype=np.uint32) * np.uint32(key_count)
+        points, local, radii = points.reshape(-1, 3), local.reshape(-1, 3), radii.reshape(-1)
+        keep = renderable_strands(first, points, radii, indices - exported + present.size,
+                                  "object %r, particle system %r" % (obj.name, psys.name),
+                                  data.warn)
+        first, (points, local, radii) = select_strands(first, keep, points, local, radii)
+        indices = indices[keep]
+        if first.size < 2:
+            continue
         data.curves.append(CurvesData(
             name="%s/%s" % (obj.name, psys.name), source="PARTICLES", material=material,
-            first=first, positions=points.reshape(-1, 3).astype(np.float32),
-            radii=radii.reshape(-1).astype(np.float32),
-            inputs=exporter.strand_inputs(material, first, local.reshape(-1, 3), indices)))
+            first=first, positions=points.astype(np.float32), radii=radii.astype(np.float32),
+            inputs=exporter.strand_inputs(material, first, local, indices)))
 
 
 def export_scene(depsgraph, camera=None):
