@@ -353,11 +353,13 @@ void describe(Fields &f, CameraOptions &o) {
 }
 
 /// Everything hairis_render reads: the renderer's settings, the hair sampler's and how the
-/// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces).
+/// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces;
+/// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape).
 struct RenderOptions {
     RenderSettings render;
     SamplerOptions sampler;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
+    CurveShape curve_shape = CurveShape::Thick;
 };
 template <typename Fields>
 void describe(Fields &f, RenderOptions &o) {
@@ -366,6 +368,9 @@ void describe(Fields &f, RenderOptions &o) {
     int backfaces = int(o.curve_backfaces);
     f.choice("curve_backfaces", backfaces, {"ignore", "hit"});
     o.curve_backfaces = CurveBackfaces(backfaces);
+    int shape = int(o.curve_shape);
+    f.choice("curve_shape", shape, {"thick", "ribbons", "thick_linear"});
+    o.curve_shape = CurveShape(shape);
 }
 
 }  // namespace hairis::capi

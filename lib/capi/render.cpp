@@ -146,6 +146,7 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
         // of the geometry so that it can be rendered again with other settings.
         SceneDesc desc = scene->desc;
         desc.curve_backfaces = o.curve_backfaces;
+        desc.curve_shape = o.curve_shape;
         desc.materials.reserve(scene->materials.size());
         for (size_t m = 0; m < scene->materials.size(); ++m) {
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {

@@ -16,7 +16,8 @@ FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, con
     hit.wo = frame.to_local(wo);
     const bool back = back_facing(sp, wo);
     const Vec3 ng = back ? -sp.normal : sp.normal, tangent = back ? -sp.tangent : sp.tangent;
-    hit.h = std::clamp(dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);  // Cycles
+    // Cycles: ribbons take h from the hit's place across the strip, round curves from Ng.
+    hit.h = std::clamp(sp.is_ribbon ? -sp.curve_v : dot(cross(ng, frame.x), frame.z), -1.0f, 1.0f);
     if (!oriented) return hit;
     // Huang's major axis: the curve normal, or Cycles' arbitrary frame where there is none.
     const Vec3 axis = HuangFiber::major_axis(tangent, sp.curve_normal);

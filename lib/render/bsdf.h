@@ -22,7 +22,7 @@ namespace hairis {
 float cycles_pixel_coverage(float footprint, float curve_radius);
 
 /// The FiberHit the renderer gives a hair material at a curve hit, as Cycles sets up the
-/// Principled Hair closure: ω_o and h = dot(cross(Ng, X), Z) in the frame
+/// Principled Hair closure: ω_o and h = dot(cross(Ng, X), Z) (ribbons: h = −v) in the frame
 /// FiberFrame::from_tangent_and_view, where a back-facing hit (the inside of a tube) turns Ng and
 /// the tangent, as Cycles turns Ng, N and dP/du towards ω_o; the
 /// major axis from the curve normal, or, where the curve has none (or it is parallel to the

@@ -22,7 +22,7 @@ namespace {
 // Cycles' Normal pass at a surface: its shading normal turned towards the viewer, as Cycles
 // turns N at a back-facing hit.
 Vec3 first_hit_normal(const SurfacePoint &sp, Vec3 wo) {
-    const Vec3 n = sp.is_curve ? sp.normal : sp.shading_normal;
+    const Vec3 n = sp.shading_normal;
     return dot(sp.normal, wo) < 0.0f ? -n : n;
 }
 

@@ -82,9 +82,10 @@ void triangle_filter(const RTCFilterFunctionNArguments *args) {
     }
 }
 
-// Round curves: ignore hits on any segment of the curve the ray starts on (the geometry's
-// user data maps segments to curves) and, unless the context says otherwise, hits on the
+// Curves: ignore hits on any segment of the curve the ray starts on (the geometry's user data
+// maps segments to curves) and, on round curves unless the context says otherwise, hits on the
 // inside of the tube (the backface culling of Cycles with Embree 3).
+template <bool kRound>
 void curve_filter(const RTCFilterFunctionNArguments *args) {
     const auto *ctx = reinterpret_cast<const TraceContext *>(args->context);
     const auto *curve_of = static_cast<const std::uint32_t *>(args->geometryUserPtr);
@@ -93,7 +94,7 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
         const float d = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
                         RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
                         RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
-        const bool culled = d > 0.0f && !ctx->hit_curve_backfaces;
+        const bool culled = kRound && d > 0.0f && !ctx->hit_curve_backfaces;
         if (culled || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
                               curve_of[RTCHitN_primID(args->hit, args->N, i)])) {
             args->valid[i] = 0;
@@ -149,6 +150,13 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
                   d0 * p0.w + d1 * p1.w + d2 * p2.w + d3 * p3.w};
 }
 
+// The straight segment p1..p2 (Cycles' linear_basis_eval) and its derivative.
+void linear(const Float4 &p1, const Float4 &p2, float t, Float4 &value, Float4 &derivative) {
+    derivative = {p2.x - p1.x, p2.y - p1.y, p2.z - p1.z, p2.w - p1.w};
+    value = {p1.x + t * derivative.x, p1.y + t * derivative.y, p1.z + t * derivative.z,
+             p1.w + t * derivative.w};
+}
+
 // A curve set's inputs: known once each, sized for its curves or points, in range, read by
 // the material's node, on a material that varies per strand.
 Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
@@ -202,6 +210,7 @@ struct Scene::Impl {
     std::optional<Camera> camera;
     SceneStats stats;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
+    CurveShape curve_shape = CurveShape::Thick;
 
     std::atomic<long long> embree_bytes{0};
     std::atomic<long long> embree_peak{0};
@@ -258,6 +267,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         return Error{"curve_backfaces must be ignore (0) or hit (1) (got " +
                      std::to_string(int(desc.curve_backfaces)) + ")"};
     impl->curve_backfaces = desc.curve_backfaces;
+    if (desc.curve_shape != CurveShape::Thick && desc.curve_shape != CurveShape::Ribbons &&
+        desc.curve_shape != CurveShape::ThickLinear)
+        return Error{"curve_shape must be thick (0), ribbons (1) or thick_linear (2) (got " +
+                     std::to_string(int(desc.curve_shape)) + ")"};
+    impl->curve_shape = desc.curve_shape;
 
     // Materials.
     for (std::size_t m = 0; m < desc.materials.size(); ++m) {
@@ -492,18 +506,26 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     rtcSetSceneFlags(impl->rtc_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(impl->rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
 
+    const CurveShape shape = impl->curve_shape;
+    const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE
+                                       : shape == CurveShape::ThickLinear ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                                          : RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE;
+    const RTCFilterFunctionN filter = shape == CurveShape::Ribbons ? &curve_filter<false> : &curve_filter<true>;
+    // Linear segments start one control point on: segment index k reads points k and k + 1
+    // past the leading duplicate.
+    const std::size_t skip = shape == CurveShape::ThickLinear ? 1 : 0;
     for (std::size_t i = 0; i < impl->curves.size(); ++i) {
         CurveGeometry &geo = impl->curves[i];
-        RTCGeometry g = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE);
+        RTCGeometry g = rtcNewGeometry(impl->device, curve_type);
         rtcSetGeometryTessellationRate(g, 5.0f);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, geo.cvs.data(),
-                                   0, sizeof(Float4), geo.cvs.size());
+                                   skip * sizeof(Float4), sizeof(Float4), geo.cvs.size() - skip);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
                                    geo.segments.data(), 0, sizeof(std::uint32_t),
                                    geo.segments.size());
         rtcSetGeometryUserData(g, geo.curve_of.data());
-        rtcSetGeometryIntersectFilterFunction(g, &curve_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &curve_filter);
+        rtcSetGeometryIntersectFilterFunction(g, filter);
+        rtcSetGeometryOccludedFilterFunction(g, filter);
         rtcCommitGeometry(g);
         const unsigned id = rtcAttachGeometry(impl->rtc_scene, g);
         rtcReleaseGeometry(g);
@@ -744,7 +766,10 @@ Vec3 Scene::curve_point(PrimRef segment, float u, Vec3 *derivative, float *radiu
     const CurveGeometry &geo = impl_->curves.at(info.index);
     const std::uint32_t k = geo.segments.at(segment.primitive);
     Float4 value, d;
-    catmull_rom(geo.cvs[k], geo.cvs[k + 1], geo.cvs[k + 2], geo.cvs[k + 3], u, value, d);
+    if (impl_->curve_shape == CurveShape::ThickLinear)
+        linear(geo.cvs[k + 1], geo.cvs[k + 2], u, value, d);
+    else
+        catmull_rom(geo.cvs[k], geo.cvs[k + 1], geo.cvs[k + 2], geo.cvs[k + 3], u, value, d);
     if (derivative) *derivative = {d.x, d.y, d.z};
     if (radius) *radius = value.w;
     return {value.x, value.y, value.z};
@@ -763,8 +788,14 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
         sp.curve_u = std::clamp(hit.u, 0.0f, 1.0f);
         sp.self = {hit.prim.geometry, geo.curve_of[hit.prim.primitive]};
         sp.material = geo.material;
-        const Vec3 n = safe_normalize(sp.position - centre);
-        sp.normal = dot(n, n) > 0.0f ? n : -dir;
+        if (impl_->curve_shape == CurveShape::Ribbons) {
+            sp.normal = -dir;
+            sp.is_ribbon = true;
+            sp.curve_v = std::clamp(hit.v, -1.0f, 1.0f);
+        } else {
+            const Vec3 n = safe_normalize(sp.position - centre);
+            sp.normal = dot(n, n) > 0.0f ? n : -dir;
+        }
         sp.shading_normal = sp.normal;
         // Per-point attributes between the segment's two points (Cycles' curve_attribute).
         const std::uint32_t key = geo.segments[hit.prim.primitive] + 1;
@@ -782,6 +813,14 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
                 orthonormal_basis(sp.normal, t1, t2);
                 sp.tangent = t1;
             }
+        }
+        if (sp.is_ribbon) {
+            // Cycles' rounded ribbon normal: sine v towards the strip's edge, cosine towards −dir.
+            const Vec3 bitangent = safe_normalize(cross(sp.tangent, -dir));
+            const Vec3 towards = safe_normalize(cross(sp.tangent, bitangent));
+            const float sine = sp.curve_v, cosine = std::sqrt(std::max(0.0f, 1.0f - sine * sine));
+            const Vec3 n = safe_normalize(bitangent * sine - towards * cosine);
+            if (dot(n, n) > 0.0f) sp.shading_normal = n;
         }
     } else {
         const MeshGeometry &geo = impl_->meshes[info.index];

@@ -1,23 +1,31 @@
 // A render scene: hair curves, triangle meshes, materials, lights, world and camera, given as
 // plain data, validated, and built into an Embree 3 BVH.
 //
-// Hair curves are Embree ROUND Catmull-Rom curves, like Cycles' "3D Curves" shape
-// (intern/cycles/bvh/embree.cpp, add_curves and set_curve_vertex_buffer): per curve of n
-// points, Embree gets n + 2 control points — the first and the last point duplicated — and
-// n − 1 segments, so the curve passes through every point from the first to the last. The
-// radius is per point (Embree's 4th vertex component). Hits on the inside of a tube (ray
-// direction · Embree's Ng > 0: a ray that starts inside another strand's tube) follow
-// SceneDesc::curve_backfaces, and a ray never hits the curve it starts on — any segment of
+// Hair curves are Embree curves of the type Cycles gives its Curves > Shape
+// (intern/cycles/bvh/embree.cpp, add_curves and set_curve_vertex_buffer; SceneDesc::curve_shape):
+// ROUND Catmull-Rom for "3D Curves" (Thick), FLAT Catmull-Rom — a strip facing the ray — for
+// "Rounded Ribbons", ROUND linear for 5.0's "Linear 3D Curves". Per curve of n points,
+// Embree gets n + 2 control points — the first and the last point duplicated — and n − 1
+// segments, so a Catmull-Rom curve passes through every point from the first to the last;
+// linear curves read the same buffer one control point on, so that segment k joins points k
+// and k + 1, as Cycles' linear layout without the duplicates does. The radius is per point
+// (Embree's 4th vertex component). Hits on the inside of a round tube (ray direction ·
+// Embree's Ng > 0: a ray that starts inside another strand's tube) follow
+// SceneDesc::curve_backfaces; ribbons have no inside (Embree's Ng of a flat curve is its
+// tangent, and Cycles culls nothing on them), and a ray never hits the curve it starts on — any segment of
 // it — as Cycles' self-intersection test does (kernel/device/cpu/bvh.h,
 // kernel_embree_is_self_intersection maps a hair segment to its curve before comparing), so
 // no origin offset is needed. The
 // Embree tessellation rate is Cycles' default: Curves > Subdivisions 2 (addon properties.py),
 // SceneParams::curve_subdivisions() = 2² = 4, rtcSetGeometryTessellationRate(4 + 1).
 //
-// Curve shading data, as Cycles' curve_shader_setup for thick curves (kernel/geom/curve.h):
-// the hit P, P_curve = the Catmull-Rom centre line at the hit's u, Ng = normalize(P − P_curve),
-// tangent = normalize(dP/du). The renderer then builds the fiber frame from the tangent and
-// ω_o and h = dot(cross(Ng, X), Z) (bsdf_principled_hair_setup). Per-point attributes are
+// Curve shading data, as Cycles' curve_shader_setup (kernel/geom/curve_intersect.h): for thick
+// curves the hit P, P_curve = the centre line at the hit's u (Catmull-Rom, or the segment's
+// straight line for linear curves), Ng = normalize(P − P_curve), tangent = normalize(dP/du);
+// the renderer then builds the fiber frame from the tangent and ω_o and
+// h = dot(cross(Ng, X), Z) (bsdf_principled_hair_setup). For ribbons Ng = ω_o, the tangent
+// is the Catmull-Rom one, N the rounded normal from Embree's v across the strip, and the
+// hair closures take h = −v. Per-point attributes are
 // interpolated linearly between the segment's two points at the hit's u, as Cycles'
 // curve_attribute does: the curve normal (Huang's major axis, kernel/svm/closure.h) and the
 // radius Cycles divides the pixel footprint by (pixel_coverage).
@@ -132,6 +140,12 @@ struct TriangleMesh {
 /// with the outward normal like any other.
 enum class CurveBackfaces : int { Ignore = 0, Hit = 1 };
 
+/// The shape hair curves are traced as: Cycles' Curves > Shape (scene.cycles_curves.shape), one
+/// for the whole scene. Thick is "3D Curves" (round Catmull-Rom tubes), Ribbons "Rounded
+/// Ribbons" (flat Catmull-Rom strips that face the ray, shaded as if round), ThickLinear
+/// Cycles 5.0's "Linear 3D Curves" (round cones from point to point).
+enum class CurveShape : int { Thick = 0, Ribbons = 1, ThickLinear = 2 };
+
 /// Everything a scene is made of, as plain data.
 struct SceneDesc {
     std::vector<Material> materials;
@@ -144,6 +158,7 @@ struct SceneDesc {
     WorldLight world;
     CameraDesc camera;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
+    CurveShape curve_shape = CurveShape::Thick;
 };
 
 /// What the build did and what it costs.
@@ -195,16 +210,22 @@ struct StrandCrossing {
 /// What shading needs at a hit point.
 struct SurfacePoint {
     Vec3 position;
-    /// Unit geometric normal: the face normal (not flipped) for triangles; for curves the
-    /// outward tube normal normalize(P − P_curve(u)) (Cycles' thick-curve Ng).
+    /// Unit geometric normal: the face normal (not flipped) for triangles; for thick curves
+    /// the outward tube normal normalize(P − P_curve(u)) (Cycles' thick-curve Ng); for ribbons
+    /// −dir, towards the ray's origin (Cycles' ribbon Ng = ω_o).
     Vec3 normal;
     /// Unit curve tangent normalize(dP/du) (zero for triangles).
     Vec3 tangent;
     /// The curve parameter of the hit in its segment, in [0, 1] (0 for triangles).
     float curve_u = 0;
     /// Triangles: the unit shading normal, on the same side as `normal` (equal to it for flat
-    /// faces); curves: equal to `normal`.
+    /// faces); thick curves: equal to `normal`; ribbons: Cycles' rounded normal, which turns
+    /// from the ray's side of the strand at v = 0 to its edges at v = ±1.
     Vec3 shading_normal;
+    /// Ribbons: Embree's hit v across the ribbon, in [−1, 1] (Cycles' sd->v; the hair offset
+    /// is h = −v); 0 otherwise.
+    float curve_v = 0;
+    bool is_ribbon = false;
     /// Triangles: the UV map at the hit ((0, 0) without one).
     float u = 0.0f, v = 0.0f;
     /// Curves: the normal attribute interpolated at the hit (not normalized; zero when the
@@ -296,8 +317,9 @@ class Scene {
     /// `values`; false (values untouched) for triangles and curves without inputs.
     bool hair_inputs(const SurfacePoint &point, HairInputValues &values) const;
 
-    /// The Catmull-Rom centre line of a curve segment at u ∈ [0, 1] (for tests): position
-    /// (and radius in `radius`), and dP/du in `derivative` when not null.
+    /// The centre line of a curve segment at u ∈ [0, 1] (Catmull-Rom, or the straight line
+    /// between the segment's points for CurveShape::ThickLinear): position (and radius in
+    /// `radius`), and dP/du in `derivative` when not null.
     Vec3 curve_point(PrimRef segment, float u, Vec3 *derivative = nullptr,
                      float *radius = nullptr) const;
 

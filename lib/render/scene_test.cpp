@@ -627,5 +627,110 @@ TEST(Scene, InvalidCurveInputsAreRefusedByName) {
     EXPECT_NE(e.find("does not vary per strand"), std::string::npos) << e;
 }
 
+// A straight hair along +X (straight_hair) as a scene of the given shape.
+Scene straight_scene(CurveShape shape) {
+    SceneDesc d;
+    d.materials = {hair_material()};
+    d.curves = {straight_hair()};
+    d.camera = small_camera();
+    d.curve_shape = shape;
+    return build_ok(std::move(d));
+}
+
+// Rays aimed at (0.3, 0, 0) + s·r·Y, Y = normalize(X × ω_o) the direction across the strand
+// as seen from ω_o, from several directions (some along the tangent, some against it): a ribbon
+// is the strip through the axis that faces the ray, so each hits at the distance of that point,
+// with Ng = ω_o, v = s, and Cycles' rounded normal s·Y + sqrt(1 − s²)·(ω_o across the strand).
+TEST(Scene, RibbonsFaceEveryRayWithCyclesRoundedNormal) {
+    const Scene ribbons = straight_scene(CurveShape::Ribbons);
+    const Vec3 tangent{1, 0, 0};
+    const float r = 0.1f, L = 3.0f;
+    for (const Vec3 d : {Vec3{0, 0, -1}, Vec3{0, -1, 0}, Vec3{0, 0.6f, 0.8f}, Vec3{0.4f, -0.6f, -0.7f},
+                         Vec3{-0.5f, 0.3f, 0.6f}, Vec3{0.7f, 0.7f, 0.1f}}) {
+        const Vec3 dir = safe_normalize(d), wo = -dir;
+        const Vec3 across = safe_normalize(cross(tangent, wo));
+        const Vec3 facing = safe_normalize(wo - tangent * dot(wo, tangent));
+        for (float s : {-0.8f, -0.3f, 0.0f, 0.5f, 0.9f}) {
+            const Vec3 target = Vec3{0.3f, 0, 0} + across * (s * r);
+            const Vec3 origin = target - dir * L;
+            const auto hit = ribbons.intersect(origin, dir, 0.0f, INFINITY);
+            ASSERT_TRUE(hit.has_value()) << d.x << "," << d.y << "," << d.z << " s=" << s;
+            EXPECT_NEAR(hit->t, L, 1e-4f);
+            const SurfacePoint sp = ribbons.surface_point(origin, dir, *hit);
+            EXPECT_TRUE(sp.is_curve && sp.is_ribbon);
+            EXPECT_NEAR(length(sp.normal - wo), 0.0f, 1e-6f);
+            EXPECT_NEAR(sp.curve_v, s, 1e-4f);
+            EXPECT_NEAR(length(sp.tangent - tangent), 0.0f, 1e-5f);
+            const Vec3 rounded = across * s + facing * std::sqrt(1.0f - s * s);
+            EXPECT_NEAR(length(sp.shading_normal - rounded), 0.0f, 1e-4f) << s;
+            EXPECT_EQ(sp.self.primitive, 0u);
+        }
+        // Beside the strip: a miss; a shadow ray is blocked by the strip, whichever its side.
+        EXPECT_FALSE(ribbons.intersect(Vec3{0.3f, 0, 0} + across * (1.2f * r) - dir * L, dir, 0.0f, INFINITY));
+        EXPECT_TRUE(ribbons.occluded(Vec3{0.3f, 0, 0} - dir * L, dir, 0.0f, 2 * L));
+    }
+
+    SceneDesc bad;
+    bad.materials = {hair_material()};
+    bad.curves = {straight_hair()};
+    bad.camera = small_camera();
+    bad.curve_shape = CurveShape(5);
+    const std::string e = build_error(std::move(bad));
+    EXPECT_NE(e.find("curve_shape must be thick (0), ribbons (1) or thick_linear (2) (got 5)"), std::string::npos)
+        << e;
+}
+
+// Linear 3D curves: segment k is the straight round cone from point k to point k + 1; a
+// Catmull-Rom curve through the same points bends away from it.
+TEST(Scene, LinearCurvesRunStraightBetweenTheirPoints) {
+    auto scene_of = [](CurveShape shape) {
+        SceneDesc d;
+        d.materials = {hair_material()};
+        HairCurves c;
+        c.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 2, 0}, {0, 3, 0}, {1, 3, 0}};
+        c.radii = {0.05f, 0.05f, 0.05f, 0.05f, 0.05f, 0.05f};
+        c.first = {0, 4, 6};
+        d.curves = {c};
+        d.camera = small_camera();
+        d.curve_shape = shape;
+        return build_ok(std::move(d));
+    };
+    const Scene linear = scene_of(CurveShape::ThickLinear), thick = scene_of(CurveShape::Thick);
+    const Vec3 points[4] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 2, 0}};
+    for (std::uint32_t k = 0; k < 3; ++k)
+        for (float u : {0.0f, 0.3f, 0.5f, 1.0f}) {
+            Vec3 derivative;
+            const Vec3 p = linear.curve_point({0, k}, u, &derivative);
+            EXPECT_NEAR(length(p - (points[k] * (1 - u) + points[k + 1] * u)), 0.0f, 1e-6f);
+            EXPECT_NEAR(length(derivative - (points[k + 1] - points[k])), 0.0f, 1e-6f);
+        }
+    // Straight down onto the middle of each segment: the top of the cone, r above the line.
+    const Vec3 down{0, 0, -1};
+    for (std::uint32_t k = 0; k < 3; ++k) {
+        const Vec3 mid = (points[k] + points[k + 1]) * 0.5f;
+        const Vec3 origin = mid + Vec3{0, 0, 5};
+        const auto hit = linear.intersect(origin, down, 0.0f, INFINITY);
+        ASSERT_TRUE(hit.has_value()) << k;
+        EXPECT_NEAR(hit->t, 5.0f - 0.05f, 1e-4f);
+        EXPECT_EQ(hit->prim.primitive, k);
+        const SurfacePoint sp = linear.surface_point(origin, down, *hit);
+        EXPECT_NEAR(length(sp.normal - Vec3{0, 0, 1}), 0.0f, 1e-3f);
+        EXPECT_NEAR(length(sp.tangent - safe_normalize(points[k + 1] - points[k])), 0.0f, 1e-5f);
+        EXPECT_FALSE(sp.is_ribbon);
+    }
+    // Off the line by half the radius across segment 1: the normal tilts by 30°.
+    const auto side = linear.intersect({1.5f, 0.025f, 5}, down, 0.0f, INFINITY);
+    ASSERT_TRUE(side.has_value());
+    EXPECT_NEAR(linear.surface_point({1.5f, 0.025f, 5}, down, *side).normal.y, 0.5f, 1e-3f);
+    // The Catmull-Rom curve passes 0.125 below segment 1's middle (y = −2/16): a miss there.
+    EXPECT_FALSE(thick.intersect({1.5f, 0, 5}, down, 0.0f, INFINITY).has_value());
+    // No segment joins one curve's last point to the next curve's first.
+    EXPECT_FALSE(linear.intersect({1.5f, 2.5f, 5}, down, 0.0f, INFINITY).has_value());
+    const auto second = linear.intersect({0.5f, 3, 5}, down, 0.0f, INFINITY);
+    ASSERT_TRUE(second.has_value());
+    EXPECT_EQ(second->prim.primitive, 3u);
+    EXPECT_EQ(linear.surface_point({0.5f, 3, 5}, down, *second).self.primitive, 1u);
+}
+
 }  // namespace
 }  // namespace hairis

@@ -324,6 +324,7 @@ static void test_defaults(void)
     expect_default("render", "tile_size", "16");
     expect_default("render", "film_transparent", "0");
     expect_default("render", "curve_backfaces", "ignore");
+    expect_default("render", "curve_shape", "thick");
     expect_default("render", "strategy", "table");
     expect_default("render", "seed", "0");
     expect_default("render", "threads", "0");
@@ -495,6 +496,7 @@ static void test_option_strings(void)
         {"area", "shape=hexagon", "shape", "ellipse"},
         {"render", "film_transparent=2", "film_transparent", "true"},
         {"render", "curve_backfaces=cull", "curve_backfaces", "hit"},
+        {"render", "curve_shape=RIBBONS", "curve_shape", "thick_linear"},
         {"camera", "orthographic=yes", "orthographic", "false"},
     };
     for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {

@@ -185,7 +185,8 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * film_transparent, curve_backfaces = ignore (default) | hit: whether a ray that meets a
  * curve from inside its tube (it started inside another, overlapping strand) passes, as in
  * Cycles built with Embree 3 (Blender 3.4), or hits it, as in Cycles with Embree 4 (Blender's
- * builds from 3.6: 4.5, 5.0), transparent_limit = plus_one (default) | setting: a path crosses
+ * builds from 3.6: 4.5, 5.0), curve_shape = thick (default) | ribbons | thick_linear: Cycles'
+ * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), transparent_limit = plus_one (default) | setting: a path crosses
  * at most max_transparent_bounces + 1 transparent surfaces, as Cycles up to 4.5 (it stores the
  * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
