@@ -125,17 +125,28 @@ struct SceneHairMaterial {
     PrincipledHairNode node;  ///< the fiber's node: what curve inputs vary
     std::shared_ptr<const HuangFiber> huang;
     std::optional<SamplingTables> tables;
+    /// A mixture (hairis_scene_add_hair_mixture): the hair materials it mixes, by index, and
+    /// their weights; the fields above are then its first closure's. Empty otherwise.
+    std::vector<std::size_t> closures;
+    std::vector<float> weights;
 };
 
 /// hairis_scene_add_curves_with_inputs' `inputs`: per node input (hair_inputs.h's names and
 /// order), where its values come from: 0 material (the fiber's own value), 1 curve, 2 point.
+/// weight0 .. weight7: the same for the weight of each closure of a hair mixture (their values
+/// follow the node inputs', one float per curve or point, in closure order).
 struct CurveInputOptions {
     int domain[kHairInputCount] = {};
+    int weight_domain[kMaxHairClosures] = {};
 };
 template <typename Fields>
 void describe(Fields &f, CurveInputOptions &o) {
     for (int i = 0; i < kHairInputCount; ++i)
         f.choice(hair_input_info(HairInput(i)).name, o.domain[i], {"material", "curve", "point"});
+    static const char *const kWeightNames[kMaxHairClosures] = {"weight0", "weight1", "weight2", "weight3",
+                                                               "weight4", "weight5", "weight6", "weight7"};
+    for (int k = 0; k < kMaxHairClosures; ++k)
+        f.choice(kWeightNames[k], o.weight_domain[k], {"material", "curve", "point"});
 }
 
 using SceneMaterial = std::variant<SceneHairMaterial, SurfaceMaterial>;

@@ -121,6 +121,21 @@ void add_dual_scattering(HairMaterial &material, const SceneHairMaterial &hair, 
     material.multiple = hair.tables->multiple;
 }
 
+// A mixture's material: each closure's shading under the settings (its own sampler and
+// tables), mixed with its weight.
+HairMaterial hair_mixture(const hairis_scene &scene, const SceneHairMaterial &hair, size_t index,
+                          const SamplerOptions &o) {
+    const std::string name = "material " + std::to_string(index) + " (hair mixture): ";
+    std::vector<HairShading> closures;
+    for (size_t m : hair.closures)
+        closures.push_back(hair_shading(std::get<SceneHairMaterial>(scene.materials[m]), m, o, false));
+    HairMaterial material{closures.front()};
+    Expected<HairMixture> mixture = HairMixture::create(std::move(closures), hair.weights);
+    if (!mixture) invalid(name + mixture.error().message);
+    material.mixture = std::make_shared<const HairMixture>(std::move(mixture).value());
+    return material;
+}
+
 }  // namespace
 
 }  // namespace hairis::capi
@@ -144,6 +159,13 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
 
         // The scene description with this render's materials. The handle keeps its own copy
         // of the geometry so that it can be rendered again with other settings.
+        if (o.render.integrator == int(Integrator::DualScattering))
+            for (size_t m = 0; m < scene->materials.size(); ++m)
+                if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]); hair && !hair->closures.empty())
+                    invalid("material " + std::to_string(m) + " (hair mixture): integrator=dual_scattering shades "
+                            "one Principled Hair BSDF per material, and this material mixes " +
+                            std::to_string(hair->closures.size()) + " (a Mix or Add Shader of hair closures); "
+                            "render with integrator=path");
         SceneDesc desc = scene->desc;
         desc.curve_backfaces = o.curve_backfaces;
         desc.curve_shape = o.curve_shape;
@@ -153,6 +175,10 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
                 // Dual scattering samples Huang with its tables: its MIS needs the sampler's
                 // density, which Cycles' own Huang sampler does not have.
                 const bool dual = o.render.integrator == int(Integrator::DualScattering);
+                if (!hair->closures.empty()) {
+                    desc.materials.push_back(hair_mixture(*scene, *hair, m, o.sampler));
+                    continue;
+                }
                 HairMaterial material{hair_shading(*hair, m, o.sampler,
                                                    o.render.huang_sampling == int(HuangSampling::Cycles) && !dual)};
                 if (dual) add_dual_scattering(material, *hair, m);

@@ -340,6 +340,14 @@ HairCurves checked_curves(const hairis_scene *scene, int material, size_t curve_
     return curves;
 }
 
+// Whether `hair`, or another closure of its mixture, reads `input`.
+bool mixture_reads(const hairis_scene &scene, const SceneHairMaterial &hair, HairInput input) {
+    if (reads(hair.node.parametrization, input)) return true;
+    for (size_t m : hair.closures)
+        if (reads(std::get<SceneHairMaterial>(scene.materials[m]).node.parametrization, input)) return true;
+    return false;
+}
+
 void add(hairis_scene &scene, HairCurves curves) {
     size_t bytes = curves.first.size() * sizeof(std::uint32_t) +
                    curves.points.size() * (sizeof(Vec3) + sizeof(float));
@@ -397,6 +405,38 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
         hair.huang = fiber->huang;
         if (tables) hair.tables = tables->sampling;
         return add_material(*scene, std::move(hair));
+    });
+}
+
+HAIRIS_API int hairis_scene_add_hair_mixture(hairis_scene *scene, size_t count, const int *materials,
+                                             const float *weights) {
+    return guard_value<int>("hairis_scene_add_hair_mixture", -1, [&] {
+        require(scene, "scene");
+        if (count < 1 || count > size_t(kMaxHairClosures))
+            invalid("hair mixture: count must be in [1, " + std::to_string(kMaxHairClosures) + "] (got " +
+                    std::to_string(count) + ")");
+        require_array(materials, count, "materials");
+        require_array(weights, count, "weights");
+        SceneHairMaterial mixture;
+        for (size_t k = 0; k < count; ++k) {
+            const int m = materials[k];
+            const std::string which = "hair mixture: closure " + std::to_string(k) + ": material " + std::to_string(m);
+            if (m < 0 || size_t(m) >= scene->materials.size())
+                invalid(which + " is not in the scene, in [0, " + std::to_string(scene->materials.size()) + ")");
+            const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[size_t(m)]);
+            if (!hair || !hair->closures.empty())
+                invalid(which + " is not a hair material of one fiber (hairis_scene_add_hair_material); a "
+                                "mixture mixes those");
+            if (hair->huang)
+                invalid(which + " is huang2022; a mixture mixes chiang2016 materials in this version");
+            if (!std::isfinite(weights[k]) || weights[k] < 0.0f)
+                invalid("hair mixture: closure " + std::to_string(k) + "'s weight is " + format_number(weights[k]) +
+                        "; weights must be finite and >= 0");
+            if (k == 0) mixture = *hair;
+            mixture.closures.push_back(size_t(m));
+            mixture.weights.push_back(weights[k]);
+        }
+        return add_material(*scene, std::move(mixture));
     });
 }
 
@@ -498,11 +538,21 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
                 invalid(std::string("curve inputs: ") + info.name + " per curve or point needs a chiang2016 " +
                         "material; material " + std::to_string(material) +
                         " is huang2022, whose inputs are the material's own in this version");
-            if (!reads(hair->node.parametrization, HairInput(i)))
+            if (!mixture_reads(*scene, *hair, HairInput(i)))
                 invalid(std::string("curve inputs: ") + info.name + " is not read by material " +
                         std::to_string(material) + "'s parametrization (" +
-                        parametrization_name(hair->node.parametrization) + ")");
+                        parametrization_name(hair->node.parametrization) + ")" +
+                        (hair->closures.empty() ? "" : " nor by another of its closures"));
             needed += size_t(info.components) * (o.domain[i] == 2 ? point_count : curve_count);
+        }
+        for (int k = 0; k < kMaxHairClosures; ++k) {
+            if (o.weight_domain[k] == 0) continue;
+            const size_t closures = hair ? hair->closures.size() : 0;
+            if (size_t(k) >= closures)
+                invalid("curve inputs: weight" + std::to_string(k) + " needs a hair mixture of more than " +
+                        std::to_string(k) + " closures; material " + std::to_string(material) + " mixes " +
+                        std::to_string(closures) + " (hairis_scene_add_hair_mixture)");
+            needed += o.weight_domain[k] == 2 ? point_count : curve_count;
         }
         if (value_count != needed)
             invalid("value_count must be " + std::to_string(needed) + " (the inputs' components for each of " +
@@ -523,6 +573,19 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
             }
             curves.inputs.push_back({input, per_point, std::vector<float>(values + at, values + at + n * k)});
             at += n * k;
+        }
+        for (int k = 0; k < kMaxHairClosures; ++k) {
+            if (o.weight_domain[k] == 0) continue;
+            const bool per_point = o.weight_domain[k] == 2;
+            const size_t n = per_point ? point_count : curve_count;
+            for (size_t j = 0; j < n; ++j)
+                if (!std::isfinite(values[at + j]) || values[at + j] < 0.0f)
+                    invalid("values: weight" + std::to_string(k) + ", " + (per_point ? "point " : "curve ") +
+                            std::to_string(j) + ": " + format_number(values[at + j]) +
+                            " (a closure weight must be finite and >= 0)");
+            CurveInput weight{HairInput::Melanin, per_point, std::vector<float>(values + at, values + at + n), k};
+            curves.inputs.push_back(std::move(weight));
+            at += n;
         }
         if (curve_count > 0) add(*scene, std::move(curves));
         return HAIRIS_OK;

@@ -52,9 +52,17 @@ std::optional<FiberHit> camera_hair_hit(const Scene &scene, int x, int y, float 
 }
 
 Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
-           const HairInputValues *inputs, ScratchBuffer &scratch) {
+           const HairInputValues *inputs, ScratchBuffer &scratch, const ClosureWeights *weights) {
     if (const auto *hair = std::get_if<HairMaterial>(&material)) {
         frame_ = hair_frame(sp, wo);
+        if (hair->mixture) {
+            // Every closure shades the same hit with the same inputs; Cycles' own Huang
+            // sampler has no density to mix with, so mixtures use the material's strategy.
+            FiberHit hit = fiber_hit(sp, wo, frame_, context);
+            hit.inputs = inputs;
+            mixture_.emplace(hair->mixture->at(hit, weights, scratch));
+            return;
+        }
         const ShadingModel *model = hair->shading.model();
         FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
         hit.inputs = inputs;
@@ -93,8 +101,8 @@ bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pd
         weight = s->weight;
         return dot(wi, wi) > 0.0f;
     }
-    if (hair_) {
-        const std::optional<BsdfSample> s = hair_->sample(u0, u1, u2);
+    if (hair_ || mixture_) {
+        const std::optional<BsdfSample> s = hair_ ? hair_->sample(u0, u1, u2) : mixture_->sample(u0, u1, u2);
         if (!s || !(s->pdf > 0.0f)) return false;
         wi = safe_normalize(frame_.to_world(s->wi));
         pdf = s->pdf;

@@ -67,15 +67,20 @@ FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, con
 /// faces.
 class Bsdf {
   public:
-    /// `inputs`: the hit's per-strand node inputs (hair), null for the material's own.
+    /// `inputs`: the hit's per-strand node inputs (hair), null for the material's own;
+    /// `weights`: its per-strand closure weights (a hair mixture), null for the material's.
     Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitContext &context,
-         const HairInputValues *inputs, ScratchBuffer &scratch);
+         const HairInputValues *inputs, ScratchBuffer &scratch, const ClosureWeights *weights = nullptr);
 
     bool black() const { return !is_hair() && surface_.black(); }
-    bool is_hair() const { return hair_.has_value() || huang_; }
+    bool is_hair() const { return hair_.has_value() || huang_ || mixture_.has_value(); }
     /// The ray passes without scattering (Huang outside its ellipse).
-    bool transparent() const { return (hair_ && hair_->transparent()) || (huang_ && huang_->transparent()); }
-    /// The prepared fiber and sampler (null for surfaces and Cycles' Huang sampling).
+    bool transparent() const {
+        return (hair_ && hair_->transparent()) || (huang_ && huang_->transparent()) ||
+               (mixture_ && mixture_->transparent());
+    }
+    /// The prepared fiber and sampler (null for surfaces, hair mixtures and Cycles' Huang
+    /// sampling).
     const HairBsdf *hair() const { return hair_ ? &*hair_ : nullptr; }
     const FiberFrame &frame() const { return frame_; }
 
@@ -87,6 +92,7 @@ class Bsdf {
             return huang_->f(frame_.to_local(wi));
         }
         if (hair_) return hair_->f_and_pdf(frame_.to_local(wi), pdf);
+        if (mixture_) return mixture_->f_and_pdf(frame_.to_local(wi), pdf);
         return surface_.eval(wi, pdf);
     }
 
@@ -96,6 +102,7 @@ class Bsdf {
 
   private:
     std::optional<HairBsdf> hair_;
+    std::optional<HairMixtureBsdf> mixture_;
     const HuangPoint *huang_ = nullptr;  // Cycles' Huang sampling
     mutable CyclesLcg lcg_;              // its sampler's numbers beyond the path's three
     FiberFrame frame_;

@@ -96,11 +96,16 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
         context.cycles_huang =
             settings_.huang_sampling == int(HuangSampling::Cycles) && !dual.may_shade(path.vertex);
         const HairInputValues *inputs = nullptr;
+        const ClosureWeights *weights = nullptr;
         if (sp.is_curve) {
             HairInputValues values;
-            if (scene_.hair_inputs(sp, values)) inputs = &scratch.make<HairInputValues>(values);
+            ClosureWeights strand_weights;
+            if (scene_.hair_inputs(sp, values, &strand_weights)) {
+                inputs = &scratch.make<HairInputValues>(values);
+                if (strand_weights.given) weights = &scratch.make<ClosureWeights>(strand_weights);
+            }
         }
-        const Bsdf bsdf(material, sp, wo, context, inputs, scratch);
+        const Bsdf bsdf(material, sp, wo, context, inputs, scratch, weights);
         if (bsdf.transparent()) {
             // The same ray goes on beyond this curve.
             path.last_segment = ++path.transparent_bounces >= transparent_crossings_;

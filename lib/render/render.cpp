@@ -51,11 +51,17 @@ Status check_integrator(const Scene &scene, const RenderSettings &s) {
     if (s.integrator != int(Integrator::DualScattering)) return std::nullopt;
     const std::vector<Material> &materials = scene.materials();
     for (std::size_t m = 0; m < materials.size(); ++m)
-        if (const auto *hair = std::get_if<HairMaterial>(&materials[m]))
+        if (const auto *hair = std::get_if<HairMaterial>(&materials[m])) {
+            if (hair->mixture)
+                return Error{"integrator=dual_scattering: hair material " + std::to_string(m) + " mixes " +
+                             std::to_string(hair->mixture->size()) + " hair closures (a Mix or Add Shader); dual "
+                             "scattering shades one Principled Hair BSDF per material: render it with "
+                             "integrator=path"};
             if (!hair->dual || !hair->multiple)
                 return Error{"integrator=dual_scattering: hair material " + std::to_string(m) +
                              " has no " + (hair->dual ? "multiple-scattering table" : "dual-scattering data") +
                              " (HairMaterial::dual and ::multiple are needed; integrator=path needs neither)"};
+        }
     return std::nullopt;
 }
 

@@ -150,6 +150,44 @@ void catmull_rom(const Float4 &p0, const Float4 &p1, const Float4 &p2, const Flo
                   d0 * p0.w + d1 * p1.w + d2 * p2.w + d3 * p3.w};
 }
 
+// The floats per curve or point of a curve input.
+int components_of(const CurveInput &in) {
+    return in.closure_weight >= 0 ? 1 : hair_input_info(in.input).components;
+}
+
+// A curve set's closure weights: one per closure of the material's mixture at most, sized for
+// its curves or points, finite and >= 0.
+Status check_closure_weight(const CurveInput &in, const std::string &set, const HairMaterial *hair,
+                            std::size_t curves, std::size_t points, std::uint32_t &seen) {
+    const std::string name = set + ", closure " + std::to_string(in.closure_weight) + "'s weight";
+    const int closures = hair && hair->mixture ? hair->mixture->size() : 0;
+    if (in.closure_weight >= closures)
+        return Error{name + ": the material has " + std::to_string(closures) +
+                     " mixed hair closure(s); a weight per strand needs a closure of a hair mixture"};
+    if ((seen >> unsigned(in.closure_weight)) & 1u) return Error{name + ": given twice"};
+    seen |= 1u << unsigned(in.closure_weight);
+    const std::size_t n = in.per_point ? points : curves;
+    if (in.values.size() != n)
+        return Error{name + ": has " + std::to_string(in.values.size()) + " values; " + std::to_string(n) +
+                     (in.per_point ? " points" : " curves") + " need " + std::to_string(n)};
+    for (std::size_t i = 0; i < n; ++i)
+        if (!std::isfinite(in.values[i]) || in.values[i] < 0.0f)
+            return Error{name + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": " +
+                         std::to_string(in.values[i]) + " (weights must be finite and >= 0)"};
+    return std::nullopt;
+}
+
+// Whether some closure of a hair material reads `input` per strand.
+bool any_closure_reads(const HairMaterial &hair, HairInput input) {
+    const int count = hair.mixture ? hair.mixture->size() : 1;
+    for (int k = 0; k < count; ++k) {
+        const ShadingModel *model = hair.mixture ? hair.mixture->closure(k).model() : hair.shading.model();
+        const StrandInputReader *strands = model ? model->strand_inputs() : nullptr;
+        if (strands && strands->reads_input(input)) return true;
+    }
+    return false;
+}
+
 // The straight segment p1..p2 (Cycles' linear_basis_eval) and its derivative.
 void linear(const Float4 &p1, const Float4 &p2, float t, Float4 &value, Float4 &derivative) {
     derivative = {p2.x - p1.x, p2.y - p1.y, p2.z - p1.z, p2.w - p1.w};
@@ -158,25 +196,31 @@ void linear(const Float4 &p1, const Float4 &p2, float t, Float4 &value, Float4 &
 }
 
 // A curve set's inputs: known once each, sized for its curves or points, in range, read by
-// the material's node, on a material that varies per strand.
+// the material's node (some closure's, for a mixture), on a material that varies per strand.
 Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
     if (hc.inputs.empty()) return std::nullopt;
     const auto *hair = std::get_if<HairMaterial>(&material);
+    const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
+    std::uint32_t seen_weights = 0;
+    for (const CurveInput &in : hc.inputs)
+        if (in.closure_weight >= 0)
+            if (auto e = check_closure_weight(in, set, hair, curves, points, seen_weights)) return e;
     const ShadingModel *model = hair ? hair->shading.model() : nullptr;
     const StrandInputReader *strands = model ? model->strand_inputs() : nullptr;
-    if (!strands)
-        return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
-                     " does not vary per strand (it needs a hair material made for curve inputs, e.g. ChiangStrands)"};
-    const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
     std::uint32_t seen = 0;
     for (const CurveInput &in : hc.inputs) {
+        if (in.closure_weight >= 0) continue;
+        if (!strands)
+            return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
+                         " does not vary per strand (it needs a hair material made for curve inputs, e.g. "
+                         "ChiangStrands)"};
         if (int(in.input) >= kHairInputCount)
             return Error{set + ": a curve input is not a node input (" + std::to_string(int(in.input)) + ")"};
         const HairInputInfo &info = hair_input_info(in.input);
         const std::string name = set + ", input " + info.name;
         if ((seen >> unsigned(in.input)) & 1u) return Error{name + ": given twice"};
         seen |= 1u << unsigned(in.input);
-        if (!strands->reads_input(in.input))
+        if (!any_closure_reads(*hair, in.input))
             return Error{name + ": the material's parametrization does not read it"};
         const std::size_t k = std::size_t(info.components), n = in.per_point ? points : curves;
         if (in.values.size() != n * k)
@@ -337,7 +381,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                              describe(hc.normals[k]) + ")"};
         CurveGeometry geo;
         geo.material = hc.material;
-        for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}});
+        for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}, in.closure_weight});
         std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
         const std::size_t curve_count = hc.first.size() - 1;
         for (std::size_t c = 0; c < curve_count; ++c) {
@@ -384,7 +428,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             }
             const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
             for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
-                const std::size_t k = std::size_t(hair_input_info(hc.inputs[i].input).components);
+                const std::size_t k = std::size_t(components_of(hc.inputs[i]));
                 const std::vector<float> &from = hc.inputs[i].values;
                 const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
                 const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
@@ -858,7 +902,7 @@ SurfacePoint Scene::surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const {
     return sp;
 }
 
-bool Scene::hair_inputs(const SurfacePoint &point, HairInputValues &values) const {
+bool Scene::hair_inputs(const SurfacePoint &point, HairInputValues &values, ClosureWeights *weights) const {
     if (!point.is_curve) return false;
     const GeometryInfo &info = impl_->geometries[point.prim.geometry];
     const CurveGeometry &geo = impl_->curves[info.index];
@@ -869,7 +913,7 @@ bool Scene::hair_inputs(const SurfacePoint &point, HairInputValues &values) cons
     const std::size_t first_point = std::size_t(geo.segments[segment]) - 2 * curve;
     const float u = point.curve_u;
     for (const CurveInput &in : geo.inputs) {
-        const int k = hair_input_info(in.input).components;
+        const int k = components_of(in);
         float v[3];
         if (in.per_point) {
             const float *a = in.values.data() + first_point * std::size_t(k), *b = a + k;
@@ -880,7 +924,12 @@ bool Scene::hair_inputs(const SurfacePoint &point, HairInputValues &values) cons
             const float *a = in.values.data() + curve * std::size_t(k);
             for (int c = 0; c < k; ++c) v[c] = a[c];
         }
-        values.set(in.input, v);
+        if (in.closure_weight < 0) {
+            values.set(in.input, v);
+        } else if (weights) {
+            weights->given |= 1u << unsigned(in.closure_weight);
+            weights->value[std::size_t(in.closure_weight)] = v[0];
+        }
     }
     return true;
 }

@@ -66,6 +66,7 @@
 #include "render/surface_material.h"
 #include "fiber/dual_scattering.h"
 #include "sampling/hair_bsdf.h"
+#include "sampling/hair_mixture.h"
 #include "sampling/sampling_table.h"
 
 namespace hairis {
@@ -74,6 +75,10 @@ namespace hairis {
 struct HairMaterial {
     explicit HairMaterial(HairShading shading_) : shading(std::move(shading_)) {}
     HairShading shading;
+    /// Set for a Mix or Add Shader of hair closures (hair_mixture.h): the material then shades
+    /// with all of them; `shading` is its first closure. Curve inputs go to every closure
+    /// that reads them; CurveInput::closure_weight varies a closure's weight per strand.
+    std::shared_ptr<const HairMixture> mixture;
     /// What integrator=dual_scattering shades with (render/dual_scattering_integrator.h): the
     /// fiber's dual-scattering averages and its baked multiple-scattering tables. Null for the
     /// path tracer.
@@ -103,6 +108,9 @@ struct CurveInput {
     HairInput input = HairInput::Melanin;
     bool per_point = false;
     std::vector<float> values;
+    /// >= 0: not a node input but the weight of this closure of the material's mixture (one
+    /// component, finite and >= 0); `input` is then ignored.
+    int closure_weight = -1;
 };
 
 /// Hair curves sharing one material. Curve c has points first[c] .. first[c + 1] − 1; first
@@ -314,8 +322,10 @@ class Scene {
     /// Shading data of a hit of the ray (origin, dir).
     SurfacePoint surface_point(Vec3 origin, Vec3 dir, const Hit &hit) const;
     /// The node inputs a curve hit's curve set gives (HairCurves::inputs) at the hit, in
-    /// `values`; false (values untouched) for triangles and curves without inputs.
-    bool hair_inputs(const SurfacePoint &point, HairInputValues &values) const;
+    /// `values`, and its closure weights in `weights` (when not null); false (both untouched)
+    /// for triangles and curves without inputs.
+    bool hair_inputs(const SurfacePoint &point, HairInputValues &values,
+                     ClosureWeights *weights = nullptr) const;
 
     /// The centre line of a curve segment at u ∈ [0, 1] (Catmull-Rom, or the straight line
     /// between the segment's points for CurveShape::ThickLinear): position (and radius in

@@ -118,7 +118,9 @@ static const char *const kinds[][2] = {
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
                      "absorption=material;roughness=material;radial_roughness=material;"
                      "coat=material;ior=material;offset=material;random_color=material;"
-                     "random_roughness=material;random=material"},
+                     "random_roughness=material;random=material;weight0=material;"
+                     "weight1=material;weight2=material;weight3=material;weight4=material;"
+                     "weight5=material;weight6=material;weight7=material"},
     {"curves", ""},
 };
 enum { KIND_COUNT = sizeof kinds / sizeof kinds[0] };
@@ -846,6 +848,7 @@ struct hairis_scene {
     int material_is_huang[MAX_MATERIALS];
     int material_has_tables[MAX_MATERIALS];
     int material_tables_match[MAX_MATERIALS];
+    int material_closures[MAX_MATERIALS]; /* a hair mixture's closure count, else 0 */
     char material_parameters[MAX_MATERIALS][1024];
     size_t curve_sets, curve_count, curve_points, curve_sets_with_normals;
     size_t input_sets, input_values;  /* hairis_scene_add_curves_with_inputs */
@@ -898,6 +901,51 @@ int hairis_scene_add_hair_material(hairis_scene *s, const hairis_fiber *fiber,
     s->material_has_tables[index] = tables != NULL;
     s->material_tables_match[index] = tables && hairis_tables_match_fiber(tables, fiber);
     memcpy(s->material_parameters[index], fiber->parameters, sizeof fiber->parameters);
+    clear_error();
+    return index;
+}
+
+int hairis_scene_add_hair_mixture(hairis_scene *s, size_t count, const int *materials,
+                                  const float *weights)
+{
+    if (!s || !materials || !weights) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene, materials and weights must not be NULL");
+        return -1;
+    }
+    if (count < 1 || count > 8) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "hair mixture: count must be in [1, 8] (got %zu)", count);
+        return -1;
+    }
+    if (s->material_count >= MAX_MATERIALS) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "too many materials");
+        return -1;
+    }
+    int has_tables = 1, match = 1;
+    for (size_t k = 0; k < count; ++k) {
+        const int m = materials[k];
+        if (m < 0 || m >= s->material_count || !s->material_is_hair[m] || s->material_closures[m] ||
+            s->material_is_huang[m]) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                 "hair mixture: closure %zu: material %d is not a chiang2016 hair material of one fiber",
+                 k, m);
+            return -1;
+        }
+        if (!isfinite(weights[k]) || weights[k] < 0.0f) {
+            fail(HAIRIS_ERROR_INVALID_ARGUMENT,
+                 "hair mixture: closure %zu's weight is %g; weights must be finite and >= 0", k,
+                 (double)weights[k]);
+            return -1;
+        }
+        has_tables &= s->material_has_tables[m];
+        match &= s->material_tables_match[m];
+    }
+    int index = s->material_count++;
+    s->material_is_hair[index] = 1;
+    s->material_closures[index] = (int)count;
+    s->material_has_tables[index] = has_tables;
+    s->material_tables_match[index] = match;
+    snprintf(s->material_parameters[index], sizeof s->material_parameters[index],
+             "mixture of %zu", count);
     clear_error();
     return index;
 }
@@ -1130,8 +1178,10 @@ int hairis_scene_add_curves(hairis_scene *s, int material, size_t curve_count,
 /* The curve inputs' names in hairis_defaults("curve_inputs") order, with their components. */
 static const char *const curve_input_names[] = {
     "color", "melanin", "melanin_redness", "tint", "absorption", "roughness", "radial_roughness",
-    "coat", "ior", "offset", "random_color", "random_roughness", "random"};
-static const int curve_input_components[] = {3, 1, 1, 3, 3, 1, 1, 1, 1, 1, 1, 1, 1};
+    "coat", "ior", "offset", "random_color", "random_roughness", "random",
+    "weight0", "weight1", "weight2", "weight3", "weight4", "weight5", "weight6", "weight7"};
+static const int curve_input_components[] = {3, 1, 1, 3, 3, 1, 1, 1, 1, 1, 1, 1, 1,
+                                             1, 1, 1, 1, 1, 1, 1, 1};
 enum { CURVE_INPUT_COUNT = sizeof curve_input_names / sizeof curve_input_names[0] };
 
 int hairis_scene_add_curves_with_inputs(hairis_scene *s, int material, size_t curve_count,

@@ -271,8 +271,8 @@ def make_fiber(options=""):
 
 CURVE_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption", "roughness",
                 "radial_roughness", "coat", "ior", "offset", "random_color", "random_roughness",
-                "random")
-"""hairis_render.h's curve inputs in their documented order."""
+                "random") + tuple("weight%d" % k for k in range(8))
+"""hairis_render.h's curve inputs in their documented order (node inputs, closure weights)."""
 
 TINY_BAKE = b"theta_r=4;theta_i=8;phi=8;n_h=1,2;threads=2"
 

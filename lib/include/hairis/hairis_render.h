@@ -31,6 +31,19 @@ HAIRIS_API void hairis_scene_destroy(hairis_scene *scene);
 HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_fiber *fiber,
                                               const hairis_tables *tables);
 /**
+ * Adds a hair material that mixes `count` (1 to 8) hair materials of this scene, each added by
+ * hairis_scene_add_hair_material with a chiang2016 fiber, as Cycles renders a Mix Shader or Add
+ * Shader of Principled Hair BSDFs: f is the sum of weights[k] times material k's f, and a
+ * sample draws one closure with probability weights[k] / (sum of weights) from its own sampler,
+ * so the density is the same weighted sum of the closures' densities. A closure's weight is
+ * Cycles' closure weight: the product of the mix factors on its way to the output (1 through
+ * an Add Shader); finite and >= 0. hairis_scene_add_curves_with_inputs' weight0 .. weight7 vary
+ * it per curve or point; its node inputs go to every closure that reads them. Returns the
+ * material index, or -1. integrator=dual_scattering refuses a mixture.
+ */
+HAIRIS_API int hairis_scene_add_hair_mixture(hairis_scene *scene, size_t count, const int *materials,
+                                             const float *weights);
+/**
  * Adds a surface material (a mesh's shader nodes, as Cycles renders them) from options; returns
  * its index or -1. type = diffuse | principled | glossy | emission | mix | add
  * (hairis_defaults(type) lists each type's names and defaults):
@@ -91,7 +104,9 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
  * ior > 1, offset in [-pi/2, pi/2], the others in [0, 1]), and only those the material's
  * parametrization reads. `values` holds value_count floats: for each input given per curve
  * or per point, in that order, its components (3 for color, tint and absorption, else 1) for
- * each curve (curve_count items) or each point (point_count items) in turn. A renderer
+ * each curve (curve_count items) or each point (point_count items) in turn, then weight0 ..
+ * weight7 (a hair mixture's closure weights, finite and >= 0) given per curve or point, one
+ * float each. A renderer
  * evaluates the fiber at a hit with the hit's values: a curve's own, or a point value
  * interpolated linearly in the segment's curve parameter between its two points, as Cycles
  * interpolates curve attributes, then mapped as Cycles maps the node (Random Color and
