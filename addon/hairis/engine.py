@@ -277,6 +277,14 @@ def build_native_scene(library, data, hair_tables):
                 except native.HairisError as error:
                     raise RenderFailed("material %r: %s" % (material.name, error.message)) \
                         from error
+            elif material.kind == "HAIR_MIX":
+                try:
+                    indices.append(scene.add_hair_mixture(
+                        [indices[k] for k in material.mixture.closures],
+                        material.mixture.material_weights()))
+                except native.HairisError as error:
+                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
+                        from error
             elif material.kind == "SURFACE":
                 try:
                     indices.append(add_surface_nodes(scene, material.nodes, texture_index))

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import bpy
 import numpy as np
 
-from . import compat, node_eval, surfaces
+from . import compat, hair_mix, node_eval, surfaces
 
 DEFAULT_CURVES_RADIUS = 0.005
 """Cycles' radius for Curves without a ``radius`` attribute."""
@@ -152,8 +152,9 @@ class HairParameters:
 
 @dataclass
 class MaterialData:
-    """One scene material: ``kind`` is 'HAIR' (``hair`` set), 'SURFACE' (``nodes`` set: the
-    surface node options of surfaces.py, root last) or 'DIFFUSE' (``albedo``, ``emission``)."""
+    """One scene material: ``kind`` is 'HAIR' (``hair`` set), 'HAIR_MIX' (``mixture`` set: a
+    Mix/Add Shader of the HAIR materials before it), 'SURFACE' (``nodes`` set: the surface node
+    options of surfaces.py, root last) or 'DIFFUSE' (``albedo``, ``emission``)."""
 
     name: str
     kind: str
@@ -161,6 +162,7 @@ class MaterialData:
     albedo: tuple = DEFAULT_ALBEDO
     emission: tuple = (0.0, 0.0, 0.0)
     nodes: list = None
+    mixture: hair_mix.Mixture = None
     material_name: str = None
     """The Blender material it came from (None for the default material)."""
     source: object = None
@@ -436,8 +438,9 @@ def hair_node(material):
 
 
 def is_hair_material(material):
-    """True for a material whose output is fed by a Principled Hair BSDF."""
-    return hair_node(material) is not None
+    """True for a material whose output is fed by a Principled Hair BSDF, or by a Mix/Add
+    Shader tree that holds one (hair_mix)."""
+    return hair_mix.has_hair_leaf(surface_node(material), HAIR_NODE_IDNAME)
 
 
 def _socket_value(socket, components):
@@ -791,6 +794,10 @@ class _Exporter:
         if index is not None:
             return index
         node = hair_node(material)
+        if node is None and for_hair and is_hair_material(material):
+            index = self.hair_mixture(material)
+            self._material_index[key] = index
+            return index
         if node is not None:
             if not for_hair:
                 self.data.warn("material %r: Principled Hair BSDF on a mesh is not supported; "
@@ -821,19 +828,63 @@ class _Exporter:
         self._material_index[key] = index
         return index
 
+    def hair_mixture(self, material):
+        """The scene index of a hair material whose output is a Mix/Add Shader tree of
+        Principled Hair BSDFs: a HAIR material per leaf, then the HAIR_MIX that mixes them."""
+        leaves, others, warnings = hair_mix.closures(surface_node(material), HAIR_NODE_IDNAME,
+                                                     material.name)
+        for node in others:
+            warnings.append("material %r: %s %r is mixed with Principled Hair BSDFs; hairis "
+                            "mixes only Principled Hair BSDFs on hair and leaves it out, so its "
+                            "share renders black and opaque"
+                            % (material.name, node.bl_label or node.bl_idname, node.name))
+        read, closures = [], []
+        for node, _ in leaves:
+            params, leaf_warnings, error = read_hair_node(node, material.name)
+            warnings.extend(leaf_warnings)
+            if error is not None:
+                raise ExportError(error)
+            if params.model != "CHIANG":
+                raise ExportError(
+                    "material %r: Principled Hair BSDF %r uses the Huang model inside a Mix or "
+                    "Add Shader; hairis mixes Chiang Principled Hair BSDFs only (switch it to "
+                    "Chiang, or connect one Huang node to the output)" % (material.name, node.name))
+            read.append((node, params))
+            closures.append(len(self.data.materials))
+            self.data.materials.append(MaterialData(
+                name="%s: %s" % (material.name, node.name), kind="HAIR", hair=params,
+                material_name=material.name))
+        strand_inputs, shared_warnings = hair_mix.shared_strand_inputs(
+            material.name, read, {name: identifier for name, identifier, _, _ in HAIR_INPUTS})
+        for warning in warnings + shared_warnings:
+            self.data.warn(warning)
+        mixture = hair_mix.Mixture(closures, [weight for _, weight in leaves], strand_inputs)
+        self.data.materials.append(MaterialData(
+            name=material.name, kind="HAIR_MIX", mixture=mixture, material_name=material.name,
+            source=material.original))
+        return len(self.data.materials) - 1
+
     def strand_inputs(self, material_index, first, positions_object, curve_indices):
         """``CurvesData.inputs`` for one curve set of a hair material whose inputs vary per
         strand: its chains evaluated on the set's Hair Info (object-space lengths, and the
         per-strand random of each curve's index within its object, as Cycles numbers them),
-        clamped with a warning."""
+        clamped with a warning; for a mixture, also the closure weights that vary."""
         material = self.data.materials[material_index]
-        if material.kind != "HAIR" or not material.hair.strand_inputs:
+        mixture = material.mixture if material.kind == "HAIR_MIX" else None
+        if mixture is not None:
+            fields = mixture.strand_inputs
+            varying = any(w.domain != "material" for w in mixture.weights)
+        elif material.kind == "HAIR":
+            fields, varying = material.hair.strand_inputs, False
+        else:
+            return {}
+        if not fields and not varying:
             return {}
         strands = node_eval.strands_of(first, positions_object,
                                        node_eval.strand_random(curve_indices))
         labels = {name: label for name, label, _, _ in HAIR_INPUTS}
-        inputs = {}
-        for field_name, compiled in material.hair.strand_inputs.items():
+        inputs = mixture.strand_weights(strands) if mixture is not None else {}
+        for field_name, compiled in fields.items():
             warnings = []
             values = _clamped(compiled.evaluate(strands), field_name, material.name,
                               labels[field_name], warnings)

@@ -98,6 +98,7 @@ PROTOTYPES = {
     "hairis_scene_create": (c_void_p, []),
     "hairis_scene_destroy": (_VOID, [c_void_p]),
     "hairis_scene_add_hair_material": (c_int, [c_void_p, c_void_p, c_void_p]),
+    "hairis_scene_add_hair_mixture": (c_int, [c_void_p, c_size_t, POINTER(c_int), _F]),
     "hairis_scene_add_surface_material": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_add_texture": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_add_texture_pixels": (c_int, [c_void_p, c_char_p, _F, c_size_t, c_size_t,
@@ -125,8 +126,9 @@ PROTOTYPES = {
 
 CURVE_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption", "roughness",
                 "radial_roughness", "coat", "ior", "offset", "random_color", "random_roughness",
-                "random")
-"""hairis_defaults("curve_inputs")' names in its order: the order of a curve set's values."""
+                "random") + tuple("weight%d" % k for k in range(8))
+"""hairis_defaults("curve_inputs")' names in its order: the order of a curve set's values (the
+node inputs, then a hair mixture's closure weights)."""
 
 CURVE_INPUT_COMPONENTS = {"color": 3, "tint": 3, "absorption": 3}
 """Components of the colour inputs (the others have one)."""
@@ -743,6 +745,20 @@ class Scene(_Handle):
             self, int(material), first.size - 1, _ptr(first, c_uint32), positions.shape[0],
             _ptr(positions, c_float), _ptr(radii, c_float), _ptr(normals, c_float), b"")
         self._library._status("hairis_scene_add_curves_with_normals", status)
+
+    def add_hair_mixture(self, materials, weights):
+        """Adds a hair material mixing the hair ``materials`` (indices) with ``weights``, as
+        Cycles renders a Mix or Add Shader of Principled Hair BSDFs; returns its index."""
+        materials = np.ascontiguousarray(materials, dtype=np.int32).reshape(-1)
+        weights = np.ascontiguousarray(weights, dtype=np.float32).reshape(-1)
+        if materials.size != weights.size:
+            raise ValueError("one weight per material: %d materials, %d weights"
+                             % (materials.size, weights.size))
+        index = self._library.raw.hairis_scene_add_hair_mixture(
+            self, materials.size, _ptr(materials, c_int), _ptr(weights, c_float))
+        if index < 0:
+            raise self._library._error("hairis_scene_add_hair_mixture")
+        return index
 
     def add_curves_with_inputs(self, material, first, positions, radii, inputs):
         """Adds curves as :meth:`add_curves` whose hair material's node inputs vary:

@@ -48,6 +48,10 @@ def principled_struct(library, params):
 def material_parameters(material):
     """The material's hair parameters, or raise TableError when it is not a usable hair one."""
     node = export.hair_node(material)
+    if node is None and export.is_hair_material(material):
+        raise TableError("material %r mixes Principled Hair BSDFs through a Mix or Add Shader; "
+                         "its closures' tables are not stored with the material: render with "
+                         "Auto Bake, or with a strategy that needs no tables" % material.name)
     if node is None:
         raise TableError("material %r has no Principled Hair BSDF connected to its output"
                          % material.name)
@@ -58,10 +62,11 @@ def material_parameters(material):
 
 
 def hair_materials(materials=None):
-    """Every material (default: all of ``bpy.data.materials`` with users) that is hair."""
+    """Every material (default: all of ``bpy.data.materials`` with users) with a Principled
+    Hair BSDF at its output (a Mix/Add Shader of them bakes per closure at render time)."""
     if materials is None:
         materials = [m for m in bpy.data.materials if m.users > 0]
-    return [m for m in materials if export.is_hair_material(m)]
+    return [m for m in materials if export.hair_node(m) is not None]
 
 
 def bake_options(library, n_h=None, threads=0, multiple=True):

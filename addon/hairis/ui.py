@@ -311,7 +311,7 @@ class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
         """Hair materials (a Principled Hair BSDF at the output)."""
         material = context.material
         return (material is not None and engine_is_hairis(context)
-                and export.is_hair_material(material))
+                and export.hair_node(material) is not None)
 
     def draw(self, context):
         """Draws the table state and the bake button."""

@@ -16,25 +16,25 @@
 namespace hairis {
 namespace {
 
-// A Chiang closure sampled by its analytic sampler.
-HairShading chiang_closure(float roughness, Rgb sigma_a) {
+std::shared_ptr<const ChiangFiber> chiang_fiber(float roughness, Rgb sigma_a) {
     ChiangParams p;
     p.roughness = roughness;
     p.radial_roughness = roughness;
     p.sigma_a = sigma_a;
-    auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(p).value());
+    return std::make_shared<const ChiangFiber>(ChiangFiber::create(p).value());
+}
+
+// A Chiang closure sampled by its analytic sampler.
+HairShading chiang_closure(float roughness, Rgb sigma_a) {
+    auto fiber = chiang_fiber(roughness, sigma_a);
     return HairShading::create(fiber, std::make_shared<const AnalyticSampler>(fiber)).value();
 }
 
 // A Chiang closure sampled uniformly (a sampler far from its f, so the mixture's pdf differs
 // from both closures').
 HairShading uniform_closure() {
-    ChiangParams p;
-    p.roughness = 0.6f;
-    p.radial_roughness = 0.6f;
-    p.sigma_a = Rgb{0.05f, 0.1f, 0.2f};
-    auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(p).value());
-    return HairShading::create(fiber, std::make_shared<const UniformSampler>()).value();
+    return HairShading::create(chiang_fiber(0.6f, Rgb{0.05f, 0.1f, 0.2f}), std::make_shared<const UniformSampler>())
+        .value();
 }
 
 std::vector<HairShading> two_closures() {

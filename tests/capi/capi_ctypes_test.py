@@ -705,9 +705,11 @@ class TestSampling(unittest.TestCase):
 class TestRender(unittest.TestCase):
     W, H = 16, 12
 
-    def make_scene(self, tables, fiber_options="", inputs=None):
+    def make_scene(self, tables, fiber_options="", inputs=None, mixture=None):
         """The test scene; ``inputs`` (an options string and a function of (curves, points)
-        giving the values) puts its curves through hairis_scene_add_curves_with_inputs."""
+        giving the values) puts its curves through hairis_scene_add_curves_with_inputs;
+        ``mixture`` (a list of (fiber options, weight)) puts them on a hair mixture of those
+        fibers instead of the material of ``fiber_options``."""
         fiber = make_fiber(fiber_options)
         self.assertTrue(fiber, last_error())
         scene = lib().hairis_scene_create()
@@ -715,6 +717,17 @@ class TestRender(unittest.TestCase):
         lib().hairis_fiber_destroy(fiber)  # the scene keeps what it needs
         self.assertEqual(lib().hairis_scene_add_surface_material(
             scene, b"type=diffuse;color=0.5,0.5,0.5"), 1)
+        hair = 0
+        if mixture is not None:
+            closures = np.arange(2, 2 + len(mixture), dtype=np.int32)
+            for options, _ in mixture:
+                closure = make_fiber(options)
+                lib().hairis_scene_add_hair_material(scene, closure, tables)
+                lib().hairis_fiber_destroy(closure)
+            weights = np.array([w for _, w in mixture], np.float32)
+            hair = lib().hairis_scene_add_hair_mixture(scene, len(mixture), ptr(closures, c_int32),
+                                                       ptr(weights))
+            self.assertEqual(hair, 2 + len(mixture), last_error())
         curves, points = 6, 5
         first = np.arange(0, curves * points + 1, points, dtype=np.uint32)
         x = np.linspace(-1.5, 1.5, points)
@@ -722,14 +735,14 @@ class TestRender(unittest.TestCase):
                               for xx in x], np.float32)
         radii = np.full(curves * points, 0.04, np.float32)
         if inputs is None:
-            self.assertEqual(lib().hairis_scene_add_curves(scene, 0, curves, ptr(first, c_uint32),
-                                                           len(positions), ptr(positions),
-                                                           ptr(radii)), OK, last_error())
+            self.assertEqual(lib().hairis_scene_add_curves(
+                scene, hair, curves, ptr(first, c_uint32), len(positions), ptr(positions),
+                ptr(radii)), OK, last_error())
         else:
             names, make_values = inputs
             values = np.ascontiguousarray(make_values(curves, len(positions)), np.float32)
             self.assertEqual(lib().hairis_scene_add_curves_with_inputs(
-                scene, 0, curves, ptr(first, c_uint32), len(positions), ptr(positions),
+                scene, hair, curves, ptr(first, c_uint32), len(positions), ptr(positions),
                 ptr(radii), names, values.size, ptr(values)), OK, last_error())
         vertices = np.array([[-3, -3, -0.5], [3, -3, -0.5], [0, 3, -0.5]], np.float32)
         indices = np.array([0, 1, 2], np.uint32)
@@ -937,6 +950,88 @@ class TestRender(unittest.TestCase):
         self.assertFalse(np.array_equal(images[3], images[0]))
         for scene in (expected, per_curve, per_point, plain):
             lib().hairis_scene_destroy(scene)
+
+    def test_hair_mixture_renders_its_weighted_closures(self):
+        """A mixture whose other closures weigh 0 (by the material, or per curve) renders as
+        its one closure, bit for bit; weights 0.5/0.5 render otherwise; the integrator=path
+        image of two closures lies between the two closures' own images on average."""
+        brown, grey = "parametrization=melanin;melanin=0.8", "parametrization=melanin;melanin=0.1"
+        alone = self.render(self.make_scene(None, grey), "analytic", 8)
+        by_material = self.make_scene(None, brown, mixture=[(brown, 0.0), (grey, 1.0)])
+        per_curve = self.make_scene(None, brown, (b"weight0=curve;weight1=point",
+                                                  lambda c, p: np.concatenate([np.zeros(c),
+                                                                               np.ones(p)])),
+                                    mixture=[(brown, 1.0), (grey, 0.0)])
+        half = self.make_scene(None, brown, mixture=[(brown, 0.5), (grey, 0.5)])
+        np.testing.assert_array_equal(self.render(by_material, "analytic", 8), alone)
+        np.testing.assert_array_equal(self.render(per_curve, "analytic", 8), alone)
+        mixed = self.render(half, "analytic", 8)
+        dark = self.render(self.make_scene(None, brown), "analytic", 8)
+        self.assertLess(dark[..., :3].sum(), mixed[..., :3].sum())
+        self.assertLess(mixed[..., :3].sum(), alone[..., :3].sum())
+        rgba = np.zeros((self.H, self.W, 4), np.float32)
+        self.assertEqual(lib().hairis_render(half, b"integrator=dual_scattering", ptr(rgba),
+                                             PROGRESS_FN(), None), ERROR_INVALID_ARGUMENT)
+        for word in ("material 4 (hair mixture)", "dual_scattering", "integrator=path"):
+            self.assertIn(word, last_error())
+
+    def test_hair_mixture_refusals(self):
+        """Bad counts, indices, weights and closures, and closure weights per strand on a
+        material that is not a mixture: refused, naming what is wrong."""
+        scene = lib().hairis_scene_create()
+        chiang, huang = make_fiber(""), make_fiber("model=huang")
+        self.assertTrue(huang, last_error())
+        self.assertEqual(lib().hairis_scene_add_hair_material(scene, chiang, None), 0)
+        self.assertEqual(lib().hairis_scene_add_hair_material(scene, huang, None), 1)
+        self.assertEqual(lib().hairis_scene_add_surface_material(scene, b"type=diffuse"), 2)
+        for fiber in (chiang, huang):
+            lib().hairis_fiber_destroy(fiber)
+
+        def mix(materials, weights):
+            materials = np.ascontiguousarray(materials, np.int32)
+            weights = np.ascontiguousarray(weights, np.float32)
+            return lib().hairis_scene_add_hair_mixture(scene, len(materials),
+                                                       ptr(materials, c_int32), ptr(weights))
+
+        cases = [
+            ([], [], ["count", "[1, 8]", "got 0"]),
+            ([0] * 9, [1] * 9, ["count", "got 9"]),
+            ([0, 5], [1, 1], ["closure 1", "material 5", "not in the scene"]),
+            ([0, 2], [1, 1], ["closure 1", "material 2", "not a hair material"]),
+            ([0, 1], [1, 1], ["closure 1", "huang2022", "chiang2016"]),
+            ([0, 0], [1, -0.5], ["closure 1's weight", ">= 0"]),
+            ([0, 0], [float("nan"), 1], ["closure 0's weight", "finite"]),
+        ]
+        for materials, weights, words in cases:
+            with self.subTest(materials=materials, weights=weights):
+                self.assertEqual(mix(materials, weights), -1)
+                for word in words:
+                    self.assertIn(word, last_error())
+        self.assertEqual(mix([0, 0], [0.3, 0.7]), 3, last_error())
+        self.assertEqual(mix([3], [1]), -1)
+        self.assertIn("not a hair material of one fiber", last_error())
+        first = np.array([0, 3, 6], np.uint32)
+        positions = np.array([[x, y, 0] for y in (0, 1) for x in (0, 1, 2)], np.float32)
+        radii = np.full(6, 0.1, np.float32)
+
+        def add(names, values, material):
+            values = np.ascontiguousarray(values, np.float32)
+            return lib().hairis_scene_add_curves_with_inputs(
+                scene, material, 2, ptr(first, c_uint32), 6, ptr(positions), ptr(radii), names,
+                values.size, ptr(values))
+
+        for names, values, material, words in [
+                (b"weight0=curve", [1, 0], 0, ["weight0", "mixes 0"]),
+                (b"weight2=curve", [1, 0], 3, ["weight2", "mixes 2"]),
+                (b"weight1=curve", [1, -1], 3, ["weight1", "curve 1", ">= 0"]),
+                (b"weight1=point", [1, 0], 3, ["value_count", "6"])]:
+            with self.subTest(names=names):
+                self.assertEqual(add(names, values, material), ERROR_INVALID_ARGUMENT)
+                for word in words:
+                    self.assertIn(word, last_error())
+        self.assertEqual(add(b"weight0=curve;weight1=point", [1, 0] + [0.5] * 6, 3), OK,
+                         last_error())
+        lib().hairis_scene_destroy(scene)
 
     def test_curve_inputs_with_table_strategy(self):
         """TABLE samples the tables of the material's own fiber: strands of other roughness
