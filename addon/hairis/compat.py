@@ -22,6 +22,8 @@ what the running Blender has, never from socket indices), so the other modules r
 - whether rays hit a hair strand from inside its tube (``hairis_render``'s
   ``curve_backfaces``): Cycles with Embree 3 (Blender 3.4) culls those back faces, Blender's
   builds from 3.6 use Embree 4, whose curve filter does not: :func:`curve_backfaces`;
+- Cycles' Curves > Shape (``scene.cycles_curves.shape``, ``hairis_render``'s ``curve_shape``):
+  RIBBONS and THICK in every version, THICK_LINEAR from 5.0: :func:`curve_shape`;
 - how many transparent surfaces a path crosses under Max Bounces: Transparent
   (``hairis_render``'s ``transparent_limit``): the setting + 1 up to 4.5, the setting (at
   least 1) from 5.0, where Cycles stores the setting itself: :func:`transparent_limit`.
@@ -181,6 +183,24 @@ def curve_backfaces(version=None):
     from inside; Cycles with Embree 3 lets it pass, with Embree 4 it is a hit.
     """
     return "hit" if tuple(version or running_version()) >= EMBREE_4_CURVES else "ignore"
+
+
+CURVE_SHAPES = {"THICK": "thick", "RIBBONS": "ribbons", "THICK_LINEAR": "thick_linear"}
+"""Cycles' Curves > Shape identifiers and the library's ``curve_shape`` of each."""
+
+
+def curve_shape(scene):
+    """(the library's ``curve_shape``, a warning or None) from Cycles' Curves > Shape.
+
+    Without Cycles' settings (its add-on not registered) curves render as 3D Curves; so does a
+    shape Hairis does not know, with a warning that names it.
+    """
+    curves = getattr(scene, "cycles_curves", None) if scene is not None else None
+    shape = str(getattr(curves, "shape", "THICK"))
+    if shape in CURVE_SHAPES:
+        return CURVE_SHAPES[shape], None
+    return "thick", ("Hairis does not render Cycles' curve shape %s: it renders the curves as "
+                     "3D Curves (THICK) instead" % shape)
 
 
 CYCLES_5_TRANSPARENT_LIMIT = (5, 0, 0)

@@ -82,7 +82,8 @@ def light_options(light):
 
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``, and how the running Blender's
-    Cycles traces curves (:func:`compat.curve_backfaces`) and limits transparent crossings
+    Cycles traces curves (:func:`compat.curve_backfaces`, the scene's Curves > Shape:
+    :func:`compat.curve_shape`) and limits transparent crossings
     (:func:`compat.transparent_limit`)."""
     return {"integrator": settings.integrator.lower(),
             "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
@@ -95,7 +96,8 @@ def render_settings(settings):
             "dual_bounce_limit": settings.dual_bounce_limit.lower(),
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
-            "curve_backfaces": compat.curve_backfaces()}
+            "curve_backfaces": compat.curve_backfaces(),
+            "curve_shape": compat.curve_shape(getattr(settings, "id_data", None))[0]}
 
 
 def adaptive_threshold(settings):
@@ -454,8 +456,9 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         dump = os.environ.get(DUMP_ENV)
         if dump:
             data.save_npz(dump)
-        for warning in data.warnings:
-            self.report({"WARNING"}, warning)
+        for warning in data.warnings + [compat.curve_shape(scene)[1]]:
+            if warning:
+                self.report({"WARNING"}, warning)
         if (data.camera.width, data.camera.height) != (width, height):
             raise RenderFailed("render size %d×%d differs from the exported camera's %d×%d"
                                % (width, height, data.camera.width, data.camera.height))

@@ -82,10 +82,14 @@ void triangle_filter(const RTCFilterFunctionNArguments *args) {
     }
 }
 
+// What a curve geometry does with hits on the inside of a tube: as the context says (Catmull-Rom
+// tubes), never hit (linear curves, as Cycles 5.0 renders them), or none (flat ribbons).
+enum class InsideHits { AsContext, Culled, NoInside };
+
 // Curves: ignore hits on any segment of the curve the ray starts on (the geometry's user data
-// maps segments to curves) and, on round curves unless the context says otherwise, hits on the
-// inside of the tube (the backface culling of Cycles with Embree 3).
-template <bool kRound>
+// maps segments to curves) and the culled hits on the inside of the tube (the backface culling
+// of Cycles with Embree 3).
+template <InsideHits kInside>
 void curve_filter(const RTCFilterFunctionNArguments *args) {
     const auto *ctx = reinterpret_cast<const TraceContext *>(args->context);
     const auto *curve_of = static_cast<const std::uint32_t *>(args->geometryUserPtr);
@@ -94,7 +98,8 @@ void curve_filter(const RTCFilterFunctionNArguments *args) {
         const float d = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
                         RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
                         RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
-        const bool culled = kRound && d > 0.0f && !ctx->hit_curve_backfaces;
+        const bool culled = kInside != InsideHits::NoInside && d > 0.0f &&
+                            (kInside == InsideHits::Culled || !ctx->hit_curve_backfaces);
         if (culled || skipped(ctx, RTCHitN_geomID(args->hit, args->N, i),
                               curve_of[RTCHitN_primID(args->hit, args->N, i)])) {
             args->valid[i] = 0;
@@ -554,7 +559,9 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE
                                        : shape == CurveShape::ThickLinear ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
                                                                           : RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE;
-    const RTCFilterFunctionN filter = shape == CurveShape::Ribbons ? &curve_filter<false> : &curve_filter<true>;
+    const RTCFilterFunctionN filter = shape == CurveShape::Ribbons       ? &curve_filter<InsideHits::NoInside>
+                                      : shape == CurveShape::ThickLinear ? &curve_filter<InsideHits::Culled>
+                                                                         : &curve_filter<InsideHits::AsContext>;
     // Linear segments start one control point on: segment index k reads points k and k + 1
     // past the leading duplicate.
     const std::size_t skip = shape == CurveShape::ThickLinear ? 1 : 0;

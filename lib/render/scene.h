@@ -11,8 +11,10 @@
 // and k + 1, as Cycles' linear layout without the duplicates does. The radius is per point
 // (Embree's 4th vertex component). Hits on the inside of a round tube (ray direction ·
 // Embree's Ng > 0: a ray that starts inside another strand's tube) follow
-// SceneDesc::curve_backfaces; ribbons have no inside (Embree's Ng of a flat curve is its
-// tangent, and Cycles culls nothing on them), and a ray never hits the curve it starts on — any segment of
+// SceneDesc::curve_backfaces on Catmull-Rom tubes and are culled on linear curves (Cycles 5.0
+// renders its linear curves so, Embree 4 or not); ribbons have no inside (Embree's Ng of a flat
+// curve is its tangent, and Cycles culls nothing on them), and a ray never hits the curve it
+// starts on — any segment of
 // it — as Cycles' self-intersection test does (kernel/device/cpu/bvh.h,
 // kernel_embree_is_self_intersection maps a hair segment to its curve before comparing), so
 // no origin offset is needed. The

@@ -730,6 +730,23 @@ TEST(Scene, LinearCurvesRunStraightBetweenTheirPoints) {
     ASSERT_TRUE(second.has_value());
     EXPECT_EQ(second->prim.primitive, 3u);
     EXPECT_EQ(linear.surface_point({0.5f, 3, 5}, down, *second).self.primitive, 1u);
+
+    // From inside a linear strand a ray passes its wall, where a Catmull-Rom tube is hit from
+    // inside under curve_backfaces = hit.
+    auto inside_of = [](CurveShape shape) {
+        SceneDesc d;
+        d.materials = {hair_material()};
+        d.curves = {straight_hair()};
+        d.camera = small_camera();
+        d.curve_backfaces = CurveBackfaces::Hit;
+        d.curve_shape = shape;
+        return build_ok(std::move(d));
+    };
+    const Scene linear_hit = inside_of(CurveShape::ThickLinear), tube_hit = inside_of(CurveShape::Thick);
+    EXPECT_FALSE(linear_hit.intersect({0.3f, 0, 0}, {0, 0, 1}, 0.0f, INFINITY).has_value());
+    EXPECT_FALSE(linear_hit.occluded({0.3f, 0, 0}, {0, 0, 1}, 0.0f, 10.0f));
+    EXPECT_TRUE(linear_hit.intersect({0.3f, 0, 5}, down, 0.0f, INFINITY).has_value());
+    EXPECT_TRUE(tube_hit.intersect({0.3f, 0, 0}, {0, 0, 1}, 0.0f, INFINITY).has_value());
 }
 
 }  // namespace

@@ -9,10 +9,15 @@ object, with
   * the Curves object's Roughness fed by a Map Range of Hair Info Random (0.2 .. 0.6).
 Both engines render SEEDS independent images of SAMPLES samples, compared per 4×4 block by
 compare_stats.compare (channel means within 2%, mean t² and max |t| within the noise bounds).
+
+test_curve_shapes_match_cycles compares Cycles' Curves > Shape the same way on a smaller scene:
+Rounded Ribbons, and in 5.0 Linear 3D Curves (the other tests render 3D Curves). With
+HAIRIS_SHAPES_AS_THICK=1 Hairis renders every shape as 3D Curves, and that test must fail.
 The per-strand random numbers are not Cycles' own (the same distribution, other values), so
 single strands differ; blocks average over enough strands for the noise bound to hold.
 """
 
+import math
 import os
 import sys
 
@@ -55,6 +60,68 @@ def make_scene():
     tree.links.new(remap.outputs["Result"], helpers.socket(node, "Roughness"))
     bpy.context.view_layer.update()
     return scene
+
+
+SHAPE_SAMPLES, SHAPE_SEEDS, SHAPE_BOUNCES = 24, 4, 4
+"""The curve shape comparison: few pixels (32×32) and samples, so that it stays cheap."""
+
+
+def make_shapes_scene(shape):
+    """The Curves object alone (500 zigzag strands of radius 0.002 to 0.02, dense enough
+    that strands shade and block each other) before a world colour, lit by a sun, with Cycles'
+    Curves > Shape set to ``shape``."""
+    scene = helpers.reset()
+    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(32, 32), percentage=100)
+    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+    dyed = helpers.make_hair_material("Dyed", "COLOR", **{"Color": (0.2, 0.5, 0.8, 1.0),
+                                                          "Roughness": 0.45})
+    helpers.make_curves(scene, dyed, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0),
+                        scale=2.0)
+    helpers.make_light(scene, "SUN", "Sun", energy=2.5, angle=math.radians(3.0),
+                       rotation=(0.6, 0.3, 0.0))
+    helpers.match_engines(scene, SHAPE_SAMPLES, SHAPE_BOUNCES)
+    scene.cycles_curves.shape = shape  # match_cycles sets 3D Curves
+    scene.hairis.strategy = STRATEGY
+    scene.hairis.auto_bake = True
+    return scene
+
+
+def test_curve_shape_setting():
+    """Curves > Shape reaches the library's curve_shape for every shape the running Blender
+    has; a shape Hairis does not know renders as 3D Curves with a warning naming it."""
+    compat, engine = helpers.module("compat"), helpers.module("engine")
+    scene = helpers.reset()
+    items = [item.identifier for item in
+             type(scene.cycles_curves).bl_rna.properties["shape"].enum_items]
+    assert items == ["RIBBONS", "THICK"] + (["THICK_LINEAR"] if helpers.VERSION >= (5, 0, 0)
+                                            else []), items
+    for shape in items:
+        scene.cycles_curves.shape = shape
+        assert engine.render_settings(scene.hairis)["curve_shape"] == shape.lower(), shape
+        assert compat.curve_shape(scene)[1] is None
+
+    class Curves:
+        shape = "BRAIDS"
+
+    class Scene:
+        cycles_curves = Curves()
+
+    shape, warning = compat.curve_shape(Scene())
+    assert shape == "thick" and "BRAIDS" in warning and "3D Curves" in warning, warning
+    assert compat.curve_shape(None) == ("thick", None)
+
+
+def test_curve_shapes_match_cycles():
+    """Cycles' Rounded Ribbons, and in 5.0 its Linear 3D Curves, render to the same image in
+    Hairis within the noise (rendered as 3D Curves instead, the image is darker by about 10%:
+    HAIRIS_SHAPES_AS_THICK=1 makes this test fail)."""
+    compat = helpers.module("compat")
+    if os.environ.get("HAIRIS_SHAPES_AS_THICK"):
+        compat.curve_shape = lambda scene: ("thick", None)
+    shapes = ["RIBBONS"] + (["THICK_LINEAR"] if helpers.VERSION >= (5, 0, 0) else [])
+    for shape in shapes:
+        scene = make_shapes_scene(shape)
+        helpers.compare_with_cycles(scene, SHAPE_SEEDS, ARGS.workdir, BLOCK, " (%s)" % shape)
 
 
 def test_strand_random_is_cycles():
@@ -118,4 +185,5 @@ def test_strands_match_cycles():
     helpers.compare_with_cycles(scene, SEEDS, ARGS.workdir, BLOCK, " (%s)" % STRATEGY)
 
 
-helpers.run([test_strand_random_is_cycles, test_strands_match_cycles])
+helpers.run([test_strand_random_is_cycles, test_strands_match_cycles, test_curve_shape_setting,
+             test_curve_shapes_match_cycles])

@@ -206,6 +206,8 @@ def test_engine_renders_scene():
     # Cycles 5.0 stores Max Bounces: Transparent as set (4.5 and older: the setting + 1).
     limit = "setting" if helpers.VERSION >= (5, 0, 0) else "plus_one"
     assert summary_value(summary, "transparent_limit") == limit, summary
+    # The scene's Curves > Shape (Cycles' default: Rounded Ribbons).
+    assert summary_value(summary, "curve_shape") == scene.cycles_curves.shape.lower(), summary
     data = export.export_scene(bpy.context.evaluated_depsgraph_get())
     assert int(summary_value(summary, "curve_sets")) == 2
     curves = {c.source: c for c in data.curves}
