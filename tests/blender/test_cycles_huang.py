@@ -117,4 +117,8 @@ def test_hairis_table_auto_bakes_huang_tables():
             cached.close()
 
 
-helpers.run([test_hairis_table_auto_bakes_huang_tables, test_hairis_matches_cycles_on_huang_hair])
+TESTS = [test_hairis_table_auto_bakes_huang_tables, test_hairis_matches_cycles_on_huang_hair]
+if helpers.VERSION >= (5, 0, 0):
+    # 5.0 bakes with 4.5's Huang closure: the auto-bake check runs once, in 4.5.
+    TESTS.remove(test_hairis_table_auto_bakes_huang_tables)
+helpers.run(TESTS)

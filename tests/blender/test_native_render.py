@@ -399,7 +399,7 @@ def test_huang_tables_without_their_f_are_stale():
         material.hairis.table_image = saved
 
 
-helpers.run([
+TESTS = [
     test_library_loads,
     test_bake_operator,
     test_each_strategy_renders,
@@ -410,4 +410,10 @@ helpers.run([
     test_cancel_within_one_second,
     test_packed_tables_render_without_their_file,
     test_huang_tables_without_their_f_are_stale,
-])
+]
+if helpers.VERSION >= (5, 0, 0):
+    # 5.0 shades hair with 4.5's closures: the two slowest library-level checks run once per
+    # hair model (3.4 and 4.5), not once per Blender.
+    TESTS = [test for test in TESTS
+             if test not in (test_strategies_agree, test_dual_scattering_renders_huang)]
+helpers.run(TESTS)
