@@ -627,13 +627,15 @@ TEST(Scene, InvalidCurveInputsAreRefusedByName) {
     EXPECT_NE(e.find("does not vary per strand"), std::string::npos) << e;
 }
 
-// A straight hair along +X (straight_hair) as a scene of the given shape.
-Scene straight_scene(CurveShape shape) {
+// Curves (by default straight_hair, a straight hair along +X) as a scene of the given shape.
+Scene curve_scene(CurveShape shape, HairCurves curves = straight_hair(),
+                  CurveBackfaces backfaces = CurveBackfaces::Ignore) {
     SceneDesc d;
     d.materials = {hair_material()};
-    d.curves = {straight_hair()};
+    d.curves = {std::move(curves)};
     d.camera = small_camera();
     d.curve_shape = shape;
+    d.curve_backfaces = backfaces;
     return build_ok(std::move(d));
 }
 
@@ -642,7 +644,7 @@ Scene straight_scene(CurveShape shape) {
 // is the strip through the axis that faces the ray, so each hits at the distance of that point,
 // with Ng = ω_o, v = s, and Cycles' rounded normal s·Y + sqrt(1 − s²)·(ω_o across the strand).
 TEST(Scene, RibbonsFaceEveryRayWithCyclesRoundedNormal) {
-    const Scene ribbons = straight_scene(CurveShape::Ribbons);
+    const Scene ribbons = curve_scene(CurveShape::Ribbons);
     const Vec3 tangent{1, 0, 0};
     const float r = 0.1f, L = 3.0f;
     for (const Vec3 d : {Vec3{0, 0, -1}, Vec3{0, -1, 0}, Vec3{0, 0.6f, 0.8f}, Vec3{0.4f, -0.6f, -0.7f},
@@ -683,19 +685,11 @@ TEST(Scene, RibbonsFaceEveryRayWithCyclesRoundedNormal) {
 // Linear 3D curves: segment k is the straight round cone from point k to point k + 1; a
 // Catmull-Rom curve through the same points bends away from it.
 TEST(Scene, LinearCurvesRunStraightBetweenTheirPoints) {
-    auto scene_of = [](CurveShape shape) {
-        SceneDesc d;
-        d.materials = {hair_material()};
-        HairCurves c;
-        c.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 2, 0}, {0, 3, 0}, {1, 3, 0}};
-        c.radii = {0.05f, 0.05f, 0.05f, 0.05f, 0.05f, 0.05f};
-        c.first = {0, 4, 6};
-        d.curves = {c};
-        d.camera = small_camera();
-        d.curve_shape = shape;
-        return build_ok(std::move(d));
-    };
-    const Scene linear = scene_of(CurveShape::ThickLinear), thick = scene_of(CurveShape::Thick);
+    HairCurves c;
+    c.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 2, 0}, {0, 3, 0}, {1, 3, 0}};
+    c.radii.assign(6, 0.05f);
+    c.first = {0, 4, 6};
+    const Scene linear = curve_scene(CurveShape::ThickLinear, c), thick = curve_scene(CurveShape::Thick, c);
     const Vec3 points[4] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 2, 0}};
     for (std::uint32_t k = 0; k < 3; ++k)
         for (float u : {0.0f, 0.3f, 0.5f, 1.0f}) {
@@ -733,16 +727,8 @@ TEST(Scene, LinearCurvesRunStraightBetweenTheirPoints) {
 
     // From inside a linear strand a ray passes its wall, where a Catmull-Rom tube is hit from
     // inside under curve_backfaces = hit.
-    auto inside_of = [](CurveShape shape) {
-        SceneDesc d;
-        d.materials = {hair_material()};
-        d.curves = {straight_hair()};
-        d.camera = small_camera();
-        d.curve_backfaces = CurveBackfaces::Hit;
-        d.curve_shape = shape;
-        return build_ok(std::move(d));
-    };
-    const Scene linear_hit = inside_of(CurveShape::ThickLinear), tube_hit = inside_of(CurveShape::Thick);
+    const Scene linear_hit = curve_scene(CurveShape::ThickLinear, straight_hair(), CurveBackfaces::Hit);
+    const Scene tube_hit = curve_scene(CurveShape::Thick, straight_hair(), CurveBackfaces::Hit);
     EXPECT_FALSE(linear_hit.intersect({0.3f, 0, 0}, {0, 0, 1}, 0.0f, INFINITY).has_value());
     EXPECT_FALSE(linear_hit.occluded({0.3f, 0, 0}, {0, 0, 1}, 0.0f, 10.0f));
     EXPECT_TRUE(linear_hit.intersect({0.3f, 0, 5}, down, 0.0f, INFINITY).has_value());

@@ -121,7 +121,9 @@ def test_curve_shapes_match_cycles():
     shapes = ["RIBBONS"] + (["THICK_LINEAR"] if helpers.VERSION >= (5, 0, 0) else [])
     for shape in shapes:
         scene = make_shapes_scene(shape)
-        helpers.compare_with_cycles(scene, SHAPE_SEEDS, ARGS.workdir, BLOCK, " (%s)" % shape)
+        figures = helpers.compare_with_cycles(scene, SHAPE_SEEDS, ARGS.workdir, BLOCK,
+                                              " (%s)" % shape)
+        print("%s: %s" % (shape, figures))
 
 
 def test_strand_random_is_cycles():
