@@ -41,6 +41,8 @@ def make_scene():
     scene.render.engine = "HAIRIS"
     # Every pixel gets every sample: the checks below count on fixed sample counts.
     scene.hairis.use_adaptive_sampling = False
+    # Round tubes (3D Curves): the dual-scattering ratios below were measured on them.
+    scene.cycles_curves.shape = "THICK"
     helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(40, 32), percentage=100)
     helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=1.0)
     hair = helpers.make_hair_material("Hair", "MELANIN", **{"Melanin": 0.3, "Roughness": 0.3})

@@ -4,7 +4,9 @@ particle groom's children differently in each process, so engines are only compa
 one). A diagnostic; prints one PROBE line per render and one EXPORT line per Hairis export.
 
 Knobs (environment): PROBE_LEN hair length, PROBE_RS radius scale, PROBE_MEL melanin,
-PROBE_OFFSET cuticle tilt in degrees, PROBE_BOUNCES bounce limit, PROBE_SPP samples,
+PROBE_OFFSET cuticle tilt in degrees, PROBE_TIP tip radius (of
+the root's), PROBE_CLOSE Close Tip (1 or 0), PROBE_SHAPE the radius shape, PROBE_EMITTER 0
+to hide the sphere, PROBE_BOUNCES bounce limit, PROBE_SPP samples,
 PROBE_CHILDREN rendered children per parent (1000 parents), PROBE_ORDER a comma-separated list
 of CYCLES, HAIRIS, HAIRIS:<strategy>, HAIRIS:hit / HAIRIS:ignore (the rule for the insides of
 tubes) and X:curves (replace the particles by a Curves object of the same strands).
@@ -59,11 +61,14 @@ def to_curves():
 def make_scene():
     scene = helpers.reset()
     helpers.make_camera(scene, location=(0.0, -0.75, 0.05), resolution=(80, 80), percentage=100)
-    helpers.make_world(scene, color=(0.5, 0.5, 0.5), strength=0.3)
-    helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(3.0),
-                       rotation=(math.radians(40), 0.0, math.radians(30)))
-    helpers.make_light(scene, "AREA", "Panel", location=(-0.4, -0.5, 0.5), energy=20.0,
-                       size=0.3, rotation=(math.radians(50), 0.0, math.radians(-40)))
+    lamps = env("PROBE_LAMPS", "1") != 0.0
+    helpers.make_world(scene, color=(0.5, 0.5, 0.5),
+                       strength=env("PROBE_WORLD", "0.3") if lamps else env("PROBE_WORLD", "2.0"))
+    if lamps:
+        helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=math.radians(3.0),
+                           rotation=(math.radians(40), 0.0, math.radians(30)))
+        helpers.make_light(scene, "AREA", "Panel", location=(-0.4, -0.5, 0.5), energy=20.0,
+                           size=0.3, rotation=(math.radians(50), 0.0, math.radians(-40)))
     hair = helpers.make_hair_material("Hair", "MELANIN", **{
         "Melanin": env("PROBE_MEL", "0.15"), "Melanin Redness": 0.8, "Roughness": 0.3,
         "Radial Roughness": 0.3, "Coat": 0.0, "IOR": 1.55,
@@ -76,6 +81,10 @@ def make_scene():
     settings = sphere.modifiers["Hair"].particle_system.settings
     settings.hair_length = env("PROBE_LEN", "0.3")
     settings.radius_scale = env("PROBE_RS", "0.004")
+    settings.tip_radius = env("PROBE_TIP", "0.2")
+    settings.use_close_tip = env("PROBE_CLOSE", "1") != 0.0
+    settings.shape = env("PROBE_SHAPE", "0.3")
+    sphere.show_instancer_for_render = env("PROBE_EMITTER", "1") != 0.0
     bounces = int(env("PROBE_BOUNCES", "8"))
     helpers.match_cycles(scene, int(env("PROBE_SPP", "16")), bounces)
     scene.hairis.samples = scene.cycles.samples
@@ -94,6 +103,7 @@ def main():
     compat = importlib.import_module(name + ".compat")
     export = importlib.import_module(name + ".export")
     export_scene, backfaces = export.export_scene, compat.curve_backfaces
+    cycles_version = compat.cycles_version
 
     def traced(depsgraph, camera=None):
         data = export_scene(depsgraph, camera)
@@ -112,12 +122,16 @@ def main():
             to_curves()
             continue
         scene.hairis.strategy = "TABLE"
+        if option.startswith("v"):  # follow another Cycles version's conventions
+            compat.cycles_version = lambda version=None, v=option[1:]: v
+            option = ""
         if option in ("hit", "ignore"):
             compat.curve_backfaces = lambda version=None, rule=option: rule
         elif option:
             scene.hairis.strategy = option
         image, seconds = helpers.render_pixels(scene, engine, 1, ARGS.workdir)
         compat.curve_backfaces = backfaces
+        compat.cycles_version = cycles_version
         print("PROBE %s %s mean %s (%.1f s)" % (
             engine, option, np.round(image.reshape(-1, 3).mean(axis=0), 5), seconds), flush=True)
 
