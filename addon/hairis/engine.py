@@ -81,10 +81,10 @@ def light_options(light):
 
 
 def render_settings(settings):
-    """The C API's render settings from ``scene.hairis``, and how the running Blender's
-    Cycles traces curves (:func:`compat.curve_backfaces`, the scene's Curves > Shape:
-    :func:`compat.curve_shape`) and limits transparent crossings
-    (:func:`compat.transparent_limit`)."""
+    """The C API's render settings from ``scene.hairis``, the scene's Cycles bounce limits per
+    kind (:func:`cycles_bounce_limits`), and how the running Blender's Cycles traces curves
+    (:func:`compat.curve_backfaces`, the scene's Curves > Shape: :func:`compat.curve_shape`)
+    and limits transparent crossings (:func:`compat.transparent_limit`)."""
     return {"integrator": settings.integrator.lower(),
             "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
             "max_transparent_bounces": int(settings.max_transparent_bounces),
@@ -97,7 +97,20 @@ def render_settings(settings):
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces(),
-            "curve_shape": compat.curve_shape(getattr(settings, "id_data", None))[0]}
+            "curve_shape": compat.curve_shape(getattr(settings, "id_data", None))[0],
+            **cycles_bounce_limits(getattr(settings, "id_data", None))}
+
+
+def cycles_bounce_limits(scene):
+    """The scene's Cycles bounce limits per kind (Light Paths > Max Bounces: Diffuse, Glossy,
+    Transmission), which a path obeys besides Hairis' total, as Cycles' paths do; none without
+    Cycles' settings (the library's defaults are Cycles' defaults)."""
+    cycles = getattr(scene, "cycles", None)
+    if cycles is None:
+        return {}
+    return {"max_diffuse_bounces": int(cycles.diffuse_bounces),
+            "max_glossy_bounces": int(cycles.glossy_bounces),
+            "max_transmission_bounces": int(cycles.transmission_bounces)}
 
 
 def adaptive_threshold(settings):

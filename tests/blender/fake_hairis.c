@@ -1494,12 +1494,12 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
     FILE *f = fopen(path, "a");
     if (!f) return;
     fprintf(f, "samples=%lld max_bounces=%lld strategy=%d multiple_weight=%.6g n_h=%lld seed=%llu "
-               "threads=%lld max_diffuse_bounces=%lld max_transmission_bounces=%lld "
+               "threads=%lld max_diffuse_bounces=%lld max_glossy_bounces=%lld max_transmission_bounces=%lld "
                "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
                "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
-            r->threads, r->max_diffuse_bounces, r->max_transmission_bounces,
+            r->threads, r->max_diffuse_bounces, r->max_glossy_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
             r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling,
             r->transparent_limit ? "setting" : "plus_one", r->dual_hair_volume ? "unbounded" : "layer",

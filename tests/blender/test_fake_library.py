@@ -190,6 +190,9 @@ def test_engine_renders_scene():
     settings.n_h = "4"
     settings.multiple_weight = 0.5
     settings.max_bounces = 5
+    # Cycles' bounce limits per kind reach the library (values apart from every default).
+    scene.cycles.diffuse_bounces, scene.cycles.glossy_bounces = 3, 6
+    scene.cycles.transmission_bounces = 21
     pixels, summary = render(scene)
     assert pixels.shape == (24, 32, 4), pixels.shape
     np.testing.assert_allclose(pixels[..., :3], np.broadcast_to((0.075, 0.15, 0.3), (24, 32, 3)),
@@ -198,6 +201,9 @@ def test_engine_renders_scene():
     assert summary_value(summary, "strategy") == "1" and summary_value(summary, "n_h") == "4"
     assert summary_value(summary, "threads") == "1"
     assert summary_value(summary, "max_bounces") == "5"
+    limits = [summary_value(summary, "max_%s_bounces" % kind)
+              for kind in ("diffuse", "glossy", "transmission")]
+    assert limits == ["3", "6", "21"], summary
     assert summary_value(summary, "integrator") == "0"  # PATH, the default
     assert float(summary_value(summary, "multiple_weight")) == 0.5
     # Cycles with Embree 4 (Blender's builds from 3.6) hits strands from inside their tube.
