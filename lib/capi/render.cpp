@@ -193,6 +193,7 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
         const Status status = render_progressive(built.value(), o.render, rgba, passes, update, &stats, schedule);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         t_last_stats = format_options({{"seconds", format_number(seconds)},
+                                       {"build_seconds", format_number(built.value().stats().build_seconds)},
                                        {"camera_rays", std::to_string(stats.camera_rays)},
                                        {"rays", std::to_string(stats.rays)},
                                        {"shadow_rays", std::to_string(stats.shadow_rays)},

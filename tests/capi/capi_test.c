@@ -1499,6 +1499,8 @@ static void test_render(void)
         CHECK(stat_of("rays") >= W * H * 4, "rays: \"%s\"", stats);
         CHECK(stat_of("shadow_rays") > 0, "shadow rays: \"%s\"", stats);
         CHECK(stat_of("seconds") > 0 && stat_of("seconds") < 600, "seconds: \"%s\"", stats);
+        CHECK(stat_of("build_seconds") > 0 && stat_of("build_seconds") < stat_of("seconds"),
+              "build seconds, a part of the whole: \"%s\"", stats);
         CHECK(stat_of("peak_memory_bytes") > 0 && stat_of("peak_memory_bytes") < 1e12,
               "peak memory: \"%s\"", stats);
         CHECK(stat_of("dropped_samples") == 0, "dropped: \"%s\"", stats);

@@ -267,8 +267,9 @@ typedef int (*hairis_update_fn)(void *user, float progress, int samples_done, in
 HAIRIS_API int hairis_render_progressive(hairis_scene *scene, const char *settings, float *rgba,
                                          float *passes, hairis_update_fn update, void *user);
 /** What the calling thread's last hairis_render or hairis_render_progressive did, as options:
- * seconds, camera_rays, rays, shadow_rays, dropped_samples, peak_memory_bytes, threads,
- * cancelled, samples, converged_pixels; "" before any render. */
+ * seconds (the whole call), build_seconds (the scene and BVH build within it), camera_rays,
+ * rays, shadow_rays, dropped_samples, peak_memory_bytes, threads, cancelled, samples,
+ * converged_pixels; "" before any render. */
 HAIRIS_API const char *hairis_last_render_stats(void);
 
 #ifdef __cplusplus
