@@ -11,6 +11,7 @@
 #include "core/frame.h"
 #include "core/quadrature.h"
 #include "fiber/fresnel.h"
+#include "fiber/principled_hair.h"
 
 namespace hairis {
 
@@ -370,6 +371,17 @@ double ChiangPoint::longitudinal(int p, double sin_i, double cos_i) const {
 
 chiang::Cone ChiangPoint::cone(int p) const {
     return chiang::Cone(cone_[std::size_t(p)], lobes_->longitudinal_[std::size_t(p)]);
+}
+
+Rgb ChiangPoint::albedo() const {
+    const double h = double(hit().h);
+    // Cycles 4.x adds the Fresnel factor; 3.4 (whose tilt is on θ_i) has the absorption alone.
+    const double f = lobes_->params_.tilt == ChiangTilt::Outgoing
+                         ? fresnel_dielectric(o_.cos * std::sqrt(std::max(0.0, 1.0 - h * h)), lobes_->eta_)
+                         : 0.0;
+    const double scale = principled_hair::albedo_roughness_scale(lobes_->v_);
+    auto channel = [&](int c) { return float(std::exp(-std::sqrt(lobes_->sigma_[std::size_t(c)]) * scale) + f); };
+    return {channel(0), channel(1), channel(2)};
 }
 
 Rgb ChiangPoint::attenuation(int p) const { return p >= 0 && p < 4 ? to_rgb(a_[std::size_t(p)]) : Rgb{}; }

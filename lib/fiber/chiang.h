@@ -231,6 +231,10 @@ class ChiangPoint final : public FiberPoint {
     /// sample() with f·|cos θ_i| at the drawn direction (f_and_pdf's).
     std::optional<DirectionSample> sample_with_f(float u0, float u1, float u2, Rgb &f) const;
 
+    /// Cycles' bsdf_hair_chiang_albedo: exp(−√σ_a · albedo_roughness_scale(v)) + F(cos θ_o cos γ_o),
+    /// with the mapped longitudinal variance v where the node's mapping reads β_n (as Cycles
+    /// does); Cycles 3.4's (ChiangTilt::Incident) has no F term.
+    Rgb albedo() const override;
     /// A_p (p in [0, 3]).
     Rgb attenuation(int p) const;
     /// luminance(A_p) / Σ luminance(A_q): the analytic sampler's lobe weights.

@@ -48,6 +48,12 @@ class FiberPoint {
     /// True when the ray passes the fiber without scattering (Cycles' Huang closure outside
     /// the ellipse inscribed in the round tube): the renderer continues it unchanged.
     virtual bool transparent() const { return false; }
+    /// Cycles' bsdf_albedo of the closure at this hit per unit closure weight, what its
+    /// denoising albedo pass sums (Cycles' default for a closure without its own: 1).
+    virtual Rgb albedo() const { return Rgb{1.0f}; }
+    /// True when Cycles' denoising normal pass reads the fiber tangent here rather than the
+    /// closure normal (its Huang closure, which it counts as far-field hair).
+    virtual bool tangent_is_denoising_normal() const { return false; }
     const FiberHit &hit() const { return hit_; }
 
   protected:

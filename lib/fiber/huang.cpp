@@ -601,6 +601,28 @@ HuangPoint::HuangPoint(const HuangFiber &fiber, const FiberHit &hit) : FiberPoin
     lcg_.state = hash_bits(seed, float_bits(hit.h));
 }
 
+Rgb HuangPoint::albedo() const {
+    // Cycles' closure frame (N, tangent, Z = N × tangent) in the hit's fiber frame (x the
+    // tangent, y = x × ω_o): N is y for a round fiber, else the major axis; h stays the offset
+    // measured from y, as Cycles keeps it when it turns N to the major axis.
+    const FiberHit &hit = this->hit();
+    Vec3 n{0.0f, 1.0f, 0.0f};
+    const Vec3 major{0.0f, hit.normal.y, hit.normal.z};
+    if (fiber_->aspect_ratio() != 1.0 && dot(major, major) > 0.0f) n = safe_normalize(major);
+    const Vec3 z{0.0f, n.z, -n.y};
+    const Vec3d i{dot(hit.wo, n), hit.wo.x, dot(hit.wo, z)};
+    const double h = hit.h, eta = fiber_->ior();
+    const double cos_i = h * i.x + std::sqrt(std::max(0.0, 1.0 - h * h)) * i.z;
+    const double f = fresnel_dielectric(cos_i, eta);
+    const double cos_t = -std::sqrt(std::max(0.0, eta * eta - 1.0 + cos_i * cos_i)) / eta;
+    const double wt_y = -i.y / eta;  // the refracted view's tangent part (refract_angle)
+    auto channel = [&](int c) {
+        const double t = std::exp(2.0 * fiber_->sigma()[std::size_t(c)] * cos_t / (1.0 - wt_y * wt_y));
+        return float((t - 2.0 * f * t + f) / (1.0 - f * t));
+    };
+    return {channel(0), channel(1), channel(2)};
+}
+
 Vec3 HuangPoint::to_huang(Vec3 w) const {
     const double c = frame_c_, s = frame_s_;
     return {w.x, float(c * w.y + s * w.z), float(-s * w.y + c * w.z)};

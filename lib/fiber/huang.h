@@ -180,7 +180,11 @@ class HuangPoint final : public FiberPoint {
                                                    CyclesLcg &lcg) const;
 
     /// |h| >= the projected radius: Cycles replaces the closure by a transparent one.
-    bool transparent() const { return view_.transparent; }
+    bool transparent() const override { return view_.transparent; }
+    /// Cycles' bsdf_hair_huang_albedo: (A − 2FA + F) / (1 − FA) with F the Fresnel factor at the
+    /// macro normal of h and A the absorption along the chord the refracted view crosses.
+    Rgb albedo() const override;
+    bool tangent_is_denoising_normal() const override { return true; }
     bool near_field() const { return view_.near; }
     double projected_radius() const { return view_.radius; }
     /// The hit's ω_o in Huang's frame, and a renderer-frame direction in it.

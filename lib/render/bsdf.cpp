@@ -112,4 +112,45 @@ bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pd
     return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy);
 }
 
+DenoisingFeatures Bsdf::denoising_features() const {
+    DenoisingFeatures d;
+    float sum_weight = 0.0f, sum_diffuse = 0.0f;
+    // One closure: its albedo, normal and sample weight (Cycles': |average(weight)|, times
+    // the albedo estimate for microfacet closures).
+    auto add = [&](Rgb albedo, Vec3 n, float sample_weight, bool specular) {
+        d.normal = d.normal + n * sample_weight;
+        sum_weight += sample_weight;
+        if (specular) {
+            d.specular_albedo += albedo;
+        } else {
+            d.albedo += albedo;
+            sum_diffuse += sample_weight;
+        }
+    };
+    // A hair closure: Cycles' transparent one where the ray passes, which is specular.
+    auto add_fiber = [&](float w, const FiberPoint *fiber) {
+        if (!fiber || fiber->transparent()) return add(Rgb(w), Vec3{0, 0, 0}, std::fabs(w), true);
+        const Vec3 n = fiber->tangent_is_denoising_normal() ? frame_.x : frame_.y;
+        add(fiber->albedo() * w, n, std::fabs(w), false);
+    };
+    if (huang_) {
+        add_fiber(1.0f, huang_);
+    } else if (hair_) {
+        add_fiber(1.0f, hair_->fiber());
+    } else if (mixture_) {
+        for (int k = 0; k < mixture_->size(); ++k) add_fiber(mixture_->weight(k), mixture_->part(k).fiber());
+    } else {
+        for (int k = 0; k < surface_.lobe_count(); ++k) {
+            const SurfaceLobe &l = surface_.lobe(k);
+            const Rgb albedo = l.weight * lobe_denoising_albedo(l, surface_.local_wo());
+            const Rgb sampled = l.kind == SurfaceLobeKind::Microfacet ? albedo : l.weight;
+            add(albedo, surface_.normal(), std::fabs(sampled.r + sampled.g + sampled.b) / 3.0f, lobe_is_specular(l));
+        }
+    }
+    // Cycles writes unless 3/4 or more of the sample weight is specular.
+    d.specular = sum_weight > 0.0f && !(sum_diffuse * 4.0f > sum_weight);
+    if (sum_weight > 0.0f) d.normal = d.normal / sum_weight;
+    return d;
+}
+
 }  // namespace hairis

@@ -61,6 +61,18 @@ inline FiberFrame hair_frame(const SurfacePoint &sp, Vec3 wo) {
 FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, const HitContext &context,
                    bool oriented = true);
 
+/// What Cycles' film_write_denoising_features_surface reads from the closures of one vertex:
+/// the closure-weighted average normal (world space; the tangent for Huang hair), the albedo
+/// of the diffuse-like closures (every hair closure counts as one) and that of the specular
+/// ones (lobe_is_specular), and whether the specular closures hold at least 3/4 of the sample
+/// weight, in which case the passes look on to the next hit through them.
+struct DenoisingFeatures {
+    Vec3 normal{0, 0, 0};
+    Rgb albedo{0.0f};
+    Rgb specular_albedo{0.0f};
+    bool specular = false;
+};
+
 /// A BSDF at a shading point: evaluation f·|cos θ_i|, its sampling density, and sampling.
 /// Hair prepares its fiber and sampler once (hair_bsdf.h), in `scratch`; surfaces build their
 /// lobes (surface_material.h) with both normals on ω_o's side, as Cycles flips them for back
@@ -99,6 +111,9 @@ class Bsdf {
     /// Draws wi; returns false when there is none. weight = f·|cos|/pdf (Cycles' Huang: its
     /// sampler's weight, with pdf 1); `glossy`: drawn from a surface's glossy lobe.
     bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy) const;
+
+    /// The denoising features of this vertex (Cycles' closures seen from ω_o).
+    DenoisingFeatures denoising_features() const;
 
   private:
     std::optional<HairBsdf> hair_;

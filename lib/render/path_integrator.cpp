@@ -26,6 +26,20 @@ Vec3 first_hit_normal(const SurfacePoint &sp, Vec3 wo) {
     return dot(sp.normal, wo) < 0.0f ? -n : n;
 }
 
+// Cycles' film_write_denoising_features_surface at a vertex the features still look for:
+// writes them there (returns false, the features are done) or, through a specular vertex,
+// carries the throughput on to the next (returns true).
+bool write_denoising_features(const Bsdf &bsdf, FirstHit &first, Rgb &throughput) {
+    const DenoisingFeatures d = bsdf.denoising_features();
+    if (d.specular) {
+        throughput *= d.specular_albedo;
+        return true;
+    }
+    first.denoising_normal = d.normal;
+    first.albedo += throughput * d.albedo;
+    return false;
+}
+
 }  // namespace
 
 Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCounters &counters,
@@ -43,6 +57,14 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
     PathState path(counters);
     DualScatteringIntegrator dual(scene_, settings_);
     alpha = 1.0f;
+    // Cycles' PATH_RAY_DENOISING_FEATURES and denoising_feature_throughput: until the features
+    // are written, the light the path meets also adds to the albedo.
+    bool features = first != nullptr;
+    Rgb feature_throughput(1.0f);
+    auto reached = [&](Rgb light) {
+        path.add_reached(light);
+        if (features && !light.is_black()) first->albedo += feature_throughput * path.beta * light;
+    };
 
     for (;;) {
         std::optional<Hit> hit;
@@ -57,13 +79,13 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
 
         // Lamps are transparent: every one crossed before the surface contributes.
         if (!through_hair)
-            path.add_reached(lights.lamps_along_ray(ray.origin, ray.dir, ray.tmin, t_end, path.prev_bsdf_pdf,
-                                                    path.use_mis, ray.from));
+            reached(lights.lamps_along_ray(ray.origin, ray.dir, ray.tmin, t_end, path.prev_bsdf_pdf, path.use_mis,
+                                           ray.from));
 
         if (!hit) {
             const bool transparent = path.vertex == 0 && settings_.film_transparent;
             if (transparent) alpha = 0.0f;
-            path.add_reached(lights.escaped(ray.from, ray.dir, path.prev_bsdf_pdf, path.use_mis, !transparent));
+            reached(lights.escaped(ray.from, ray.dir, path.prev_bsdf_pdf, path.use_mis, !transparent));
             break;
         }
 
@@ -79,7 +101,7 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
                 const float abs_cos = std::fabs(dot(sp.normal, ray.dir));
                 w = power_heuristic(path.prev_bsdf_pdf, lights.emissive_triangle_pdf(hit->t, abs_cos));
             }
-            path.add(path.beta * emission * w);
+            reached(emission * w);
         }
 
         // A terminating ray shades nothing (Cycles evaluates no closures for it, so Huang's
@@ -113,7 +135,12 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
             ray.skip = sp.self;
             continue;
         }
-        if (first && path.vertex == 0) *first = FirstHit{true, sp.position, first_hit_normal(sp, wo), Rgb{0.0f}};
+        if (first && path.vertex == 0) {
+            first->found = true;
+            first->position = sp.position;
+            first->normal = first_hit_normal(sp, wo);
+        }
+        if (features) features = write_denoising_features(bsdf, *first, feature_throughput);
         if (bsdf.black()) break;
 
         // Light a mesh reflects onto the dual vertex the ray left.

@@ -116,12 +116,15 @@ struct PathState {
 };
 
 /// What the data passes read where a camera path first meets a surface that is not
-/// transparent (Huang hair the ray passes is not that surface), as Cycles writes them there.
+/// transparent (Huang hair the ray passes is not that surface), as Cycles writes them there,
+/// and Cycles' denoising features: the normal at the first vertex that is not specular
+/// (DenoisingFeatures) and the albedo summed along the way to it, light met included.
 struct FirstHit {
     bool found = false;  ///< false: the camera ray met no such surface
     Vec3 position;
     Vec3 normal;  ///< the shading normal in world space, on the side of the ray's origin
-    Rgb albedo;   ///< Cycles' denoising albedo
+    Vec3 denoising_normal{0, 0, 0};  ///< world space; 0 where the path found no such vertex
+    Rgb albedo{0.0f};                ///< Cycles' denoising albedo
 };
 
 /// The path tracer of one render (settings validated by render()).

@@ -104,7 +104,6 @@ Expected<std::vector<PassKind>> passes_of(const std::string &text) {
         if (kind < 0)
             return Error{"passes must be names among depth, normal, denoising_albedo, denoising_normal "
                          "separated by ',' (got \"" + name + "\")"};
-        if (kind >= int(PassKind::DenoisingAlbedo)) return Error{"passes: " + name + " is not implemented yet"};
         kinds.push_back(PassKind(kind));
         begin = end + 1;
     }
@@ -209,9 +208,10 @@ struct Film {
                 if (sample == 0) q[0] = first.found ? double(dot(first.position - camera.origin, camera.forward)) : 1e10;
             } else if (first.found && k == PassKind::Normal) {
                 v = first.normal;
-            } else if (first.found && k == PassKind::DenoisingNormal) {
-                v = Vec3{dot(first.normal, camera.right), dot(first.normal, camera.up), dot(first.normal, camera.forward)};
-            } else if (first.found && k == PassKind::DenoisingAlbedo) {
+            } else if (k == PassKind::DenoisingNormal) {
+                const Vec3 n = first.denoising_normal;
+                v = Vec3{dot(n, camera.right), dot(n, camera.up), dot(n, camera.forward)};
+            } else if (k == PassKind::DenoisingAlbedo) {
                 v = Vec3{first.albedo.r, first.albedo.g, first.albedo.b};
             }
             if (k != PassKind::Depth) {

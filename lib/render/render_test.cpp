@@ -1429,6 +1429,92 @@ TEST(Progressive, DepthAndNormalPassesAsCyclesWritesThem) {
     EXPECT_TRUE(render_progressive(scene, s, rgba.data(), nullptr, {}, nullptr).has_value());
 }
 
+TEST(Progressive, DenoisingPassesOfADiffusePlaneAreItsAlbedoAndNormal) {
+    // The quad of DepthAndNormalPasses, albedo (0.3, 0.5, 0.7), in a world of 0.2: Cycles'
+    // denoising albedo is the closure weight on the quad and the world the camera sees around
+    // it (0 with a transparent film); the normal is the quad's in camera space (z along the
+    // view, so −1 facing the camera) and 0 around it.
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.3f, 0.5f, 0.7f)}};
+    d.meshes = {quad(0.5f, 0.5f, 0)};
+    d.world = {Rgb(0.2f), 1.0f};
+    d.camera = ortho_down(1, 1, 8, 8);
+    const Scene scene = build(std::move(d));
+    for (const bool transparent : {false, true}) {
+        RenderSettings s;
+        s.samples = 4;
+        s.film_transparent = transparent;
+        s.passes = "denoising_albedo,denoising_normal";
+        std::vector<float> rgba(8 * 8 * 4), passes(8 * 8 * 6, -1.0f);
+        ASSERT_FALSE(render_progressive(scene, s, rgba.data(), passes.data(), {}, nullptr).has_value());
+        const float *albedo = passes.data(), *normal = passes.data() + 8 * 8 * 3;
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) {
+                const std::size_t p = std::size_t(y) * 8 + std::size_t(x);
+                const bool hit = x >= 2 && x < 6 && y >= 2 && y < 6;
+                const Rgb want = hit ? Rgb(0.3f, 0.5f, 0.7f) : Rgb(transparent ? 0.0f : 0.2f);
+                for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(albedo[p * 3 + std::size_t(c)], want[c]) << x << "," << y;
+                expect_vec({normal[p * 3], normal[p * 3 + 1], normal[p * 3 + 2]}, Vec3{0, 0, hit ? -1.0f : 0.0f},
+                           1e-6f, "denoising normal");
+            }
+    }
+}
+
+// The denoising passes of the one pixel of a camera looking down at a hair along X through its
+// axis (θ_o = 0, h within ±1% of 0), in a black world.
+std::array<float, 6> strand_denoising_passes(HairMaterial material) {
+    SceneDesc d;
+    d.materials = {std::move(material)};
+    d.curves = {straight_hair(0.0f, 0.0f, 0.1f, 1.0f)};
+    d.world = {Rgb(0.0f), 1.0f};
+    d.camera = ortho_down(0.001f, 0.001f, 1, 1);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 4;
+    s.passes = "denoising_albedo,denoising_normal";
+    std::vector<float> rgba(4);
+    std::array<float, 6> passes{};
+    EXPECT_FALSE(render_progressive(scene, s, rgba.data(), passes.data(), {}, nullptr).has_value());
+    return passes;
+}
+
+TEST(Progressive, DenoisingPassesOfAChiangStrandAreCyclesEstimate) {
+    // Cycles' bsdf_hair_chiang_albedo: exp(−√σ · scale(v)) + F(cos θ_o cos γ_o) with v the
+    // mapped longitudinal variance of the default Roughness 0.3 and scale its polynomial; the
+    // normal is Y = cross(tangent, ω_o) = −y, perpendicular to the strand and the view.
+    // Cycles 3.4's albedo (the tilt on θ_i) has no F term.
+    const Rgb sigma(0.2f, 0.5f, 1.0f);
+    for (const ChiangTilt tilt : {ChiangTilt::Incident, ChiangTilt::Outgoing}) {
+        ChiangParams params;
+        params.sigma_a = sigma;
+        params.tilt = tilt;
+        const auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(params).value());
+        const std::array<float, 6> p =
+            strand_denoising_passes(hair(fiber, std::make_shared<const AnalyticSampler>(fiber)));
+        const double beta = 0.3, v = sqr(0.726 * beta + 0.812 * beta * beta + 3.7 * std::pow(beta, 20));
+        const double scale = (((((0.245 * v) + 5.574) * v - 10.73) * v + 2.532) * v - 0.215) * v + 5.969;
+        const double f0 = tilt == ChiangTilt::Outgoing ? sqr((1.55 - 1.0) / (1.55 + 1.0)) : 0.0;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(p[std::size_t(c)], std::exp(-std::sqrt(double(sigma[c])) * scale) + f0, 1e-4)
+                << chiang_tilt_name(tilt) << " " << c;
+        expect_vec({p[3], p[4], p[5]}, Vec3{0, -1, 0}, 1e-4f, "Chiang denoising normal");
+    }
+}
+
+TEST(Progressive, DenoisingPassesOfAHuangStrandAreCyclesEstimate) {
+    // Cycles' bsdf_hair_huang_albedo seen perpendicularly through the axis: F = F0, the
+    // refracted view crosses the diameter (A = exp(−2σ)), albedo (A − 2FA + F) / (1 − FA);
+    // the normal is the tangent (+x, the curve's direction).
+    const std::array<float, 6> p = strand_denoising_passes(huang_hair(1.0f));
+    const Rgb sigma = HuangParams{}.sigma_a;
+    const double f0 = sqr((1.55 - 1.0) / (1.55 + 1.0));
+    for (int c = 0; c < 3; ++c) {
+        const double a = std::exp(-2.0 * double(sigma[c]));
+        EXPECT_NEAR(p[std::size_t(c)], (a - 2.0 * f0 * a + f0) / (1.0 - f0 * a), 1e-4) << c;
+    }
+    expect_vec({p[3], p[4], p[5]}, Vec3{1, 0, 0}, 1e-4f, "Huang denoising normal");
+}
+
 class NanPoint final : public SamplerPoint {
   public:
     std::optional<DirectionSample> sample(float u0, float u1, float) const override {

@@ -98,6 +98,14 @@ Rgb eval_microfacet(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf, float *r
 
 }  // namespace
 
+Rgb lobe_denoising_albedo(const SurfaceLobe &l, Vec3 wo) {
+    return l.kind == SurfaceLobeKind::Microfacet ? microfacet_fresnel(l, std::clamp(wo.z, 0.0f, 1.0f)) : Rgb(1.0f);
+}
+
+bool lobe_is_specular(const SurfaceLobe &l) {
+    return l.kind == SurfaceLobeKind::Microfacet && l.alpha * l.alpha <= sqr(0.075f);
+}
+
 Rgb eval_lobe(const SurfaceLobe &l, Vec3 wo, Vec3 wi, float &pdf, float *reported) {
     if (l.kind == SurfaceLobeKind::Microfacet) return eval_microfacet(l, wo, wi, pdf, reported);
     const float ci = wi.z;

@@ -120,6 +120,13 @@ struct SurfaceLobe {
 /// f·|cos θ_i| of one lobe (without its weight), the density with which it samples ω_i and
 /// (when `reported` is not null) the density it reports for the sample weight.
 Rgb eval_lobe(const SurfaceLobe &lobe, Vec3 wo, Vec3 wi, float &pdf, float *reported = nullptr);
+/// Cycles' bsdf_albedo of one lobe seen from ω_o (local), per unit weight, what its denoising
+/// albedo pass sums: 1 for the diffuse lobes, the Fresnel factor at ω_o·n for microfacet lobes
+/// (Cycles' smooth-surface estimate, which its tables refine with roughness for 4.x Principled).
+Rgb lobe_denoising_albedo(const SurfaceLobe &lobe, Vec3 wo);
+/// Cycles' denoising rule for a "specular" closure: a microfacet lobe with α_x α_y <= 0.075²,
+/// through which the denoising passes look on to the next hit.
+bool lobe_is_specular(const SurfaceLobe &lobe);
 /// A direction drawn from one lobe with u0, u1; false when there is none (below n).
 bool sample_lobe(const SurfaceLobe &lobe, Vec3 wo, float u0, float u1, Vec3 &wi);
 

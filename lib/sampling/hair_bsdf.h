@@ -28,6 +28,8 @@ class HairBsdf {
     Rgb f(Vec3 wi) const { return fiber_ ? fiber_->f(wi) : Rgb{}; }
     /// The ray passes the fiber without scattering (FiberPoint::transparent).
     bool transparent() const { return fiber_ && fiber_->transparent(); }
+    /// The fiber model at the hit (null for a bare sampler).
+    const FiberPoint *fiber() const { return fiber_; }
     /// The density sample() draws from.
     float pdf(Vec3 wi) const { return sampler_->pdf(wi); }
     /// f(wi) and pdf(wi) together (what a light sample needs), computed in one pass where the

@@ -49,6 +49,9 @@ class HairMixtureBsdf {
     /// The ray passes: every closure of non-zero weight is transparent.
     bool transparent() const;
     int size() const { return count_; }
+    /// Closure k and its weight, k in [0, size()).
+    const HairBsdf &part(int k) const { return *part_[std::size_t(k)]; }
+    float weight(int k) const { return weight_[std::size_t(k)]; }
 
   private:
     friend class HairMixture;

@@ -22,6 +22,8 @@ class HuangTabulatedPoint final : public FiberPoint {
     HuangTabulatedPoint(const HuangTabulatedFiber &model, const FiberHit &hit);
     Rgb f(Vec3 wi) const override;
     bool transparent() const override { return point_.transparent(); }
+    Rgb albedo() const override { return point_.albedo(); }
+    bool tangent_is_denoising_normal() const override { return true; }
     /// Cycles' closure at the hit (its frame, R, the near-field eval).
     const HuangPoint &huang() const { return point_; }
     /// The view located in the table (HuangTable::locate of ω_o in Huang's frame).

@@ -252,13 +252,20 @@ typedef int (*hairis_update_fn)(void *user, float progress, int samples_done, in
  *  - region = "x0,y0,x1,y1" (pixels, half-open, rows counted as in rgba: bottom row 0;
  *    default "0,0,0,0" = the whole image): only these pixels are rendered, the others are 0
  *    in rgba and passes; a region's pixels equal the full render's bit for bit;
- *  - passes = a comma list of depth and normal (default "": none), as Cycles writes them at
- *    the first surface that is not transparent (Huang hair the ray passes is not it): depth
- *    (1 channel) the distance from the camera along its view axis of sample 0's surface,
- *    1e10 where it found none, not averaged (Cycles' Z pass); normal (3) the shading normal
- *    in world space turned towards the viewer, 0 where the ray found nothing, averaged over
- *    the pixel's samples as rgba. The names denoising_albedo and denoising_normal are
- *    reserved for Cycles' denoising passes and refused for now.
+ *  - passes = a comma list of depth, normal, denoising_albedo and denoising_normal (default
+ *    "": none), as Cycles writes them at the first surface that is not transparent (Huang
+ *    hair the ray passes is not it): depth (1 channel) the distance from the camera along its
+ *    view axis of sample 0's surface, 1e10 where it found none, not averaged (Cycles' Z
+ *    pass); normal (3) the shading normal in world space turned towards the viewer, 0 where
+ *    the ray found nothing, averaged over the pixel's samples as rgba. The denoising passes
+ *    (3 each, averaged likewise) are Cycles' Denoising Albedo and Denoising Normal, written
+ *    at the first vertex whose closures are not mostly specular (microfacet roughness² up to
+ *    0.075²; every hair closure counts as diffuse): the sum of its closures' albedos (Cycles'
+ *    bsdf_albedo; for Principled Hair the Chiang or Huang reflectance estimate) times the
+ *    specular albedos passed on the way, plus the light the path meets before it (the world
+ *    where the camera sees it; 0 for a transparent film), and the closure-weighted average
+ *    normal there (Chiang: perpendicular to the strand and the view; Huang: the strand
+ *    tangent) in camera space (x right, y up, z along the view), 0 where there is none.
  * `passes` (may be NULL when passes is empty) holds width·height·K floats, K the sum of the
  * channels of the passes in the order given: all pixels of the first pass (each pixel's
  * channels together, bottom row first), then of the next. hairis_last_render_stats adds
