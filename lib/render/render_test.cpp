@@ -1594,6 +1594,35 @@ Material surface(std::vector<SurfaceNode> nodes) {
     return std::move(m).value();
 }
 
+TEST(Render, DenoisingPassesLookThroughAMirror) {
+    // A sharp Glossy BSDF of colour C is specular for the denoising passes: they look on
+    // through it with throughput C and meet the world W, which Cycles adds as throughput ×
+    // its contribution (itself C·W): albedo C²·W, and no vertex writes a normal. A rough
+    // one (roughness 0.5, α² > 0.075²) is where they stop: albedo C, normal (0, 0, −1).
+    const Rgb c(0.9f, 0.6f, 0.3f), world(0.5f);
+    for (const float roughness : {0.0f, 0.5f}) {
+        GlossyBsdfNode glossy;
+        glossy.color.value = c;
+        glossy.roughness = roughness;
+        SceneDesc d;
+        d.materials = {surface({glossy})};
+        d.meshes = {quad(10.0f, 0.5f, 0)};
+        d.world = {world, 1.0f};
+        d.camera = ortho_down(1, 1, 2, 2);
+        const Scene scene = build(std::move(d));
+        RenderSettings s;
+        s.samples = 4;
+        s.passes = "denoising_albedo,denoising_normal";
+        std::vector<float> rgba(2 * 2 * 4), passes(2 * 2 * 6, -1.0f);
+        ASSERT_FALSE(render_progressive(scene, s, rgba.data(), passes.data(), {}, nullptr).has_value());
+        const Rgb want = roughness == 0.0f ? c * c * world : c;
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(passes[std::size_t(k)], want[k], 1e-5) << roughness;
+        const float *normal = passes.data() + 2 * 2 * 3;
+        expect_vec({normal[0], normal[1], normal[2]}, Vec3{0, 0, roughness == 0.0f ? 0.0f : -1.0f}, 1e-6f,
+                   "denoising normal");
+    }
+}
+
 TEST(Render, TexturedDiffusePlaneUnderTheSun) {
     // A 2 × 2 texture (Closest) on a Diffuse BSDF lit from straight above by a delta sun of
     // strength E: every pixel sees its texel's colour × E / π, exactly (no noise: one light, a
