@@ -327,8 +327,9 @@ HairCurves checked_curves(const hairis_scene *scene, int material, size_t curve_
                 "; got " + std::to_string(first[curve_count]) + ")");
     for (size_t i = 0; i < point_count; ++i) {
         for (size_t k = 0; k < 3; ++k)
-            require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
-        require_non_negative(radii[i], indexed("radii", i));
+            if (!std::isfinite(positions[3 * i + k]))
+                require_finite(positions[3 * i + k], indexed("positions", 3 * i + k));
+        if (!(radii[i] >= 0.0f && std::isfinite(radii[i]))) require_non_negative(radii[i], indexed("radii", i));
     }
     HairCurves curves;
     if (curve_count == 0) return curves;  // nothing to add
@@ -489,7 +490,8 @@ HAIRIS_API int hairis_scene_set_mesh_attribute(hairis_scene *scene, const char *
                     std::to_string(corners) + " corners: " + std::to_string(corners * per_corner) +
                     "), got " + std::to_string(count));
         require_array(values, count, "values");
-        for (size_t i = 0; i < count; ++i) require_finite(values[i], indexed("values", i));
+        for (size_t i = 0; i < count; ++i)
+            if (!std::isfinite(values[i])) require_finite(values[i], indexed("values", i));
         if (o.name == 0) {
             std::vector<Vec3> normals(corners);
             for (size_t k = 0; k < corners; ++k) {
@@ -602,7 +604,8 @@ HAIRIS_API int hairis_scene_add_curves_with_normals(hairis_scene *scene, int mat
         CurveOptions o;
         read_options(options, "curve options", o);
         for (size_t i = 0; i < point_count; ++i)
-            for (size_t k = 0; k < 3; ++k) require_finite(normals[3 * i + k], indexed("normals", 3 * i + k));
+            for (size_t k = 0; k < 3; ++k)
+                if (!std::isfinite(normals[3 * i + k])) require_finite(normals[3 * i + k], indexed("normals", 3 * i + k));
         if (curve_count == 0) return HAIRIS_OK;
         curves.normals.resize(point_count);
         for (size_t i = 0; i < point_count; ++i) curves.normals[i] = vec3(normals + 3 * i);
@@ -625,7 +628,7 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
             invalid("vertex_count must be at most 2^32 - 1 (got " + std::to_string(vertex_count) +
                     ")");
         for (size_t i = 0; i < 3 * vertex_count; ++i)
-            require_finite(positions[i], indexed("positions", i));
+            if (!std::isfinite(positions[i])) require_finite(positions[i], indexed("positions", i));
         for (size_t t = 0; t < triangle_count; ++t) {
             for (size_t k = 0; k < 3; ++k)
                 if (indices[3 * t + k] >= vertex_count)
