@@ -42,6 +42,51 @@ bool write_denoising_features(const Bsdf &bsdf, FirstHit &first, Rgb &throughput
 
 }  // namespace
 
+Bsdf PathIntegrator::bsdf_at(const SurfacePoint &sp, const Material &material, Vec3 wo, int vertex,
+                             float footprint, std::uint64_t seed, const DualScatteringIntegrator &dual,
+                             ScratchBuffer &scratch) const {
+    HitContext context;
+    context.camera_ray = vertex == 0;
+    context.footprint = footprint;
+    context.seed = seed;
+    // A vertex dual scattering may shade needs the strategy's sampler (its MIS needs a
+    // density); the exact bounces before it are path-traced as integrator=path traces them.
+    context.cycles_huang = settings_.huang_sampling == int(HuangSampling::Cycles) && !dual.may_shade(vertex);
+    const HairInputValues *inputs = nullptr;
+    const ClosureWeights *weights = nullptr;
+    if (sp.is_curve) {
+        HairInputValues values;
+        ClosureWeights strand_weights;
+        if (scene_.hair_inputs(sp, values, &strand_weights)) {
+            inputs = &scratch.make<HairInputValues>(values);
+            if (strand_weights.given) weights = &scratch.make<ClosureWeights>(strand_weights);
+        }
+    }
+    return Bsdf(material, sp, wo, context, inputs, scratch, weights);
+}
+
+Rgb PathIntegrator::sample_ld(const SurfacePoint &sp, const Bsdf &bsdf, const SobolSampleRng &rng, int vertex,
+                              PathCounters &counters) const {
+    const auto ls = scene_.lights().sample(sp.position, rng.get(dim(vertex, kDimLightSelect)),
+                                           rng.get(dim(vertex, kDimLightU)), rng.get(dim(vertex, kDimLightV)));
+    if (!ls || !(ls->pdf > 0.0f)) return Rgb{0.0f};
+    float light_dir_bsdf_pdf = 0.0f;
+    const Rgb f = bsdf.eval(ls->wi, light_dir_bsdf_pdf);
+    if (f.is_black()) return Rgb{0.0f};
+    const float shadow_tmax = std::isinf(ls->distance) ? INFINITY : ls->distance * (1.0f - 1e-5f);
+    ++counters.shadow_rays;
+    const PrimRef target{ls->skip_geometry, ls->skip_primitive};
+    if (scene_.occluded(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax, sp.self, target)) return Rgb{0.0f};
+    const float w = ls->delta ? 1.0f : power_heuristic(ls->pdf, light_dir_bsdf_pdf);
+    return f * ls->value * (w / ls->pdf);
+}
+
+bool PathIntegrator::count_bounce(PathState &path, bool hair, bool glossy) const {
+    if (hair) return ++path.transmission_bounces > settings_.max_transmission_bounces;
+    if (glossy) return ++path.glossy_bounces > settings_.max_glossy_bounces;
+    return ++path.diffuse_bounces > settings_.max_diffuse_bounces;
+}
+
 Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCounters &counters,
                        ScratchBuffer &scratch, FirstHit *first) const {
     const Camera &camera = scene_.camera();
@@ -109,25 +154,8 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
         if (path.vertex > settings_.max_bounces || path.last_segment) break;
 
         scratch.reset();  // the previous vertex's BSDF is done with
-        HitContext context;
-        context.camera_ray = path.vertex == 0;
-        context.footprint = cr.footprint_at(hit->t);
-        context.seed = vertex_seed(seeds, path.vertex);
-        // A vertex dual scattering may shade needs the strategy's sampler (its MIS needs a
-        // density); the exact bounces before it are path-traced as integrator=path traces them.
-        context.cycles_huang =
-            settings_.huang_sampling == int(HuangSampling::Cycles) && !dual.may_shade(path.vertex);
-        const HairInputValues *inputs = nullptr;
-        const ClosureWeights *weights = nullptr;
-        if (sp.is_curve) {
-            HairInputValues values;
-            ClosureWeights strand_weights;
-            if (scene_.hair_inputs(sp, values, &strand_weights)) {
-                inputs = &scratch.make<HairInputValues>(values);
-                if (strand_weights.given) weights = &scratch.make<ClosureWeights>(strand_weights);
-            }
-        }
-        const Bsdf bsdf(material, sp, wo, context, inputs, scratch, weights);
+        const Bsdf bsdf = bsdf_at(sp, material, wo, path.vertex, cr.footprint_at(hit->t),
+                                  vertex_seed(seeds, path.vertex), dual, scratch);
         if (bsdf.transparent()) {
             // The same ray goes on beyond this curve.
             path.last_segment = ++path.transparent_bounces >= transparent_crossings_;
@@ -158,22 +186,7 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
         if (closes) {
             dual.add_light(path, sp, bsdf, wo, rng);
         } else if (!lights.empty()) {
-            const auto ls = lights.sample(sp.position, rng.get(dim(path.vertex, kDimLightSelect)),
-                                          rng.get(dim(path.vertex, kDimLightU)),
-                                          rng.get(dim(path.vertex, kDimLightV)));
-            if (ls && ls->pdf > 0.0f) {
-                float light_dir_bsdf_pdf = 0.0f;
-                const Rgb f = bsdf.eval(ls->wi, light_dir_bsdf_pdf);
-                if (!f.is_black()) {
-                    const float shadow_tmax = std::isinf(ls->distance) ? INFINITY : ls->distance * (1.0f - 1e-5f);
-                    ++counters.shadow_rays;
-                    const PrimRef target{ls->skip_geometry, ls->skip_primitive};
-                    if (!scene_.occluded(sp.spawn_point(ls->wi), ls->wi, 0.0f, shadow_tmax, sp.self, target)) {
-                        const float w = ls->delta ? 1.0f : power_heuristic(ls->pdf, light_dir_bsdf_pdf);
-                        path.add(path.beta * f * ls->value * (w / ls->pdf));
-                    }
-                }
-            }
+            path.add(path.beta * sample_ld(sp, bsdf, rng, path.vertex, counters));
         }
 
         // Continue along a BSDF sample.
@@ -187,12 +200,7 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
                      : bsdf.sample(u0, u1, u2, wi, weight, scatter_pdf, glossy)))
             break;
         dual.leave(path, sp, bsdf, wo, wi);
-        if (bsdf.is_hair())
-            path.last_segment = ++path.transmission_bounces > settings_.max_transmission_bounces;
-        else if (glossy)
-            path.last_segment = ++path.glossy_bounces > settings_.max_glossy_bounces;
-        else
-            path.last_segment = ++path.diffuse_bounces > settings_.max_diffuse_bounces;
+        path.last_segment = count_bounce(path, bsdf.is_hair(), glossy);
         path.beta *= weight;
         if (!finite(path.beta)) {
             ++counters.dropped;

@@ -62,6 +62,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/rng.h"
 #include "core/scratch.h"
 #include "render/dual_scattering_integrator.h"
 #include "render/render_settings.h"
@@ -139,6 +140,17 @@ class PathIntegrator {
            ScratchBuffer &scratch, FirstHit *first = nullptr) const;
 
   private:
+    /// The BSDF at a path vertex, with the strand's inputs and closure weights, made in scratch.
+    Bsdf bsdf_at(const SurfacePoint &sp, const Material &material, Vec3 wo, int vertex, float footprint,
+                 std::uint64_t seed, const DualScatteringIntegrator &dual, ScratchBuffer &scratch) const;
+    /// Next-event estimation at a vertex (pbrt's SampleLd): one light sample, MIS-weighted
+    /// against the BSDF's density, without the path's throughput.
+    Rgb sample_ld(const SurfacePoint &sp, const Bsdf &bsdf, const SobolSampleRng &rng, int vertex,
+                  PathCounters &counters) const;
+    /// Counts a bounce against Cycles' limit for its kind (every hair bounce is transmission);
+    /// true when the limit is passed.
+    bool count_bounce(PathState &path, bool hair, bool glossy) const;
+
     const Scene &scene_;
     const RenderSettings &settings_;
     int transparent_crossings_;  ///< transparent_crossings() of the settings
