@@ -253,14 +253,11 @@ def test_passes_as_cycles_names_them():
     assert set(plain.calls[-1]) == {"Combined"}, set(plain.calls[-1])
     layer.use_pass_z = True
     layer.use_pass_normal = True
-    denoising = library_has_denoising_passes()
-    layer.cycles.denoising_store_passes = denoising
+    layer.cycles.denoising_store_passes = True
     with Recorder("_write", write_record) as written:
         f12(scene, "passes")
     passes = written.calls[-1]
-    expected = {"Combined", "Depth", "Normal"}
-    if denoising:
-        expected |= {"Denoising Normal", "Denoising Albedo"}
+    expected = {"Combined", "Depth", "Normal", "Denoising Normal", "Denoising Albedo"}
     assert expected <= set(passes), set(passes)
     depth = passes["Depth"][:, 0]
     assert depth.min() > 2.0 and depth.min() < 4.0, depth.min()  # the hair is ~3.2 m away
@@ -272,9 +269,8 @@ def test_passes_as_cycles_names_them():
     assert np.all(lengths <= 1.0 + 1e-4) and lengths[hit].max() > 0.99, lengths[hit]
     # Depth is sample 0's: where it missed, at most 3 of the 4 samples found a normal.
     assert np.all(lengths[~hit] <= 0.75 + 1e-4), lengths[~hit].max()
-    if denoising:
-        albedo = passes["Denoising Albedo"]
-        assert np.all(albedo >= 0.0) and albedo[hit].max() > 0.0
+    albedo = passes["Denoising Albedo"]
+    assert np.all(albedo >= 0.0) and albedo[hit].max() > 0.0
     layer.use_pass_z = layer.use_pass_normal = False
     layer.cycles.denoising_store_passes = False
 
@@ -284,41 +280,10 @@ def noise(image):
     return float(np.abs(np.diff(image[..., :3], axis=1)).mean())
 
 
-def library_has_denoising_passes():
-    """Whether the real library writes the denoising passes yet."""
-    lib = native.load_library()
-    with lib.scene() as scene:
-        scene.set_world((1.0, 1.0, 1.0), 1.0)
-        material = scene.add_diffuse_material((0.5, 0.5, 0.5))
-        scene.add_mesh([(-1, -1, -5), (1, -1, -5), (0, 1, -5)], [(0, 1, 2)], [material])
-        scene.set_camera({"width": 2, "height": 2})
-        try:
-            scene.render_progressive({"samples": 1}, None, ["denoising_albedo"])
-        except native.HairisError as error:
-            if "not implemented" in error.message:
-                return False
-            raise
-    return True
-
-
 def test_denoise_in_one_click():
     """Denoise builds Render Layers → Denoise (with albedo and normal) → output; F12's image
     is then the denoised one; off restores the plain image. Without OpenImageDenoise the
-    setting does nothing. Until the library writes the denoising passes this runs on the fake
-    library with noise."""
-    fake = not library_has_denoising_passes()
-    if fake:
-        helpers.use_library(ARGS.fake_library)
-        os.environ["HAIRIS_FAKE_NOISE"] = "0.5"
-    try:
-        check_denoise()
-    finally:
-        helpers.use_library(None)
-        os.environ.pop("HAIRIS_FAKE_NOISE", None)
-
-
-def check_denoise():
-    """test_denoise_in_one_click with the library in use."""
+    setting does nothing."""
     scene = make_scene(samples=2, resolution=(64, 48))
     noisy = f12(scene, "noisy")
     assert noise(noisy) > 0.0
