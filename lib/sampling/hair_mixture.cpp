@@ -67,7 +67,6 @@ std::optional<BsdfSample> HairMixtureBsdf::sample(float u0, float u1, float u2) 
     const float u = std::fmin(std::fmax((u0 - below) / share, 0.0f), std::nextafter(1.0f, 0.0f));
     std::optional<BsdfSample> s = part_[std::size_t(pick)]->sample(u, u1, u2);
     if (!s || !(s->pdf > 0.0f)) return std::nullopt;
-    if (count_ == 1) return s;
     Rgb f = s->f * weight_[std::size_t(pick)];
     float pdf = share * s->pdf;
     for (int k = 0; k < count_; ++k) {

@@ -122,6 +122,23 @@ TEST(HairMixture, LeavesOutClosuresOfWeightZero) {
     EXPECT_FALSE(black.transparent());
 }
 
+// The one closure left keeps its weight: a sample's f is the mixture's f at its direction
+// (Σ w_k f_k, here 0.5 f_1), as eval gives it for light samples.
+TEST(HairMixture, ALoneClosureKeepsItsWeightWhenSampled) {
+    const HairMixture mixture = HairMixture::create(two_closures(), {0.0f, 0.5f}).value();
+    ScratchBuffer scratch;
+    const HairMixtureBsdf lone = mixture.at(kHit, nullptr, scratch);
+    ASSERT_EQ(lone.size(), 1);
+    for (float u : {0.2f, 0.5f, 0.8f}) {
+        const auto s = lone.sample(u, 0.3f, 0.7f);
+        ASSERT_TRUE(s.has_value());
+        float pdf = 0.0f;
+        const Rgb f = lone.f_and_pdf(s->wi, pdf);
+        EXPECT_NEAR(s->pdf, pdf, 1e-5f * pdf);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(s->f[c], f[c], 1e-5f * f[c] + 1e-12f) << c;
+    }
+}
+
 TEST(HairMixture, RefusesBadWeightsAndClosureCounts) {
     EXPECT_FALSE(HairMixture::create({}, {}).ok());
     auto count = HairMixture::create(two_closures(), {1.0f});
