@@ -76,6 +76,9 @@ lobe multipliers are shown as Reflection, Transmission and Secondary Reflection)
 
 HUANG_LOBES = ("reflection", "transmission", "secondary_reflection")
 
+HUANG_MATERIAL_ONLY = ("aspect_ratio",) + HUANG_LOBES
+"""Huang inputs that cannot vary per strand: linked, they render with their unlinked value."""
+
 HUANG_CYCLES = (4, 5, 0)
 """Hairis' Huang is Cycles 4.5's (5.0's is the same); 4.0 to 4.4 integrate it differently."""
 
@@ -511,7 +514,8 @@ def read_hair_node(node, material_name="?"):
     ``strand_inputs``, and one with an unsupported node is a warning naming it (the input's
     unlinked value is used). An unlinked Random is Cycles' per-strand random number wherever
     Random Color or Random Roughness can use it; the fiber's own Random is then 0.5 (the
-    middle strand). Huang takes every input's unlinked value, with a warning for a linked one.
+    middle strand). Huang's Aspect Ratio and lobe multipliers take their unlinked value, with
+    a warning when linked.
     """
     warnings = []
     model = compat.hair_model(node)
@@ -543,19 +547,6 @@ def read_hair_node(node, material_name="?"):
         error = _huang_checks(values, material_name, warnings)
         if error is not None:
             return None, warnings, error
-        for field_name, socket in sockets.items():
-            if (getattr(socket, "is_linked", False)
-                    and parametrization in READ_BY.get(field_name, {parametrization})):
-                warnings.append("material %r: input %r of the Principled Hair BSDF is linked; "
-                                "hairis uses its unlinked value for Huang hair"
-                                % (material_name, socket.name))
-        randomized = values["random_roughness"] > 0.0 or (
-            values["random_color"] > 0.0 and parametrization == "MELANIN")
-        if randomized and not getattr(sockets["random"], "is_linked", False):
-            warnings.append("material %r: Cycles varies Random Color/Random Roughness per strand "
-                            "when Random is unlinked; hairis uses Random = %g for every Huang "
-                            "strand" % (material_name, values["random"]))
-        return HairParameters(**values), warnings, None
     strand_inputs = {}
     for field_name, input_name, components, _ in HAIR_INPUTS:
         if field_name not in sockets:
@@ -564,6 +555,12 @@ def read_hair_node(node, material_name="?"):
         if parametrization not in READ_BY.get(field_name, {parametrization}):
             continue  # hidden by the parametrization: Cycles does not read it either
         if not getattr(socket, "is_linked", False):
+            continue
+        if field_name in HUANG_MATERIAL_ONLY:
+            # The fiber's shape and lobe multipliers are what its tables are baked for.
+            warnings.append("material %r: input %r of the Principled Hair BSDF is linked; "
+                            "hairis uses its unlinked value for Huang hair"
+                            % (material_name, socket.name))
             continue
         try:
             compiled = node_eval.compile_input(socket, components)

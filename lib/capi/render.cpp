@@ -37,8 +37,13 @@ HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name
     }
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
+    // Every Huang material shades through the strands model, as Chiang's do.
+    Expected<HuangStrands> strands = HuangStrands::create(hair.node, hair.huang);
+    if (!strands) refuse(HAIRIS_ERROR_INTERNAL, name + strands.error().message);
+    auto model = std::make_shared<const HuangStrands>(std::move(strands).value());
+    if (kind == StrategyKind::Table) inputs.huang_strands = model;
     // TABLE shades with the table's baked f where the table has one.
-    Expected<HairShading> shading = make_hair_shading(kind, inputs, hair.huang);
+    Expected<HairShading> shading = make_hair_shading(kind, inputs, model);
     if (!shading) refuse(code_of(shading.error().kind), name + shading.error().message);
     return std::move(shading).value();
 }

@@ -342,10 +342,16 @@ HairCurves checked_curves(const hairis_scene *scene, int material, size_t curve_
 }
 
 // Whether `hair`, or another closure of its mixture, reads `input`.
+// Whether the material's model reads `input` (Huang has no Radial Roughness and no Coat).
+bool material_reads(const SceneHairMaterial &hair, HairInput input) {
+    if (hair.huang && (input == HairInput::RadialRoughness || input == HairInput::Coat)) return false;
+    return reads(hair.node.parametrization, input);
+}
+
 bool mixture_reads(const hairis_scene &scene, const SceneHairMaterial &hair, HairInput input) {
-    if (reads(hair.node.parametrization, input)) return true;
+    if (material_reads(hair, input)) return true;
     for (size_t m : hair.closures)
-        if (reads(std::get<SceneHairMaterial>(scene.materials[m]).node.parametrization, input)) return true;
+        if (material_reads(std::get<SceneHairMaterial>(scene.materials[m]), input)) return true;
     return false;
 }
 
@@ -536,14 +542,10 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
             if (!hair)
                 invalid(std::string("curve inputs: ") + info.name + " needs a hair material; material " +
                         std::to_string(material) + " is a surface material");
-            if (hair->huang)
-                invalid(std::string("curve inputs: ") + info.name + " per curve or point needs a chiang2016 " +
-                        "material; material " + std::to_string(material) +
-                        " is huang2022, whose inputs are the material's own in this version");
             if (!mixture_reads(*scene, *hair, HairInput(i)))
                 invalid(std::string("curve inputs: ") + info.name + " is not read by material " +
-                        std::to_string(material) + "'s parametrization (" +
-                        parametrization_name(hair->node.parametrization) + ")" +
+                        std::to_string(material) + "'s model and parametrization (" +
+                        (hair->huang ? "huang2022, " : "") + parametrization_name(hair->node.parametrization) + ")" +
                         (hair->closures.empty() ? "" : " nor by another of its closures"));
             needed += size_t(info.components) * (o.domain[i] == 2 ? point_count : curve_count);
         }

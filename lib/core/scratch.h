@@ -27,6 +27,14 @@ class ScratchBuffer {
         return *new (allocate(sizeof(T), alignof(T))) T(std::forward<Args>(args)...);
     }
 
+    /// Constructs a T whose only non-trivial part is a virtual destructor (a model class whose
+    /// members are all trivially destructible): reset() skips its destructor, which does nothing.
+    template <typename T, typename... Args>
+    T &make_polymorphic(Args &&...args) {
+        static_assert(std::has_virtual_destructor_v<T>, "use make() for other types");
+        return *new (allocate(sizeof(T), alignof(T))) T(std::forward<Args>(args)...);
+    }
+
     /// Releases everything made since the last reset; keeps the current (largest) block.
     void reset() {
         full_.clear();

@@ -12,6 +12,7 @@ namespace hairis {
 
 struct HairInputValues;
 class HuangFiber;
+class HuangPoint;
 class StrandInputReader;
 
 /// Where a ray met a fiber, in the fiber frame of frame.h (x = tangent).
@@ -54,6 +55,9 @@ class FiberPoint {
     /// True when Cycles' denoising normal pass reads the fiber tangent here rather than the
     /// closure normal (its Huang closure, which it counts as far-field hair).
     virtual bool tangent_is_denoising_normal() const { return false; }
+    /// Cycles' Huang closure of this hit's own fiber, or null: a renderer that samples Huang
+    /// with Cycles' sampler samples and shades with it.
+    virtual const HuangPoint *huang_point() const { return nullptr; }
     const FiberHit &hit() const { return hit_; }
 
   protected:

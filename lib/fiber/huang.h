@@ -185,6 +185,7 @@ class HuangPoint final : public FiberPoint {
     /// macro normal of h and A the absorption along the chord the refracted view crosses.
     Rgb albedo() const override;
     bool tangent_is_denoising_normal() const override { return true; }
+    const HuangPoint *huang_point() const override { return this; }
     bool near_field() const { return view_.near; }
     double projected_radius() const { return view_.radius; }
     /// The hit's ω_o in Huang's frame, and a renderer-frame direction in it.
@@ -193,6 +194,8 @@ class HuangPoint final : public FiberPoint {
     /// The HuangHit this point evaluates (for HuangFiber::expectation).
     HuangHit huang_hit() const;
     const HuangFiber &fiber() const { return *fiber_; }
+    /// The point's LCG as its next eval will start it (seeded per hit).
+    CyclesLcg lcg() const { return lcg_; }
 
   private:
     const HuangFiber *fiber_;

@@ -66,13 +66,13 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
         const ShadingModel *model = hair->shading.model();
         FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
         hit.inputs = inputs;
-        const HuangFiber *huang = context.cycles_huang && model ? model->as_huang() : nullptr;
-        if (huang) {
-            huang_ = &scratch.make<HuangPoint>(*huang, hit);
+        // Cycles' own Huang sampler samples the hit's own fiber (a strand's, with its inputs).
+        const bool cycles_huang = context.cycles_huang && model && model->as_huang();
+        huang_ = cycles_huang ? model->prepare(hit, scratch).huang_point() : nullptr;
+        if (huang_)
             lcg_.state = hit.seed ^ 0x9e3779b9u;
-        } else {
+        else
             hair_.emplace(hair->shading.at(hit, scratch));
-        }
         return;
     }
     const bool back = back_facing(sp, wo);

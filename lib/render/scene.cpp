@@ -218,7 +218,7 @@ Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Ma
         if (!strands)
             return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
                          " does not vary per strand (it needs a hair material made for curve inputs, e.g. "
-                         "ChiangStrands)"};
+                         "ChiangStrands or HuangStrands)"};
         if (int(in.input) >= kHairInputCount)
             return Error{set + ": a curve input is not a node input (" + std::to_string(int(in.input)) + ")"};
         const HairInputInfo &info = hair_input_info(in.input);

@@ -3,12 +3,21 @@
 // which Cycles estimates with one random microfacet chain per node, are read from the baked
 // expectation (huang_f_table.h). Near-field hits (camera rays on hair wider than the pixel)
 // keep Cycles' one-sample eval: the table holds the far field only.
+//
+// A strand whose inputs differ from the node's (HuangStrands) is shaded with its own f. When
+// only its absorption differs, the table is a control variate: f = the baked expectation +
+// (the strand's Cycles eval − the node's), both evals drawing the same microfacet chains, so
+// the correction has mean (strand − node) and little noise. A strand of another roughness,
+// IOR or offset draws other chains; it is shaded with its own Cycles eval.
 #pragma once
 
 #include <memory>
 
 #include "core/expected.h"
+#include <optional>
+
 #include "fiber/huang.h"
+#include "fiber/huang_strands.h"
 #include "sampling/huang_f_table.h"
 #include "sampling/huang_table.h"
 
@@ -19,44 +28,53 @@ class HuangTabulatedFiber;
 /// The tabulated fiber at one hit; also hands the table's located view to the table sampler.
 class HuangTabulatedPoint final : public FiberPoint {
   public:
-    HuangTabulatedPoint(const HuangTabulatedFiber &model, const FiberHit &hit);
+    /// `strand`: the hit's own fiber when its inputs differ from the node's, else null.
+    HuangTabulatedPoint(const HuangTabulatedFiber &model, const FiberHit &hit, const HuangFiber *strand = nullptr);
     Rgb f(Vec3 wi) const override;
     bool transparent() const override { return point_.transparent(); }
     Rgb albedo() const override { return point_.albedo(); }
     bool tangent_is_denoising_normal() const override { return true; }
+    const HuangPoint *huang_point() const override { return &point_; }
     /// Cycles' closure at the hit (its frame, R, the near-field eval).
     const HuangPoint &huang() const { return point_; }
     /// The view located in the table (HuangTable::locate of ω_o in Huang's frame).
     const HuangTableQuery &query() const { return query_; }
 
   private:
-    HuangPoint point_;
+    HuangPoint point_;  // the strand's own fiber at the hit
     HuangTableQuery query_;
     const HuangFTable *f_;
+    // A strand of the node's geometry: the node's fiber at the hit, the control variate's.
+    std::optional<HuangPoint> node_;
+    bool own_eval_ = false;  // a strand of another geometry: its Cycles eval alone
+    mutable CyclesLcg lcg_;
 };
 
 /// A Huang fiber shaded with its baked f (HuangSamplingTable::f).
 class HuangTabulatedFiber final : public ShadingModel {
   public:
-    /// Refuses a null fiber, a table without its f part, and a table baked for other parameters.
+    /// Refuses a null fiber, a table without its f part, a table baked for other parameters
+    /// and strands of another fiber. `strands` (optional): the material's per-strand inputs.
     static Expected<HuangTabulatedFiber> create(std::shared_ptr<const HuangFiber> fiber,
-                                                std::shared_ptr<const HuangSamplingTable> table);
-    const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
-        return scratch.make<HuangTabulatedPoint>(*this, hit);
-    }
+                                                std::shared_ptr<const HuangSamplingTable> table,
+                                                std::shared_ptr<const HuangStrands> strands = nullptr);
+    const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override;
     bool reads_orientation() const override { return true; }
     /// The fiber it tabulates: a renderer that samples Huang with Cycles' own sampler shades
     /// with the fiber's Cycles eval instead.
     const HuangFiber *as_huang() const override { return fiber_.get(); }
+    const StrandInputReader *strand_inputs() const override { return strands_.get(); }
     const HuangFiber &fiber() const { return *fiber_; }
     const HuangTable &table() const { return *table_->table; }
     const HuangFTable &f_table() const { return *table_->f; }
 
   private:
-    HuangTabulatedFiber(std::shared_ptr<const HuangFiber> fiber, std::shared_ptr<const HuangSamplingTable> table)
-        : fiber_(std::move(fiber)), table_(std::move(table)) {}
+    HuangTabulatedFiber(std::shared_ptr<const HuangFiber> fiber, std::shared_ptr<const HuangSamplingTable> table,
+                        std::shared_ptr<const HuangStrands> strands)
+        : fiber_(std::move(fiber)), table_(std::move(table)), strands_(std::move(strands)) {}
     std::shared_ptr<const HuangFiber> fiber_;
     std::shared_ptr<const HuangSamplingTable> table_;
+    std::shared_ptr<const HuangStrands> strands_;
 };
 
 }  // namespace hairis

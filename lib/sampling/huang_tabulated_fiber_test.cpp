@@ -14,6 +14,8 @@
 #include "core/frame.h"
 #include "fiber/principled_hair.h"
 #include "sampling/hair_bsdf.h"
+#include "fiber/hair_inputs.h"
+#include "fiber/huang_strands.h"
 #include "sampling/huang_table_sampler.h"
 #include "sampling/strategy.h"
 #include "tables/huang_bake.h"
@@ -169,6 +171,141 @@ TEST(HuangTabulatedFiber, RefusesMissingPartsAndOtherParameters) {
     const Expected<HuangTabulatedFiber> other = HuangTabulatedFiber::create(make_fiber(0.7f, 0.5f), fx.table);
     ASSERT_FALSE(other);
     EXPECT_NE(other.error().message.find("baked for"), std::string::npos) << other.error().message;
+}
+
+
+// Per-strand inputs (HuangStrands): the node is Melanin Concentration at 0.5; strands vary it
+// (absorption only: the control variate) or the roughness (the strand's own Cycles eval).
+struct StrandFixture {
+    PrincipledHairNode node;
+    std::shared_ptr<const HuangFiber> fiber;
+    std::shared_ptr<const HuangStrands> strands;
+    std::shared_ptr<const HuangSamplingTable> table;
+    std::shared_ptr<const HuangTabulatedFiber> model;
+};
+
+const StrandFixture &strand_fixture() {
+    static const StrandFixture f = [] {
+        StrandFixture s;
+        s.node.parametrization = HairParametrization::Melanin;
+        s.node.melanin = 0.5f;
+        s.node.roughness = 0.35f;
+        s.node.aspect_ratio = 0.7f;
+        s.fiber = std::make_shared<const HuangFiber>(HuangFiber::create(to_huang_params(s.node).value()).value());
+        s.strands = std::make_shared<const HuangStrands>(HuangStrands::create(s.node, s.fiber).value());
+        s.table = bake(*s.fiber);
+        s.model = std::make_shared<const HuangTabulatedFiber>(HuangTabulatedFiber::create(s.fiber, s.table, s.strands).value());
+        return s;
+    }();
+    return f;
+}
+
+// The strand's fiber made from the node with `input` set to `value` directly (not through
+// HairInputValues).
+HuangFiber strand_fiber(PrincipledHairNode node, HairInput input, float value) {
+    if (input == HairInput::Melanin) node.melanin = value;
+    if (input == HairInput::Roughness) node.roughness = value;
+    return HuangFiber::create(to_huang_params(node).value()).value();
+}
+
+struct Moments {
+    double mean = 0, variance = 0;
+};
+
+// Mean and variance of the green channel of `draws` calls of point.f(wi).
+Moments moments(const FiberPoint &point, Vec3 wi, int draws) {
+    double sum = 0, sum2 = 0;
+    for (int n = 0; n < draws; ++n) {
+        const double g = point.f(wi).g;
+        sum += g;
+        sum2 += g * g;
+    }
+    const double mean = sum / draws;
+    return {mean, std::max(0.0, sum2 / draws - mean * mean)};
+}
+
+TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoise) {
+    const StrandFixture &fx = strand_fixture();
+    const HuangFiber own = strand_fiber(fx.node, HairInput::Melanin, 0.3f);
+    HairInputValues inputs;
+    const float melanin = 0.3f;
+    inputs.set(HairInput::Melanin, &melanin);
+    const int draws = 2000;
+    const Vec3 directions[] = {safe_normalize(Vec3{-0.3f, 0.6f, 0.7f}), safe_normalize(Vec3{0.4f, -0.2f, 0.9f}),
+                               safe_normalize(Vec3{-0.5f, 0.1f, -0.8f})};
+    for (const Vec3 wi : directions) {
+        FiberHit hit = hit_at(25.0, 0.7);
+        hit.seed = 3;
+        hit.inputs = &inputs;
+        ScratchBuffer scratch;
+        const FiberPoint &point = fx.model->prepare(hit, scratch);
+        // Draw by draw: the node's table at the hit, plus the strand's Cycles eval minus the
+        // node's, both replaying the point's LCG stream (the fibers are made independently of
+        // HuangStrands, from the node with the melanin set directly).
+        const HuangPoint node_point = fx.fiber->at(hit), own_point = own.at(hit);
+        const Vec3 wi_h = node_point.to_huang(wi);
+        const Rgb table = fx.model->f_table().f_cos(fx.model->table().locate(node_point.to_huang(hit.wo)), wi_h);
+        CyclesLcg lcg = point.huang_point()->lcg();
+        double sum_cv = 0, sum2_cv = 0, sum_own = 0, sum2_own = 0;
+        for (int n = 0; n < draws; ++n) {
+            CyclesLcg node_lcg = lcg;
+            const Rgb strand = own_point.f_estimate(wi, lcg);
+            const Rgb expected = table + node_point.f_reflection(wi) + strand - node_point.f_estimate(wi, node_lcg);
+            const Rgb f = point.f(wi);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(f[c], expected[c], 1e-6f * (1.0f + std::fabs(expected[c]))) << n;
+            sum_cv += f.g;
+            sum2_cv += double(f.g) * f.g;
+            sum_own += strand.g;
+            sum2_own += double(strand.g) * strand.g;
+        }
+        // On the same draws the corrected table is far less noisy than the strand's own eval.
+        const double var_cv = sum2_cv / draws - (sum_cv / draws) * (sum_cv / draws);
+        const double var_own = sum2_own / draws - (sum_own / draws) * (sum_own / draws);
+        EXPECT_LT(var_cv, 0.5 * var_own) << wi.x << " " << wi.y << " " << wi.z;
+    }
+}
+
+TEST(HuangTabulatedFiber, AStrandOfOtherRoughnessIsShadedWithItsOwnEval) {
+    const StrandFixture &fx = strand_fixture();
+    const HuangFiber own = strand_fiber(fx.node, HairInput::Roughness, 0.6f);
+    HairInputValues inputs;
+    const float roughness = 0.6f;
+    inputs.set(HairInput::Roughness, &roughness);
+    FiberHit hit = hit_at(-40.0, 0.2);
+    hit.seed = 9;
+    hit.inputs = &inputs;
+    ScratchBuffer scratch;
+    const FiberPoint &point = fx.model->prepare(hit, scratch);
+    const HuangPoint own_point = own.at(hit);
+    const Vec3 wi = safe_normalize(Vec3{0.2f, 0.5f, 0.8f});
+    const Moments m = moments(point, wi, 3000);
+    const double exact = own.expectation(own_point.huang_hit()).f(own_point.to_huang(wi)).g;
+    EXPECT_NEAR(m.mean, exact, 5.0 * std::sqrt(m.variance / 3000) + 1e-4 * exact);
+    // Cycles' sampler of the hit is the strand's: its R lobe is the strand's R.
+    ASSERT_NE(point.huang_point(), nullptr);
+    EXPECT_EQ(point.huang_point()->f_reflection(wi).g, own_point.f_reflection(wi).g);
+}
+
+TEST(HuangTabulatedFiber, AStrandWithoutInputsIsTheNodesBakedF) {
+    const StrandFixture &fx = strand_fixture();
+    const HuangTabulatedFiber without = HuangTabulatedFiber::create(fx.fiber, fx.table).value();
+    const HairInputValues none;  // given == 0: the node's own values
+    for (const HairInputValues *inputs : {static_cast<const HairInputValues *>(nullptr), &none}) {
+        FiberHit hit = hit_at(15.0, 1.2);
+        hit.inputs = inputs;
+        ScratchBuffer scratch;
+        const Vec3 wi = safe_normalize(Vec3{0.1f, -0.7f, 0.4f});
+        EXPECT_EQ(fx.model->prepare(hit, scratch).f(wi).b, without.prepare(hit, scratch).f(wi).b);
+    }
+}
+
+TEST(HuangTabulatedFiber, ReadsTheStrandsInputsAndRefusesStrandsOfAnotherFiber) {
+    const StrandFixture &fx = strand_fixture();
+    EXPECT_EQ(fx.model->strand_inputs(), fx.strands.get());
+    EXPECT_EQ(fixture().model->strand_inputs(), nullptr);
+    const Expected<HuangTabulatedFiber> other = HuangTabulatedFiber::create(fixture().fiber, fixture().table, fx.strands);
+    ASSERT_FALSE(other);
+    EXPECT_NE(other.error().message.find("strands"), std::string::npos) << other.error().message;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "fiber/chiang.h"
 #include "fiber/chiang_strands.h"
 #include "fiber/huang.h"
+#include "fiber/huang_strands.h"
 #include "fiber/seed_pdfs.h"
 #include "sampling/hair_bsdf.h"
 #include "sampling/huang_table.h"
@@ -89,6 +90,9 @@ struct StrategyInputs {
     /// The Huang table (TABLE with `huang`): it must have been baked for `huang`'s parameters.
     /// Null: the Huang part of `tables`, if they have one.
     std::shared_ptr<const HuangSamplingTable> huang_table;
+    /// A Huang material whose inputs vary per strand (its fiber must be `huang`): TABLE's
+    /// baked f then serves the strands as huang_tabulated_fiber.h says.
+    std::shared_ptr<const HuangStrands> huang_strands;
     /// TABLE with `huang`: the uniform sphere's weight in the mixture, in [0, 1).
     float huang_uniform_weight = kHuangUniformWeight;
 };

@@ -657,7 +657,11 @@ def test_huang_materials_export():
     helpers.socket(node, "Radial Roughness").default_value = 0.9  # Chiang only: not read
     data = export.export_context()
     hair = data.materials[particle_curves(data).material]
-    check_hair_material(hair, material, fields=HUANG_FIELDS)
+    # Random Color/Roughness with Random unlinked vary per strand for Huang as for Chiang.
+    check_hair_material(hair, material, {"random": 0.5}, fields=HUANG_FIELDS)
+    curves = particle_curves(data)
+    assert set(curves.inputs) == {"random"}, curves.inputs.keys()
+    check_strand_random(*curves.inputs["random"], len(curves.first) - 1)
     assert hair.hair.model == "HUANG" and hair.hair.radial_roughness == 0.3, hair.hair
     native = helpers.module("native")
     options = native.principled_options(hair.hair.as_dict())

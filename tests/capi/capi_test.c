@@ -2384,6 +2384,24 @@ static void test_curve_inputs(void)
     CHECK(memcmp(expected, plain, bytes) != 0, "and the inputs change the image");
     for (int k = 0; k < 4; ++k) hairis_scene_destroy(scenes[k]);
 
+    /* The same for a huang2022 material (uniform strategy: the strand's own Cycles eval, whose
+     * draws are seeded by the hit alone). Huang reads no radial roughness. */
+    const char *huang_settings = "samples=2;max_bounces=2;strategy=uniform;seed=5";
+    hairis_scene *huang_scenes[3] = {
+        curve_input_scene("model=huang;parametrization=melanin;melanin=0.8", "", 0, NULL),
+        curve_input_scene("model=huang;parametrization=melanin;melanin=0.3", "melanin=curve", 5, curve_values),
+        curve_input_scene("model=huang;parametrization=melanin;melanin=0.3", "", 0, NULL)};
+    float *huang_images[3] = {expected, per_curve, plain};
+    for (int k = 0; k < 3; ++k)
+        CHECK(hairis_render(huang_scenes[k], huang_settings, huang_images[k], NULL, NULL) == HAIRIS_OK,
+              "huang render %d: %s", k, hairis_last_error());
+    CHECK(memcmp(expected, per_curve, bytes) == 0, "huang2022 melanin=curve 0.8 renders as melanin 0.8");
+    CHECK(memcmp(expected, plain, bytes) != 0, "and the inputs change the huang2022 image");
+    CHECK(add_strands_with(huang_scenes[2], 0, "radial_roughness=curve", 5, curve_values) ==
+              HAIRIS_ERROR_INVALID_ARGUMENT, "radial roughness on Huang");
+    CHECK_ERROR_MENTIONS("huang2022");
+    for (int k = 0; k < 3; ++k) hairis_scene_destroy(huang_scenes[k]);
+
     /* Refusals name the input, the item and the range. */
     hairis_scene *scene = curve_input_scene("parametrization=melanin", "", 0, NULL);
     point_values[7] = 1.25f;

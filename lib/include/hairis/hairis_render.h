@@ -102,7 +102,7 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
  * offset (radians), random_color, random_roughness, random — the node inputs of
  * hairis_fiber_create, in the same units and ranges (colour and tint > 0, absorption >= 0,
  * ior > 1, offset in [-pi/2, pi/2], the others in [0, 1]), and only those the material's
- * parametrization reads. `values` holds value_count floats: for each input given per curve
+ * parametrization reads (a huang2022 material reads neither radial_roughness nor coat). `values` holds value_count floats: for each input given per curve
  * or per point, in that order, its components (3 for color, tint and absorption, else 1) for
  * each curve (curve_count items) or each point (point_count items) in turn, then weight0 ..
  * weight7 (a hair mixture's closure weights, finite and >= 0) given per curve or point, one
@@ -111,7 +111,9 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
  * interpolated linearly in the segment's curve parameter between its two points, as Cycles
  * interpolates curve attributes, then mapped as Cycles maps the node (Random Color and
  * Random Roughness from the hit's random, melanin, colours). The TABLE strategy samples the
- * tables baked for the fiber's own values and stays exact for every strand.
+ * tables baked for the fiber's own values and stays exact for every strand; a huang2022
+ * strand is shaded with its own f (the baked f corrected by the strand's Cycles eval where
+ * only its absorption differs, else its Cycles eval).
  */
 HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int material, size_t curve_count,
                                                    const uint32_t *first, size_t point_count,
