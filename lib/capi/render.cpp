@@ -150,6 +150,74 @@ using namespace hairis::capi;
 
 namespace {
 
+// What a built scene depends on among the render settings: the sampler (the materials), the
+// integrator and Huang sampling (the shading), the curves' backfaces and shape (the BVH).
+std::string build_key(const RenderOptions &o) {
+    return write_options(o.sampler) + ";integrator=" + std::to_string(o.render.integrator) +
+           ";huang_sampling=" + std::to_string(o.render.huang_sampling) + ";curve_backfaces=" +
+           std::to_string(int(o.curve_backfaces)) + ";curve_shape=" + std::to_string(int(o.curve_shape));
+}
+
+// The scene built with this render's materials, and whether it is the last render's: render
+// settings the same as its keep its build (only the camera is set again, when no other
+// render is using it).
+std::pair<std::shared_ptr<Scene>, bool> built_scene(hairis_scene &scene, const RenderOptions &o) {
+    const std::string key = build_key(o);
+    unsigned camera = 0;
+    {
+        std::lock_guard<std::mutex> lock(scene.build_mutex);
+        camera = scene.camera_revision;
+        if (scene.built && scene.built_key == key) {
+            if (scene.built_camera == camera) return {scene.built, true};
+            if (scene.built.use_count() == 1) {
+                ok_or_invalid(scene.built->set_camera(scene.desc.camera), "camera: ");
+                scene.built_camera = camera;
+                return {scene.built, true};
+            }
+        }
+        // Free the old build before making the new one (a render using it keeps it alive).
+        scene.built.reset();
+        scene.built_key.clear();
+    }
+    // The scene description with this render's materials. The handle keeps its own copy
+    // of the geometry so that it can be rendered again with other settings.
+    if (o.render.integrator == int(Integrator::DualScattering))
+        for (size_t m = 0; m < scene.materials.size(); ++m)
+            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene.materials[m]); hair && !hair->closures.empty())
+                invalid("material " + std::to_string(m) + " (hair mixture): integrator=dual_scattering shades "
+                        "one Principled Hair BSDF per material, and this material mixes " +
+                        std::to_string(hair->closures.size()) + " (a Mix or Add Shader of hair closures); "
+                        "render with integrator=path");
+    SceneDesc desc = scene.desc;
+    desc.curve_backfaces = o.curve_backfaces;
+    desc.curve_shape = o.curve_shape;
+    desc.materials.reserve(scene.materials.size());
+    for (size_t m = 0; m < scene.materials.size(); ++m) {
+        if (const auto *hair = std::get_if<SceneHairMaterial>(&scene.materials[m])) {
+            // Dual scattering samples Huang with its tables: its MIS needs the sampler's
+            // density, which Cycles' own Huang sampler does not have.
+            const bool dual = o.render.integrator == int(Integrator::DualScattering);
+            if (!hair->closures.empty()) {
+                desc.materials.push_back(hair_mixture(scene, *hair, m, o.sampler));
+                continue;
+            }
+            HairMaterial material{hair_shading(*hair, m, o.sampler,
+                                               o.render.huang_sampling == int(HuangSampling::Cycles) && !dual)};
+            if (dual) add_dual_scattering(material, *hair, m);
+            desc.materials.push_back(std::move(material));
+        } else
+            desc.materials.push_back(std::get<SurfaceMaterial>(scene.materials[m]));
+    }
+    Expected<Scene> made = Scene::build(std::move(desc));
+    if (!made) invalid("scene: " + made.error().message);
+    auto built = std::make_shared<Scene>(std::move(made).value());
+    std::lock_guard<std::mutex> lock(scene.build_mutex);
+    scene.built = built;
+    scene.built_key = key;
+    scene.built_camera = camera;
+    return {built, false};
+}
+
 // hairis_render and hairis_render_progressive: the scene built with this render's materials,
 // rendered by render/render.h, the statistics kept for hairis_last_render_stats.
 int render_scene(const char *function, hairis_scene *scene, const char *settings, float *rgba, float *passes,
@@ -162,43 +230,14 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
         read_options(settings, "render settings", o);
         if (!scene->has_camera) invalid("scene has no camera: call hairis_scene_set_camera before " + std::string(function));
 
-        // The scene description with this render's materials. The handle keeps its own copy
-        // of the geometry so that it can be rendered again with other settings.
-        if (o.render.integrator == int(Integrator::DualScattering))
-            for (size_t m = 0; m < scene->materials.size(); ++m)
-                if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m]); hair && !hair->closures.empty())
-                    invalid("material " + std::to_string(m) + " (hair mixture): integrator=dual_scattering shades "
-                            "one Principled Hair BSDF per material, and this material mixes " +
-                            std::to_string(hair->closures.size()) + " (a Mix or Add Shader of hair closures); "
-                            "render with integrator=path");
-        SceneDesc desc = scene->desc;
-        desc.curve_backfaces = o.curve_backfaces;
-        desc.curve_shape = o.curve_shape;
-        desc.materials.reserve(scene->materials.size());
-        for (size_t m = 0; m < scene->materials.size(); ++m) {
-            if (const auto *hair = std::get_if<SceneHairMaterial>(&scene->materials[m])) {
-                // Dual scattering samples Huang with its tables: its MIS needs the sampler's
-                // density, which Cycles' own Huang sampler does not have.
-                const bool dual = o.render.integrator == int(Integrator::DualScattering);
-                if (!hair->closures.empty()) {
-                    desc.materials.push_back(hair_mixture(*scene, *hair, m, o.sampler));
-                    continue;
-                }
-                HairMaterial material{hair_shading(*hair, m, o.sampler,
-                                                   o.render.huang_sampling == int(HuangSampling::Cycles) && !dual)};
-                if (dual) add_dual_scattering(material, *hair, m);
-                desc.materials.push_back(std::move(material));
-            } else
-                desc.materials.push_back(std::get<SurfaceMaterial>(scene->materials[m]));
-        }
-        Expected<Scene> built = Scene::build(std::move(desc));
-        if (!built) invalid("scene: " + built.error().message);
+        const auto [built, reused] = built_scene(*scene, o);
 
         RenderStats stats;
-        const Status status = render_progressive(built.value(), o.render, rgba, passes, update, &stats, schedule);
+        const Status status = render_progressive(*built, o.render, rgba, passes, update, &stats, schedule);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         t_last_stats = format_options({{"seconds", format_number(seconds)},
-                                       {"build_seconds", format_number(built.value().stats().build_seconds)},
+                                       {"build_seconds", format_number(reused ? 0.0 : built->stats().build_seconds)},
+                                       {"scene_reused", reused ? "1" : "0"},
                                        {"camera_rays", std::to_string(stats.camera_rays)},
                                        {"rays", std::to_string(stats.rays)},
                                        {"shadow_rays", std::to_string(stats.shadow_rays)},

@@ -303,6 +303,13 @@ Scene &Scene::operator=(Scene &&) noexcept = default;
 Scene::~Scene() = default;
 
 const Camera &Scene::camera() const { return *impl_->camera; }
+
+Status Scene::set_camera(const CameraDesc &camera) {
+    auto cam = Camera::create(camera);
+    if (!cam) return cam.error();
+    impl_->camera.emplace(std::move(cam).value());
+    return std::nullopt;
+}
 const LightSet &Scene::lights() const { return impl_->lights; }
 const std::vector<Material> &Scene::materials() const { return impl_->materials; }
 const SceneStats &Scene::stats() const { return impl_->stats; }

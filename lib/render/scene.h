@@ -281,6 +281,9 @@ class Scene {
     ~Scene();
 
     const Camera &camera() const;
+    /// Replaces the camera, refused as build() refuses one: nothing else in a built scene
+    /// depends on it, so a new view needs no new BVH. Not while the scene is being rendered.
+    Status set_camera(const CameraDesc &camera);
     const LightSet &lights() const;
     const std::vector<Material> &materials() const;
     const SceneStats &stats() const;

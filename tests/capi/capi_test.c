@@ -1508,6 +1508,36 @@ static void test_render(void)
         CHECK(stat_of("cancelled") == 0, "cancelled: \"%s\"", stats);
     }
 
+    /* A render with the last render's build settings keeps its build: only the camera is set
+     * again. Its image is a fresh scene's with that camera, bit for bit; a change to the scene
+     * or to the sampler builds anew. */
+    {
+        static float fresh[W * H * 4];
+        const char *moved = "matrix=1,0,0,0.1,0,1,0,0,0,0,1,2.5,0,0,0,1;"
+                            "frame=0.3,0.3,-1,0.3,-0.3,-1,-0.3,-0.3,-1,-0.3,0.3,-1;width=16;height=16";
+        const char *settings = tiny_settings(s, "table", ";seed=3;threads=2");
+        CHECK(hairis_render(scene, settings, rgba, NULL, NULL) == HAIRIS_OK, "first render");
+        CHECK(hairis_scene_set_camera(scene, moved) == HAIRIS_OK, "move the camera");
+        CHECK(hairis_render(scene, settings, rgba, NULL, NULL) == HAIRIS_OK, "render after the move");
+        CHECK(stat_of("scene_reused") == 1 && stat_of("build_seconds") == 0,
+              "the same settings reuse the build: \"%s\"", hairis_last_render_stats());
+        hairis_scene *other = make_scene_of("", g_tables, "type=diffuse;color=0.5,0.5,0.5;emission=0,0,0",
+                                            "type=sun;direction=0.3,0.2,1;color=1,1,1;strength=3;angle=0.05",
+                                            SKY, moved);
+        CHECK(hairis_render(other, settings, fresh, NULL, NULL) == HAIRIS_OK, "fresh scene");
+        CHECK(memcmp(rgba, fresh, sizeof fresh) == 0, "the reused build renders as a fresh one");
+        CHECK(hairis_scene_add_light(scene, "type=point;position=0,0,1;power=40") == HAIRIS_OK, "a light");
+        CHECK(hairis_render(scene, settings, again, NULL, NULL) == HAIRIS_OK, "render after the light");
+        CHECK(stat_of("scene_reused") == 0, "a changed scene builds anew: \"%s\"", hairis_last_render_stats());
+        CHECK(memcmp(rgba, again, sizeof again) != 0, "and the light shows");
+        CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2"), again, NULL, NULL) ==
+                  HAIRIS_OK, "other strategy");
+        CHECK(stat_of("scene_reused") == 0, "another strategy builds anew");
+        hairis_scene_destroy(other);
+        hairis_scene_destroy(scene);
+        scene = make_scene("", g_tables);
+    }
+
     /* Dual scattering: with either sampler for the direct term, an image of its own (not the
      * path tracer's), the same for any thread count. */
     {

@@ -217,8 +217,12 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * first hair hit, the paper's), and dual_bounce_limit = bounces (default: that vertex adds only
  * the orders of scattering the path tracer would reach within max_bounces and
  * max_transmission_bounces, as Cycles ends its paths) | none (every order, the paper's). A scene without camera is
- * refused; one without geometry renders the world (every ray misses). Each call builds the scene anew, so
- * a scene can be rendered again with other settings, also from several threads at once.
+ * refused; one without geometry renders the world (every ray misses). A scene can be rendered
+ * again with other settings, also from several threads at once. The scene keeps the last
+ * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
+ * sampler, integrator, huang_sampling, curve_backfaces and curve_shape are the last render's
+ * reuses it with the current camera (build_seconds 0, scene_reused 1), so a new view costs no
+ * new BVH; any other hairis_scene_* call frees it. hairis_scene_destroy frees it too.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
                              hairis_progress_fn progress, void *user);
@@ -276,7 +280,8 @@ typedef int (*hairis_update_fn)(void *user, float progress, int samples_done, in
 HAIRIS_API int hairis_render_progressive(hairis_scene *scene, const char *settings, float *rgba,
                                          float *passes, hairis_update_fn update, void *user);
 /** What the calling thread's last hairis_render or hairis_render_progressive did, as options:
- * seconds (the whole call), build_seconds (the scene and BVH build within it), camera_rays,
+ * seconds (the whole call), build_seconds (the scene and BVH build within it, 0 when
+ * scene_reused is 1: the last render's build with a new camera), camera_rays,
  * rays, shadow_rays, dropped_samples, peak_memory_bytes, threads, cancelled, samples,
  * converged_pixels; "" before any render. */
 HAIRIS_API const char *hairis_last_render_stats(void);
