@@ -418,4 +418,8 @@ if helpers.VERSION >= (5, 0, 0):
     # hair model (3.4 and 4.5), not once per Blender.
     TESTS = [test for test in TESTS
              if test not in (test_strategies_agree, test_dual_scattering_renders_huang)]
+elif helpers.VERSION < (4, 0, 0):
+    # The strategies' exactness for 3.4's Chiang tilt is proved by the library's χ² and
+    # render tests (strategy_test, render_test); the Blender-level agreement runs in 4.5.
+    TESTS.remove(test_strategies_agree)
 helpers.run(TESTS)
