@@ -567,6 +567,17 @@ def make_huang_scene(samples, bounces, huang_sampling, resolution=(64, 48)):
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
+def study_settings(resolution, ref_spp, spps, seeds):
+    """A study's (resolution, reference spp, spps, seeds): the defaults given, each replaced by
+    HAIRIS_STUDY_RESOLUTION ("WxH"), HAIRIS_STUDY_REF_SPP, HAIRIS_STUDY_SPPS ("a,b,c") and
+    HAIRIS_STUDY_SEEDS when set."""
+    env = os.environ.get
+    text = env("HAIRIS_STUDY_RESOLUTION", "%dx%d" % tuple(resolution))
+    return (tuple(int(v) for v in text.split("x")), int(env("HAIRIS_STUDY_REF_SPP", ref_spp)),
+            [int(v) for v in env("HAIRIS_STUDY_SPPS", ",".join(map(str, spps))).split(",")],
+            int(env("HAIRIS_STUDY_SEEDS", seeds)))
+
+
 def run_script(main):
     """Runs a study script's ``main``: prints its result line (FAILED with the traceback when
     it raises) and exits with 0 or 1, so run_test.py reports it."""

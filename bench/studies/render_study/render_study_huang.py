@@ -26,7 +26,8 @@ at the time Cycles took for each of its sample counts, divided by Cycles' RMSE t
 
 Writes render_study_huang.json and render_study_huang.md into HAIRIS_STUDY_OUT
 (default: this folder). Environment: HAIRIS_STUDY_RESOLUTION (64x48), HAIRIS_STUDY_REF_SPP (2048),
-HAIRIS_STUDY_SPPS (4,16,64,256), HAIRIS_STUDY_SEEDS (3).
+HAIRIS_STUDY_SPPS (4,16,64,256), HAIRIS_STUDY_SEEDS (3), HAIRIS_STUDY_SCENE (compare: the
+scene above; default, rough01, random: the issue's three acceptance scenes, see SCENES).
 """
 
 import json
@@ -57,6 +58,21 @@ REF_SPP = int(os.environ.get("HAIRIS_STUDY_REF_SPP", "2048"))
 SPPS = [int(v) for v in os.environ.get("HAIRIS_STUDY_SPPS", "4,16,64,256").split(",")]
 SEEDS = int(os.environ.get("HAIRIS_STUDY_SEEDS", "3"))
 OUT = os.environ.get("HAIRIS_STUDY_OUT", HERE)
+SCENE = os.environ.get("HAIRIS_STUDY_SCENE", "compare")
+SCENES = {
+    "compare": "tests/blender/test_cycles_huang.py's (Huang hair of aspect 0.85 on Curves and on "
+               "particle hair, thick fibers of aspect 0.5 with lobes (1, 0.5, 0.2), sun, point, "
+               "area light, world colour)",
+    "default": "Blender's default Huang node (every input at its default) on 400 particle "
+               "strands on a diffuse sphere, sun, point, area light, world colour",
+    "rough01": "a Curves object of 150 strands with Huang hair at roughness 0.1 (aspect 0.85, "
+               "blond), sun, point, area light, world colour",
+    "random": "an aspect 0.5 Huang fiber under Melanin Concentration (0.4) with Random Color "
+              "0.8 and Random unlinked (per strand) on 400 particle strands on a diffuse "
+              "sphere, sun, point, area light, world colour",
+}
+if SCENE not in SCENES:
+    raise SystemExit("HAIRIS_STUDY_SCENE must be one of %s (got %r)" % (", ".join(SCENES), SCENE))
 BOUNCES = 4
 METHODS = ("UNIFORM", "TABLE", "HAIRIS_CYCLES_SAMPLING", "CYCLES")
 REFERENCE_OF = {"UNIFORM": "HAIRIS", "TABLE": "HAIRIS", "HAIRIS_CYCLES_SAMPLING": "CYCLES",
@@ -139,11 +155,9 @@ def markdown(results):
                                     m["cpu_model"], m["load_average_start"][0],
                                     m["load_average_end"][0], m["total_seconds"]),
         "",
-        "Scene: tests/blender/test_cycles_huang.py's (Huang hair of aspect 0.85 on Curves and "
-        "on particle hair, thick fibers of aspect 0.5 with lobes (1, 0.5, 0.2), sun, point, "
-        "area light, world colour) at %dx%d pixels, %d bounces, Cycles matched as in the "
+        "Scene %s: %s, at %dx%d pixels, %d bounces, Cycles matched as in the "
         "README's \"Comparing with Cycles\"; seeds %s per sample count." % (
-            s["resolution"][0], s["resolution"][1], s["bounces"],
+            s["scene"], SCENES[s["scene"]], s["resolution"][0], s["resolution"][1], s["bounces"],
             ", ".join(str(v) for v in s["seeds"])),
         "",
         "References, one per engine (see the script's header for why): Hairis TABLE and "
@@ -181,10 +195,43 @@ def markdown(results):
     return "\n".join(lines)
 
 
+def make_scene():
+    """The study's scene (HAIRIS_STUDY_SCENE, see SCENES)."""
+    if SCENE == "compare":
+        return helpers.make_huang_scene(SPPS[0], BOUNCES, "STRATEGY", resolution=RESOLUTION)
+    scene = helpers.reset()
+    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=RESOLUTION, percentage=100)
+    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=0.8)
+    skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    if SCENE == "rough01":
+        blond = helpers.make_huang_material("Blond", (0.55, 0.4, 0.25, 1.0), 0.85, roughness=0.1)
+        helpers.make_fresh_curves(scene, "Curls", blond, 150, 8, 0.006, 3, (0.0, 0.0, -0.6), 0.5)
+    else:
+        hair, node = helpers.make_bsdf_material("Hair", "ShaderNodeBsdfHairPrincipled")
+        node.model = "HUANG"
+        if SCENE == "random":
+            node.parametrization = "MELANIN"
+            helpers.socket(node, "Melanin").default_value = 0.4
+            helpers.socket(node, "Random Color").default_value = 0.8
+            helpers.socket(node, "Aspect Ratio").default_value = 0.5
+        helpers.make_particle_hair(scene, count=400, location=(0.0, 0.6, -0.3), scale=0.9,
+                                   hair_material=hair, skin_material=skin)
+    helpers.make_comparison_lights(scene)
+    helpers.match_cycles(scene, SPPS[0], BOUNCES)
+    settings = scene.hairis
+    settings.samples = SPPS[0]
+    settings.max_bounces = BOUNCES
+    settings.max_transparent_bounces = BOUNCES
+    settings.auto_bake = True
+    settings.threads = 0
+    bpy.context.view_layer.update()
+    return scene
+
+
 def study():
     """Renders everything; returns the results dictionary."""
     info = helpers.machine_info()
-    scene = helpers.make_huang_scene(SPPS[0], BOUNCES, "STRATEGY", resolution=RESOLUTION)
+    scene = make_scene()
     pixels = RESOLUTION[0] * RESOLUTION[1]
     log("scene %dx%d, %d bounces; %s" % (RESOLUTION[0], RESOLUTION[1], BOUNCES, info))
     for method in METHODS:  # warm-up: TABLE auto-bakes its Huang tables, kernels load
@@ -217,7 +264,8 @@ def study():
                            / references["CYCLES"]["channel_mean"] - 1.0)
     return {
         "machine": info,
-        "settings": {"resolution": list(RESOLUTION), "pixels": pixels, "bounces": BOUNCES,
+        "settings": {"scene": SCENE, "resolution": list(RESOLUTION), "pixels": pixels,
+                     "bounces": BOUNCES,
                      "ref_spp": REF_SPP, "spps": SPPS, "seeds": list(range(1, SEEDS + 1))},
         "references": {name: {"mean": ref["mean"], "seconds": ref["seconds"],
                               "noise_relative_rmse": math.sqrt(ref["mse"]) / ref["mean"],
