@@ -27,7 +27,7 @@ at the time Cycles took for each of its sample counts, divided by Cycles' RMSE t
 Writes render_study_huang.json and render_study_huang.md into HAIRIS_STUDY_OUT
 (default: this folder). Environment: HAIRIS_STUDY_RESOLUTION (64x48), HAIRIS_STUDY_REF_SPP (2048),
 HAIRIS_STUDY_SPPS (4,16,64,256), HAIRIS_STUDY_SEEDS (3), HAIRIS_STUDY_SCENE (compare: the
-scene above; default, rough01, random: the issue's three acceptance scenes, see SCENES).
+scene above; default, rough01, random: three more, see SCENES).
 """
 
 import json
