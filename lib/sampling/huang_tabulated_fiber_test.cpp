@@ -208,20 +208,23 @@ HuangFiber strand_fiber(PrincipledHairNode node, HairInput input, float value) {
     return HuangFiber::create(to_huang_params(node).value()).value();
 }
 
+// Running mean and variance of a sequence of draws.
 struct Moments {
-    double mean = 0, variance = 0;
+    double count = 0, sum = 0, sum2 = 0;
+    void add(double v) {
+        count += 1;
+        sum += v;
+        sum2 += v * v;
+    }
+    double mean() const { return sum / count; }
+    double variance() const { return std::max(0.0, sum2 / count - mean() * mean()); }
 };
 
-// Mean and variance of the green channel of `draws` calls of point.f(wi).
+// The moments of the green channel of `draws` calls of point.f(wi).
 Moments moments(const FiberPoint &point, Vec3 wi, int draws) {
-    double sum = 0, sum2 = 0;
-    for (int n = 0; n < draws; ++n) {
-        const double g = point.f(wi).g;
-        sum += g;
-        sum2 += g * g;
-    }
-    const double mean = sum / draws;
-    return {mean, std::max(0.0, sum2 / draws - mean * mean)};
+    Moments m;
+    for (int n = 0; n < draws; ++n) m.add(point.f(wi).g);
+    return m;
 }
 
 TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoise) {
@@ -246,22 +249,18 @@ TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoi
         const Vec3 wi_h = node_point.to_huang(wi);
         const Rgb table = fx.model->f_table().f_cos(fx.model->table().locate(node_point.to_huang(hit.wo)), wi_h);
         CyclesLcg lcg = point.huang_point()->lcg();
-        double sum_cv = 0, sum2_cv = 0, sum_own = 0, sum2_own = 0;
+        Moments cv, plain;
         for (int n = 0; n < draws; ++n) {
             CyclesLcg node_lcg = lcg;
             const Rgb strand = own_point.f_estimate(wi, lcg);
             const Rgb expected = table + node_point.f_reflection(wi) + strand - node_point.f_estimate(wi, node_lcg);
             const Rgb f = point.f(wi);
             for (int c = 0; c < 3; ++c) ASSERT_NEAR(f[c], expected[c], 1e-6f * (1.0f + std::fabs(expected[c]))) << n;
-            sum_cv += f.g;
-            sum2_cv += double(f.g) * f.g;
-            sum_own += strand.g;
-            sum2_own += double(strand.g) * strand.g;
+            cv.add(f.g);
+            plain.add(strand.g);
         }
         // On the same draws the corrected table is far less noisy than the strand's own eval.
-        const double var_cv = sum2_cv / draws - (sum_cv / draws) * (sum_cv / draws);
-        const double var_own = sum2_own / draws - (sum_own / draws) * (sum_own / draws);
-        EXPECT_LT(var_cv, 0.5 * var_own) << wi.x << " " << wi.y << " " << wi.z;
+        EXPECT_LT(cv.variance(), 0.5 * plain.variance()) << wi.x << " " << wi.y << " " << wi.z;
     }
 }
 
@@ -280,7 +279,7 @@ TEST(HuangTabulatedFiber, AStrandOfOtherRoughnessIsShadedWithItsOwnEval) {
     const Vec3 wi = safe_normalize(Vec3{0.2f, 0.5f, 0.8f});
     const Moments m = moments(point, wi, 3000);
     const double exact = own.expectation(own_point.huang_hit()).f(own_point.to_huang(wi)).g;
-    EXPECT_NEAR(m.mean, exact, 5.0 * std::sqrt(m.variance / 3000) + 1e-4 * exact);
+    EXPECT_NEAR(m.mean(), exact, 5.0 * std::sqrt(m.variance() / 3000) + 1e-4 * exact);
     // Cycles' sampler of the hit is the strand's: its R lobe is the strand's R.
     ASSERT_NE(point.huang_point(), nullptr);
     EXPECT_EQ(point.huang_point()->f_reflection(wi).g, own_point.f_reflection(wi).g);
