@@ -438,21 +438,28 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
             if (!ggx::refract(p.v, h1, eta_, wt)) wt = -p.v;
             return std::array<double, 2>{-dot(wt, node.meso), -dot(wt, node.macro)};
         };
+        auto add_tt = [&](const Entry &e, double base) {
+            HuangExpectation::TtPath path;
+            path.wt = e.wt;
+            path.n2 = e.n2;
+            path.cos_m2 = e.cos_m2;
+            path.coefficient = base * m_tt_ * c.ellipse.arc(e.gamma2) * e.t1 * e.s1 * e.s2 * e.g1o * e.cos_m1 / e.cos_o1;
+            path.colour = e.at;
+            out.tt_.push_back(path);
+        };
+        const int tt_order = q.tt_order > 0 ? q.tt_order : q.first_order;
+        if (m_tt_ > 0.0 && tt_order != q.first_order)
+            for (const ggx::VisibleNode &first :
+                 ggx::visible_rule_split(alpha_, p.v, node.meso, tt_order, tt_order, q.scan, entry_events)) {
+                const Entry e = entry(c, node.gamma, node.meso, node.macro, first.h);
+                if (e.ok) add_tt(e, node.weight * first.weight);
+            }
         for (const ggx::VisibleNode &first :
              ggx::visible_rule_split(alpha_, p.v, node.meso, q.first_order, q.first_order, q.scan, entry_events)) {
             const Entry e = entry(c, node.gamma, node.meso, node.macro, first.h);
             if (!e.ok) continue;
             const double base = node.weight * first.weight;
-            if (m_tt_ > 0.0) {
-                HuangExpectation::TtPath path;
-                path.wt = e.wt;
-                path.n2 = e.n2;
-                path.cos_m2 = e.cos_m2;
-                path.coefficient = base * m_tt_ * c.ellipse.arc(e.gamma2) * e.t1 * e.s1 * e.s2 *
-                                   e.g1o * e.cos_m1 / e.cos_o1;
-                path.colour = e.at;
-                out.tt_.push_back(path);
-            }
+            if (m_tt_ > 0.0 && tt_order == q.first_order) add_tt(e, base);
             if (m_trt_ <= 0.0) continue;
             // The internal reflection: Fresnel's kink at the critical angle and the visibility
             // tests of the reflected direction against the inner meso- and macronormal.

@@ -93,6 +93,9 @@ struct HuangCyclesSample {
 struct HuangQuadrature {
     int first_order = 8;   ///< Gauss nodes per angle for the entry microfacet (order², ≤ 32)
     int second_order = 5;  ///< ... for the internal-reflection microfacet of TRT/TRRT+
+    /// ... for the entry microfacet of TT alone (0: first_order). TT's one-microfacet chains are
+    /// cheap and its lobe is the brightest, so a finer rule there buys accuracy for little time.
+    int tt_order = 0;
     int scan = 8;          ///< points per ψ line bracketing the events the rules split at
     /// Divides Cycles' Simpson steps (0.7α, 0.8α); 1 = Cycles. Only for studying the
     /// discretization: any other value is no longer Cycles' function.

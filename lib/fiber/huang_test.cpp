@@ -429,5 +429,42 @@ TEST(Huang, FarFieldViewsNeverShareCachedLobes) {
     }
 }
 
+// HuangQuadrature::tt_order refines TT's entry rule alone: TT is then the TT of the finer first
+// rule, TRT and TRRT+ stay the coarse rule's, and TT comes closer to the reference rule.
+TEST(Huang, TtOrderRefinesTtAlone) {
+    const HuangFiber fiber = make_fiber(0.3f, 0.85f);
+    FiberHit hit;
+    hit.wo = view_at(0.2);
+    hit.normal = normal_at(0.4);
+    const HuangPoint point = fiber.at(hit);
+    HuangQuadrature coarse, refined, fine, reference;
+    coarse.first_order = refined.first_order = 4;
+    coarse.second_order = refined.second_order = fine.second_order = 3;
+    refined.tt_order = fine.first_order = 8;
+    reference.first_order = 16;
+    reference.second_order = 1;  // TT reads the first rule only
+    const HuangHit h = point.huang_hit();
+    const HuangExpectation ec = fiber.expectation(h, coarse), er = fiber.expectation(h, refined),
+                           ef = fiber.expectation(h, fine), ref = fiber.expectation(h, reference);
+    double error_coarse = 0, error_refined = 0, total = 0;
+    for (int i = 0; i < 24; ++i)
+        for (int j = 0; j < 48; ++j) {
+            const Vec3 wi = point.to_huang(light_at(-1.5 + 3.0 * (i + 0.5) / 24, -kPi + kTwoPi * (j + 0.5) / 48));
+            const auto c = ec.lobes(wi), r = er.lobes(wi), f = ef.lobes(wi), x = ref.lobes(wi);
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_NEAR(r[1][k], f[1][k], 1e-6 * (1.0 + f[1][k])) << i << " " << j;  // TT: the fine rule's
+                EXPECT_EQ(r[2][k], c[2][k]) << i << " " << j;                              // TRT: the coarse rule's
+                EXPECT_EQ(r[3][k], c[3][k]) << i << " " << j;                              // TRRT+
+            }
+            error_coarse += std::fabs(double(c[1].g) - x[1].g);
+            error_refined += std::fabs(double(r[1].g) - x[1].g);
+            total += x[1].g;
+        }
+    EXPECT_GT(total, 0.0);
+    EXPECT_LT(error_refined, error_coarse / 3.0) << "TT's L1 error: coarse " << error_coarse / total << ", refined "
+                                                 << error_refined / total;
+}
+
 }  // namespace
 }  // namespace hairis
+

@@ -55,6 +55,7 @@ HuangQuadrature rule_of(const HuangBakeOptions &o) {
     HuangQuadrature q;
     q.first_order = o.f_first_order;
     q.second_order = o.f_second_order;
+    q.tt_order = o.f_tt_order;
     return q;
 }
 

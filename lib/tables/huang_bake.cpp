@@ -50,7 +50,8 @@ Status HuangBakeOptions::validate() const {
                                check::count_in_range("estimates", estimates, 1, 1024),
                                check::count_in_range("threads", threads, 0, 1024),
                                check::count_in_range("f_first_order", f_first_order, 1, 32),
-                               check::count_in_range("f_second_order", f_second_order, 1, 32)))
+                               check::count_in_range("f_second_order", f_second_order, 1, 32),
+                               check::count_in_range("f_tt_order", f_tt_order, 0, 32)))
         return s;
     if (evaluator != "expectation" && evaluator != "estimate")
         return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};
@@ -88,9 +89,11 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
     HuangQuadrature rule;
     rule.first_order = o.first_order;
     rule.second_order = o.second_order;
+    rule.tt_order = o.f_tt_order;
     HuangQuadrature f_rule;
     f_rule.first_order = o.f_first_order;
     f_rule.second_order = o.f_second_order;
+    f_rule.tt_order = o.f_tt_order;
     // The sampling values reuse the f part's evaluations when both use one rule at one point.
     const bool shared_rule = o.f && expectation && p_is_one(o) && o.f_first_order == o.first_order &&
                              o.f_second_order == o.second_order;

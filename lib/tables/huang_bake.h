@@ -32,6 +32,9 @@ struct HuangBakeOptions {
     /// rule below, RGB, at each cell's midpoint.
     bool f = true;
     int f_first_order = 4, f_second_order = 3;  ///< the f part's rule (HuangQuadrature)
+    /// TT's entry rule in both parts (HuangQuadrature::tt_order; 0: first_order): the brightest
+    /// lobe needs a finer rule than TRT to be baked within a few percent at its peak.
+    int f_tt_order = 8;
 
     /// Names the first option out of range.
     Status validate() const;

@@ -85,6 +85,7 @@ TEST(HuangBake, CellsHoldFAtTheirCentres) {
     HuangQuadrature rule;
     rule.first_order = o.first_order;
     rule.second_order = o.second_order;
+    rule.tt_order = o.f_tt_order;  // both parts refine TT alike
     int positive = 0;
     for (int q : {0, 1, 2})
         for (int r : {1, 3}) {

@@ -927,6 +927,7 @@ BakedFError baked_f_error(const HuangFiber &fiber, const HairShading &baked, int
     HuangQuadrature bake_rule;
     bake_rule.first_order = HuangBakeOptions{}.f_first_order;
     bake_rule.second_order = HuangBakeOptions{}.f_second_order;
+    bake_rule.tt_order = HuangBakeOptions{}.f_tt_order;
     std::vector<Sums> sums(all.size());
     tbb::parallel_for(0, views, [&](int k) {
         const View &v = all[size_t(k)];
@@ -1019,7 +1020,7 @@ void section_baked_f() {
     const int views = quick ? 6 : 48, grid = quick ? 16 : 32;
     print("## 9. The baked f against the expectation\n\n"
           "Renders shade Huang hair with R exactly (Cycles' R is deterministic) and TT + TRT + TRRT+ interpolated from the "
-          "expectation baked beside the sampling table (the default bake: f part at the rule (%d,%d)). Against the "
+          "expectation baked beside the sampling table (the default bake: f part at the rule (%d,%d), TT's entry at %d). Against the "
           "expectation at the rule (8,6), over %d random far-field views × a jittered %d × %d grid of ω_i, in luminance: "
           "R's largest error over its peak; for TT + TRT + TRRT+ the L1 error Σ|Δ|/Σ f (the error light from every "
           "direction sees), the error of the integral Σ f_baked/Σ f − 1, and the largest and 99th-percentile relative "
@@ -1030,7 +1031,8 @@ void section_baked_f() {
           "| aspect | roughness | bake (s) | memory (MB) | R max error | L1 | integral | max relative | 99%% relative | "
           "rule alone: L1 | rule alone: integral | baked f (ns) | Cycles eval (ns) |\n"
           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-          HuangBakeOptions{}.f_first_order, HuangBakeOptions{}.f_second_order, views, grid, 2 * grid);
+          HuangBakeOptions{}.f_first_order, HuangBakeOptions{}.f_second_order, HuangBakeOptions{}.f_tt_order, views, grid,
+          2 * grid);
     const FiberCase cases[] = {{0.85f, 0.3f}, {0.5f, 0.25f}, {1.0f, 0.3f}, {0.85f, 0.1f}, {0.5f, 0.1f},
                                {1.0f, 0.1f},  {0.85f, 0.8f}, {0.5f, 0.8f}};
     for (const FiberCase &c : cases) {
