@@ -30,10 +30,6 @@ UNLIMITED_SAMPLES = 1 << 24
 PREVIEW_DIVIDER = 4
 """The first pass renders at 1/PREVIEW_DIVIDER of the view's resolution, for prompt pixels."""
 
-BUILD_QUALITY = "low"
-"""The viewport's BVH build quality: a view gets few samples, so a fast build beats fast
-traversal (F12 keeps the library's default)."""
-
 _LIVE = weakref.WeakSet()
 """Every running ViewportRender, so that quitting Blender stops their threads."""
 
@@ -227,7 +223,7 @@ class ViewportRender:
             if self._cancelled(generation):
                 return
             scene.set_camera(dict(view.camera, width=width, height=height))
-            settings = dict(view.settings, samples=samples, build_quality=BUILD_QUALITY)
+            settings = dict(view.settings, samples=samples)
             self.renders += 1
             self.status = "Rendering"
             scene.render_progressive(settings, self._updater(generation, samples))

@@ -366,14 +366,12 @@ void describe(Fields &f, CameraOptions &o) {
 
 /// Everything hairis_render reads: the renderer's settings, the hair sampler's and how the
 /// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces;
-/// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape) and builds its BVH
-/// (build_quality=low|medium|high, scene.h's BuildQuality).
+/// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape).
 struct RenderOptions {
     RenderSettings render;
     SamplerOptions sampler;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
-    BuildQuality build_quality = BuildQuality::Medium;
 };
 template <typename Fields>
 void describe(Fields &f, RenderOptions &o) {
@@ -385,9 +383,6 @@ void describe(Fields &f, RenderOptions &o) {
     int shape = int(o.curve_shape);
     f.choice("curve_shape", shape, {"thick", "ribbons", "thick_linear"});
     o.curve_shape = CurveShape(shape);
-    int quality = int(o.build_quality);
-    f.choice("build_quality", quality, {"low", "medium", "high"});
-    o.build_quality = BuildQuality(quality);
 }
 
 }  // namespace hairis::capi

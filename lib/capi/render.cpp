@@ -151,13 +151,11 @@ using namespace hairis::capi;
 namespace {
 
 // What a built scene depends on among the render settings: the sampler (the materials), the
-// integrator and Huang sampling (the shading), the curves' backfaces and shape and the build
-// quality (the BVH).
+// integrator and Huang sampling (the shading), the curves' backfaces and shape (the BVH).
 std::string build_key(const RenderOptions &o) {
     return write_options(o.sampler) + ";integrator=" + std::to_string(o.render.integrator) +
            ";huang_sampling=" + std::to_string(o.render.huang_sampling) + ";curve_backfaces=" +
-           std::to_string(int(o.curve_backfaces)) + ";curve_shape=" + std::to_string(int(o.curve_shape)) +
-           ";build_quality=" + std::to_string(int(o.build_quality));
+           std::to_string(int(o.curve_backfaces)) + ";curve_shape=" + std::to_string(int(o.curve_shape));
 }
 
 // The scene built with this render's materials, and whether it is the last render's: render
@@ -193,7 +191,6 @@ std::pair<std::shared_ptr<Scene>, bool> built_scene(hairis_scene &scene, const R
     SceneDesc desc = scene.desc;
     desc.curve_backfaces = o.curve_backfaces;
     desc.curve_shape = o.curve_shape;
-    desc.build_quality = o.build_quality;
     desc.materials.reserve(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m) {
         if (const auto *hair = std::get_if<SceneHairMaterial>(&scene.materials[m])) {

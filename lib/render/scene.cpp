@@ -560,10 +560,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     rtcSetDeviceMemoryMonitorFunction(impl->device, &Impl::memory_monitor, impl.get());
     impl->rtc_scene = rtcNewScene(impl->device);
     rtcSetSceneFlags(impl->rtc_scene, RTC_SCENE_FLAG_ROBUST);
-    const BuildQuality quality = desc.build_quality;
-    rtcSetSceneBuildQuality(impl->rtc_scene, quality == BuildQuality::Low    ? RTC_BUILD_QUALITY_LOW
-                                             : quality == BuildQuality::High ? RTC_BUILD_QUALITY_HIGH
-                                                                             : RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetSceneBuildQuality(impl->rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
 
     const CurveShape shape = impl->curve_shape;
     const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE

@@ -157,11 +157,6 @@ enum class CurveBackfaces : int { Ignore = 0, Hit = 1 };
 enum class CurveShape : int { Thick = 0, Ribbons = 1, ThickLinear = 2 };
 
 /// Everything a scene is made of, as plain data.
-/// Embree's BVH build quality. Low builds several times faster and traces somewhat slower,
-/// which pays while a view is only rendered for a few samples (the viewport); the hits found
-/// are the same.
-enum class BuildQuality { Low, Medium, High };
-
 struct SceneDesc {
     std::vector<Material> materials;
     std::vector<HairCurves> curves;
@@ -174,7 +169,6 @@ struct SceneDesc {
     CameraDesc camera;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
-    BuildQuality build_quality = BuildQuality::Medium;
 };
 
 /// What the build did and what it costs.

@@ -497,7 +497,6 @@ static void test_option_strings(void)
         {"render", "film_transparent=2", "film_transparent", "true"},
         {"render", "curve_backfaces=cull", "curve_backfaces", "hit"},
         {"render", "curve_shape=RIBBONS", "curve_shape", "thick_linear"},
-        {"render", "build_quality=fast", "build_quality", "medium"},
         {"camera", "orthographic=yes", "orthographic", "false"},
     };
     for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
@@ -1534,17 +1533,6 @@ static void test_render(void)
         CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2"), again, NULL, NULL) ==
                   HAIRIS_OK, "other strategy");
         CHECK(stat_of("scene_reused") == 0, "another strategy builds anew");
-        /* Each build quality builds anew and finds the same hits: the same image, bit for bit. */
-        const char *qualities[2] = {"low", "high"};
-        CHECK(hairis_render(other, settings, fresh, NULL, NULL) == HAIRIS_OK, "medium quality, again");
-        for (int q = 0; q < 2; ++q) {
-            char with_quality[TEXT + 32];
-            snprintf(with_quality, sizeof with_quality, "%s;build_quality=%s", settings, qualities[q]);
-            CHECK(hairis_render(other, with_quality, again, NULL, NULL) == HAIRIS_OK, "build_quality=%s",
-                  qualities[q]);
-            CHECK(stat_of("scene_reused") == 0, "build_quality=%s builds anew", qualities[q]);
-            CHECK(memcmp(fresh, again, sizeof again) == 0, "build_quality=%s renders the same image", qualities[q]);
-        }
         hairis_scene_destroy(other);
         hairis_scene_destroy(scene);
         scene = make_scene("", g_tables);

@@ -203,9 +203,7 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * curve from inside its tube (it started inside another, overlapping strand) passes, as in
  * Cycles built with Embree 3 (Blender 3.4), or hits it, as in Cycles with Embree 4 (Blender's
  * builds from 3.6: 4.5, 5.0), curve_shape = thick (default) | ribbons | thick_linear: Cycles'
- * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), build_quality = low | medium
- * (default) | high: Embree's BVH build quality (low builds fastest and traces slower, for views
- * rendered with few samples; the image is the same), transparent_limit = plus_one (default) | setting: a path crosses
+ * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), transparent_limit = plus_one (default) | setting: a path crosses
  * at most max_transparent_bounces + 1 transparent surfaces, as Cycles up to 4.5 (it stores the
  * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
@@ -222,7 +220,7 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * refused; one without geometry renders the world (every ray misses). A scene can be rendered
  * again with other settings, also from several threads at once. The scene keeps the last
  * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
- * sampler, integrator, huang_sampling, curve_backfaces, curve_shape and build_quality are the last render's
+ * sampler, integrator, huang_sampling, curve_backfaces and curve_shape are the last render's
  * reuses it with the current camera (build_seconds 0, scene_reused 1), so a new view costs no
  * new BVH; any other hairis_scene_* call frees it. hairis_scene_destroy frees it too.
  */
