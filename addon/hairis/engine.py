@@ -632,9 +632,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             return found
         try:
             for index, material in data.hair_materials():
-                if (material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES"
-                        and settings.integrator != "DUAL_SCATTERING"):
-                    continue  # Cycles' own Huang sampler needs no tables (Dual Scattering does)
+                # Cycles' own Huang sampler needs no tables (Dual Scattering does); with them,
+                # light samples are shaded with the baked expectation of Cycles' eval.
+                optional = (material.hair.model == "HUANG" and settings.huang_sampling == "CYCLES"
+                            and settings.integrator != "DUAL_SCATTERING")
                 node = tables.principled_struct(library, material.hair)
                 try:
                     fiber = library.fiber_principled(node)
@@ -664,7 +665,7 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                         except native.HairisError as error:
                             raise RenderFailed("material %r: %s" % (material.name, error.message)) \
                                 from error
-                    else:
+                    elif not optional:
                         problems.append(status.message)
         except BaseException:
             for table in found.values():

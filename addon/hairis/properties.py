@@ -114,7 +114,9 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
                 "The strategy above with its exact density, which converges to Cycles' Huang "
                 "eval rather than to Cycles' image", 0),
                ("CYCLES", "Cycles",
-                "Cycles' own Huang sampler, so the image converges to what Cycles renders", 1)),
+                "Cycles' own Huang sampler, so the image converges to what Cycles renders; with "
+                "the Table strategy, light samples read the tables' baked f instead of Cycles' "
+                "slower eval", 1)),
         default="CYCLES")
     multiple_weight: FloatProperty(
         name="Multiple Weight",

@@ -17,12 +17,20 @@ namespace {
 
 thread_local std::string t_last_stats;
 
+// Whether a Huang material's tables were baked for its own fiber and hold a baked f.
+bool has_baked_f(const SceneHairMaterial &hair) {
+    return hair.huang && hair.tables && hair.tables->huang && hair.tables->huang->f &&
+           hair.tables->model == hair.huang->name() &&
+           hair.tables->parameters == canonical_parameters(huang_parameters(hair.huang->params()));
+}
+
 // The shading of a Huang material: TABLE samples the material's Huang table (baked for its
-// parameters), UNIFORM and GAUSSIAN need none; with Cycles' own sampling (huang_sampling=cycles)
-// the renderer samples the fiber itself and the strategy is not used.
+// parameters), UNIFORM and GAUSSIAN need none. With Cycles' own sampling (huang_sampling=cycles)
+// the renderer samples the fiber itself and the strategy is not used; a material whose tables
+// hold a baked f still shades with it, since that f is the expectation of Cycles' eval.
 HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name, StrategyKind kind,
                           const SamplerOptions &o, bool cycles_sampling) {
-    if (cycles_sampling) kind = StrategyKind::Uniform;
+    if (cycles_sampling) kind = has_baked_f(hair) ? StrategyKind::Table : StrategyKind::Uniform;
     if (kind == StrategyKind::Analytic)
         invalid(name + "strategy=analytic has no sampler with a known density for a huang2022 fiber (Cycles' "
                        "own Huang sampler has none); render with strategy=table or uniform");
@@ -37,6 +45,9 @@ HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name
     }
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
+    // Cycles' sampler, not the eval, makes most of that image's noise: a strand of its own
+    // inputs takes its one Cycles eval, not the two of the control variate.
+    if (cycles_sampling) inputs.huang_strand_shading = StrandShading::OwnEval;
     // Every Huang material shades through the strands model, as Chiang's do.
     Expected<HuangStrands> strands = HuangStrands::create(hair.node, hair.huang);
     if (!strands) refuse(HAIRIS_ERROR_INTERNAL, name + strands.error().message);

@@ -66,9 +66,12 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
         const ShadingModel *model = hair->shading.model();
         FiberHit hit = fiber_hit(sp, wo, frame_, context, !model || model->reads_orientation());
         hit.inputs = inputs;
-        // Cycles' own Huang sampler samples the hit's own fiber (a strand's, with its inputs).
-        const bool cycles_huang = context.cycles_huang && model && model->as_huang();
-        huang_ = cycles_huang ? model->prepare(hit, scratch).huang_point() : nullptr;
+        // Cycles' own Huang sampler samples the hit's own fiber (a strand's, with its inputs);
+        // the model's point shades it (a tabulated model's with the baked f).
+        if (context.cycles_huang && model && model->as_huang()) {
+            huang_f_ = &model->prepare(hit, scratch);
+            huang_ = huang_f_->huang_point();
+        }
         if (huang_)
             lcg_.state = hit.seed ^ 0x9e3779b9u;
         else

@@ -96,12 +96,12 @@ class Bsdf {
     const HairBsdf *hair() const { return hair_ ? &*hair_ : nullptr; }
     const FiberFrame &frame() const { return frame_; }
 
-    /// f·|cos θ_i| and the density with which sample() draws wi (Cycles' Huang: its eval and
-    /// pdf 1, what Cycles' MIS weighs with).
+    /// f·|cos θ_i| and the density with which sample() draws wi (Cycles' Huang: its eval, or
+    /// the baked expectation of it, and pdf 1, what Cycles' MIS weighs with).
     Rgb eval(Vec3 wi, float &pdf) const {
         if (huang_) {
             pdf = 1.0f;
-            return huang_->f(frame_.to_local(wi));
+            return huang_f_->f(frame_.to_local(wi));
         }
         if (hair_) return hair_->f_and_pdf(frame_.to_local(wi), pdf);
         if (mixture_) return mixture_->f_and_pdf(frame_.to_local(wi), pdf);
@@ -118,7 +118,8 @@ class Bsdf {
   private:
     std::optional<HairBsdf> hair_;
     std::optional<HairMixtureBsdf> mixture_;
-    const HuangPoint *huang_ = nullptr;  // Cycles' Huang sampling
+    const HuangPoint *huang_ = nullptr;      // Cycles' Huang sampling: the closure it samples
+    const FiberPoint *huang_f_ = nullptr;    // ... and the f it shades with (baked or Cycles')
     mutable CyclesLcg lcg_;              // its sampler's numbers beyond the path's three
     FiberFrame frame_;
     SurfaceBsdf surface_;

@@ -101,7 +101,9 @@ struct RenderSettings {
     bool film_transparent = false;
     /// A HuangSampling: how Huang hair samples directions (integrator=dual_scattering uses
     /// the strategy's sampler at the vertex that closes the path, whose MIS needs a density,
-    /// which Cycles' sampler lacks; its exact bounces follow this setting).
+    /// which Cycles' sampler lacks; its exact bounces follow this setting). With Cycles' own
+    /// sampling, light samples are shaded with the material's model: the baked f where its
+    /// tables hold one (huang_tabulated_fiber.h), else Cycles' eval.
     int huang_sampling = int(HuangSampling::Strategy);
     /// A DualHairVolume for integrator=dual_scattering: "layer" or "unbounded".
     int dual_hair_volume = int(DualHairVolume::Layer);

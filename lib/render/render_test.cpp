@@ -9,6 +9,9 @@
 #include "core/quadrature.h"
 #include "fiber/huang.h"
 #include "sampling/analytic_sampler.h"
+#include "fiber/principled_hair.h"
+#include "sampling/huang_tabulated_fiber.h"
+#include "tables/huang_bake.h"
 #include "sampling/near_field_table.h"
 #include "sampling/strategy.h"
 #include "sampling/uniform_sampler.h"
@@ -1043,6 +1046,76 @@ TEST(Render, HuangFurnaceFollowsEvalOrCyclesSampler) {
     const FurnaceEstimate cycles_mode = huang_furnace(fiber, int(HuangSampling::Cycles), 6);
     EXPECT_NEAR(cycles_mode.mean, 1.007, 4.0 * cycles_mode.standard_error + 0.01)
         << "standard error " << cycles_mode.standard_error;
+}
+
+// A thin Huang fiber across the view (far field) under a sun, direct light only: every hair
+// sample is f·E at the sun's ω_i, so radiance / alpha is f there. Per seed: that ratio over the
+// hair pixels, its least and greatest.
+struct SunlitFiber {
+    double mean = 0, low = 1e300, high = -1e300;
+};
+SunlitFiber sunlit_fiber(std::shared_ptr<const ShadingModel> model, Vec3 to_sun, HuangSampling sampling,
+                         std::uint64_t seed) {
+    SceneDesc d;
+    d.materials = {HairMaterial{HairShading::create(std::move(model), std::make_shared<const UniformSampler>()).value()}};
+    d.curves = {straight_hair(0.0f, 0.0f, 0.01f, 3.0f)};  // pixels 0.025 wide: pixel_coverage 1.25
+    SunLight sun;
+    sun.to_sun = to_sun;
+    sun.strength = 2.0f;
+    d.suns = {sun};
+    d.camera = ortho_down(0.05f, 0.05f, 4, 4, {0, 0, 5});
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 64;
+    s.max_bounces = 0;
+    s.film_transparent = true;
+    s.huang_sampling = int(sampling);
+    s.seed = seed;
+    const auto img = render_ok(scene, s);
+    SunlitFiber out;
+    double radiance = 0, alpha = 0;
+    for (std::size_t i = 0; i < img.size(); i += 4) {
+        radiance += img[i + 1];
+        alpha += img[i + 3];
+        if (img[i + 3] < 0.05f) continue;
+        const double ratio = img[i + 1] / img[i + 3];
+        out.low = std::min(out.low, ratio);
+        out.high = std::max(out.high, ratio);
+    }
+    out.mean = radiance / alpha;
+    return out;
+}
+
+TEST(Render, HuangCyclesSamplingShadesLightSamplesWithTheBakedF) {
+    // With Cycles' own Huang sampling, a material whose table holds a baked f shades light
+    // samples with it (the expectation of Cycles' eval, huang_tabulated_fiber_test), as the
+    // strategy's sampling does: under a sun, direct light only, both images are the baked f,
+    // the same at every sample of every seed, where Cycles' one-sample eval is noisy.
+    HuangParams p;
+    p.sigma_a = principled_hair::sigma_from_reflectance({0.55f, 0.4f, 0.25f}, 0.3f);
+    auto fiber = std::make_shared<const HuangFiber>(HuangFiber::create(p).value());
+    HuangBakeOptions o;
+    o.theta_o_count = 8;
+    o.phi_o_count = 3;
+    o.theta_i_count = 16;
+    o.phi_count = 24;
+    auto table = std::make_shared<const HuangSamplingTable>(
+        HuangSamplingTable::from(bake_huang_table(*fiber, o).value()).value());
+    auto tabulated = std::make_shared<const HuangTabulatedFiber>(HuangTabulatedFiber::create(fiber, table).value());
+    // Lit from behind (TT), from the side (TRT and R) and from the front (R).
+    for (const Vec3 to_sun : {safe_normalize(Vec3{0.2f, 0.1f, -1.0f}), safe_normalize(Vec3{0.3f, 0.9f, 0.3f}),
+                              safe_normalize(Vec3{-0.4f, 0.2f, 0.9f})}) {
+        std::vector<double> cycles_means;
+        for (std::uint64_t seed = 0; seed < 4; ++seed) {
+            const SunlitFiber baked = sunlit_fiber(tabulated, to_sun, HuangSampling::Cycles, seed);
+            const SunlitFiber strategy = sunlit_fiber(tabulated, to_sun, HuangSampling::Strategy, seed);
+            EXPECT_GT(baked.mean, 0.0) << "to_sun " << to_sun.z;
+            EXPECT_NEAR(baked.low, baked.high, 1e-4 * baked.high) << "to_sun " << to_sun.z << ", seed " << seed;
+            EXPECT_NEAR(baked.mean, strategy.mean, 1e-4 * strategy.mean) << "to_sun " << to_sun.z << ", seed " << seed;
+            const SunlitFiber cycles = sunlit_fiber(fiber, to_sun, HuangSampling::Cycles, seed);
+            EXPECT_GT(cycles.high - cycles.low, 0.02 * cycles.mean) << "to_sun " << to_sun.z << ", seed " << seed;
+        }
+    }
 }
 
 TEST(Render, MaxBouncesCountLikeCycles) {

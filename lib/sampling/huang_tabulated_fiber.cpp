@@ -22,7 +22,7 @@ HuangTabulatedPoint::HuangTabulatedPoint(const HuangTabulatedFiber &model, const
     : FiberPoint(hit), point_(strand ? *strand : model.fiber(), hit),
       query_(model.table().locate(point_.to_huang(hit.wo))), f_(&model.f_table()), lcg_(point_.lcg()) {
     if (!strand || strand == &model.fiber()) return;
-    if (same_chains(*strand, model.fiber()))
+    if (model.strand_shading() == StrandShading::ControlVariate && same_chains(*strand, model.fiber()))
         node_.emplace(model.fiber(), hit);
     else
         own_eval_ = true;
@@ -46,7 +46,8 @@ const FiberPoint &HuangTabulatedFiber::prepare(const FiberHit &hit, ScratchBuffe
 
 Expected<HuangTabulatedFiber> HuangTabulatedFiber::create(std::shared_ptr<const HuangFiber> fiber,
                                                           std::shared_ptr<const HuangSamplingTable> table,
-                                                          std::shared_ptr<const HuangStrands> strands) {
+                                                          std::shared_ptr<const HuangStrands> strands,
+                                                          StrandShading strand_shading) {
     if (!fiber) return Error{"tabulated Huang fiber: no Huang fiber was given"};
     if (!table || !table->table) return Error{"tabulated Huang fiber: no Huang table was given"};
     if (!table->f)
@@ -58,7 +59,7 @@ Expected<HuangTabulatedFiber> HuangTabulatedFiber::create(std::shared_ptr<const 
                      ErrorKind::InvalidTable};
     if (strands && strands->fiber() != fiber)
         return Error{"tabulated Huang fiber: the strands' node fiber is not the tabulated fiber"};
-    return HuangTabulatedFiber(std::move(fiber), std::move(table), std::move(strands));
+    return HuangTabulatedFiber(std::move(fiber), std::move(table), std::move(strands), strand_shading);
 }
 
 }  // namespace hairis

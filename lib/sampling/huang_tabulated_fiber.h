@@ -8,7 +8,9 @@
 // only its absorption differs, the table is a control variate: f = the baked expectation +
 // (the strand's Cycles eval − the node's), both evals drawing the same microfacet chains, so
 // the correction has mean (strand − node) and little noise. A strand of another roughness,
-// IOR or offset draws other chains; it is shaded with its own Cycles eval.
+// IOR or offset draws other chains; it is shaded with its own Cycles eval. The control variate
+// costs two evals; a renderer whose noise is not the eval's can ask for the strand's own eval
+// everywhere (StrandShading::OwnEval).
 #pragma once
 
 #include <memory>
@@ -24,6 +26,12 @@
 namespace hairis {
 
 class HuangTabulatedFiber;
+
+/// How a strand whose inputs differ from the node's is shaded.
+enum class StrandShading {
+    ControlVariate,  ///< the baked f corrected where only the absorption differs (two evals)
+    OwnEval,         ///< the strand's own Cycles eval (one eval, noisier)
+};
 
 /// The tabulated fiber at one hit; also hands the table's located view to the table sampler.
 class HuangTabulatedPoint final : public FiberPoint {
@@ -57,24 +65,28 @@ class HuangTabulatedFiber final : public ShadingModel {
     /// and strands of another fiber. `strands` (optional): the material's per-strand inputs.
     static Expected<HuangTabulatedFiber> create(std::shared_ptr<const HuangFiber> fiber,
                                                 std::shared_ptr<const HuangSamplingTable> table,
-                                                std::shared_ptr<const HuangStrands> strands = nullptr);
+                                                std::shared_ptr<const HuangStrands> strands = nullptr,
+                                                StrandShading strand_shading = StrandShading::ControlVariate);
     const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override;
     bool reads_orientation() const override { return true; }
-    /// The fiber it tabulates: a renderer that samples Huang with Cycles' own sampler shades
-    /// with the fiber's Cycles eval instead.
+    /// The fiber it tabulates: a renderer that samples Huang with Cycles' own sampler samples
+    /// the point's huang_point() and still shades with the point's f.
     const HuangFiber *as_huang() const override { return fiber_.get(); }
     const StrandInputReader *strand_inputs() const override { return strands_.get(); }
     const HuangFiber &fiber() const { return *fiber_; }
     const HuangTable &table() const { return *table_->table; }
     const HuangFTable &f_table() const { return *table_->f; }
+    StrandShading strand_shading() const { return strand_shading_; }
 
   private:
     HuangTabulatedFiber(std::shared_ptr<const HuangFiber> fiber, std::shared_ptr<const HuangSamplingTable> table,
-                        std::shared_ptr<const HuangStrands> strands)
-        : fiber_(std::move(fiber)), table_(std::move(table)), strands_(std::move(strands)) {}
+                        std::shared_ptr<const HuangStrands> strands, StrandShading strand_shading)
+        : fiber_(std::move(fiber)), table_(std::move(table)), strands_(std::move(strands)),
+          strand_shading_(strand_shading) {}
     std::shared_ptr<const HuangFiber> fiber_;
     std::shared_ptr<const HuangSamplingTable> table_;
     std::shared_ptr<const HuangStrands> strands_;
+    StrandShading strand_shading_;
 };
 
 }  // namespace hairis

@@ -264,6 +264,35 @@ TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoi
     }
 }
 
+TEST(HuangTabulatedFiber, OwnEvalShadesAStrandOfOtherMelaninWithItsCyclesEval) {
+    // StrandShading::OwnEval: no control variate, the strand's own one-sample Cycles eval,
+    // draw by draw (the strand's fiber made from the node with the melanin set directly).
+    const StrandFixture &fx = strand_fixture();
+    const HuangTabulatedFiber own_eval =
+        HuangTabulatedFiber::create(fx.fiber, fx.table, fx.strands, StrandShading::OwnEval).value();
+    const HuangFiber own = strand_fiber(fx.node, HairInput::Melanin, 0.3f);
+    HairInputValues inputs;
+    const float melanin = 0.3f;
+    inputs.set(HairInput::Melanin, &melanin);
+    FiberHit hit = hit_at(25.0, 0.7);
+    hit.seed = 3;
+    hit.inputs = &inputs;
+    ScratchBuffer scratch;
+    const FiberPoint &point = own_eval.prepare(hit, scratch);
+    const HuangPoint own_point = own.at(hit);
+    const Vec3 wi = safe_normalize(Vec3{-0.3f, 0.6f, 0.7f});
+    CyclesLcg lcg = point.huang_point()->lcg();
+    for (int n = 0; n < 50; ++n) {
+        const Rgb expected = own_point.f_estimate(wi, lcg);
+        const Rgb f = point.f(wi);
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(f[c], expected[c]) << n;
+    }
+    // A strand without inputs of its own still takes the baked f.
+    FiberHit plain = hit;
+    plain.inputs = nullptr;
+    EXPECT_EQ(own_eval.prepare(plain, scratch).f(wi).g, fx.model->prepare(plain, scratch).f(wi).g);
+}
+
 TEST(HuangTabulatedFiber, AStrandOfOtherRoughnessIsShadedWithItsOwnEval) {
     const StrandFixture &fx = strand_fixture();
     const HuangFiber own = strand_fiber(fx.node, HairInput::Roughness, 0.6f);

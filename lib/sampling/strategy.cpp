@@ -176,7 +176,8 @@ Expected<HairShading> make_hair_shading(StrategyKind kind, const StrategyInputs 
         Expected<std::shared_ptr<const HuangSamplingTable>> table = huang_table_of(inputs);
         if (!table) return table.error();
         if (table.value()->f) {
-            Expected<HuangTabulatedFiber> tabulated = HuangTabulatedFiber::create(inputs.huang, table.value(), inputs.huang_strands);
+            Expected<HuangTabulatedFiber> tabulated = HuangTabulatedFiber::create(inputs.huang, table.value(), inputs.huang_strands,
+                                                                                  inputs.huang_strand_shading);
             if (!tabulated) return tabulated.error();
             auto shared_model = std::make_shared<const HuangTabulatedFiber>(std::move(tabulated).value());
             Expected<std::shared_ptr<const Sampler>> sampler = huang_table_sampler(inputs, shared_model);

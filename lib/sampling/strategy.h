@@ -13,6 +13,7 @@
 #include "fiber/seed_pdfs.h"
 #include "sampling/hair_bsdf.h"
 #include "sampling/huang_table.h"
+#include "sampling/huang_tabulated_fiber.h"
 #include "sampling/near_field_table.h"
 #include "sampling/sampler.h"
 #include "sampling/sampling_table.h"
@@ -93,6 +94,8 @@ struct StrategyInputs {
     /// A Huang material whose inputs vary per strand (its fiber must be `huang`): TABLE's
     /// baked f then serves the strands as huang_tabulated_fiber.h says.
     std::shared_ptr<const HuangStrands> huang_strands;
+    /// How the baked f serves strands whose inputs differ (huang_tabulated_fiber.h).
+    StrandShading huang_strand_shading = StrandShading::ControlVariate;
     /// TABLE with `huang`: the uniform sphere's weight in the mixture, in [0, 1).
     float huang_uniform_weight = kHuangUniformWeight;
 };

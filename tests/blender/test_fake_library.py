@@ -390,10 +390,18 @@ def test_huang_material_by_bake_and_render():
     scene.hairis.auto_bake = True
     _pixels, summary = render(scene)
     assert re.search(r"hair \d+ tables=1 huang=1 ", summary), summary
-    scene.hairis.huang_sampling = "CYCLES"  # Cycles' sampler needs no tables
+    scene.hairis.huang_sampling = "CYCLES"  # its light samples read the tables' baked f
     _pixels, summary = render(scene)
     assert summary_value(summary, "huang_sampling") == "1", summary
+    assert re.search(r"hair \d+ tables=1 huang=1 ", summary), summary
+    # Without current tables and without Auto Bake, Cycles' sampler still renders (with
+    # Cycles' eval): it needs no tables.
+    helpers.socket(node, "Aspect Ratio").default_value = 0.6
+    scene.hairis.auto_bake = False
+    _pixels, summary = render(scene)
     assert re.search(r"hair \d+ tables=0 huang=1 ", summary), summary
+    helpers.socket(node, "Aspect Ratio").default_value = 0.7
+    scene.hairis.auto_bake = True
     scene.hairis.huang_sampling = "STRATEGY"
     scene.hairis.strategy = "UNIFORM"
     _pixels, summary = render(scene)

@@ -10,7 +10,9 @@ Runs inside Blender 4.x/5.0 through tests/blender/run_test.py:
 The scene is tests/blender/test_cycles_huang.py's (helpers.make_huang_scene). Methods:
 UNIFORM and TABLE (Hairis' strategies with their exact pdfs, MIS'd with light sampling),
 HAIRIS_CYCLES_SAMPLING (Hairis with Cycles' chained microfacet sampler and pdf 1, as Cycles
-MISes Huang) and CYCLES.
+MISes Huang, its light samples shaded with the tables' baked f: the add-on's defaults),
+HAIRIS_CYCLES_EVAL (the same with Cycles' one-sample eval on light samples, as without tables)
+and CYCLES.
 
 One reference per engine. Cycles' BSDF samples carry its chained sampler's weight, whose
 mean is 0.89-0.99 of its eval's energy (docs/huang.md §8), so Cycles (and Hairis with Cycles'
@@ -18,7 +20,8 @@ sampling) converge to another image than Hairis' exact strategies, about 1% away
 reference would charge that difference to both as error. Hairis' reference is TABLE, Cycles'
 is CYCLES, each the average of two halves of REF_SPP/2 samples with seeds of their own;
 the halves give the reference's own noise (MSE_ref = mean((a - b)^2) / 4), subtracted from
-every MSE measured against it. HAIRIS_CYCLES_SAMPLING is measured against Cycles' reference.
+every MSE measured against it. HAIRIS_CYCLES_SAMPLING and HAIRIS_CYCLES_EVAL are measured
+against Cycles' reference.
 The difference of the two references is reported.
 
 Equal time: each method's noise-corrected RMSE, interpolated in its log-log time-RMSE curve,
@@ -74,8 +77,9 @@ SCENES = {
 if SCENE not in SCENES:
     raise SystemExit("HAIRIS_STUDY_SCENE must be one of %s (got %r)" % (", ".join(SCENES), SCENE))
 BOUNCES = 4
-METHODS = ("UNIFORM", "TABLE", "HAIRIS_CYCLES_SAMPLING", "CYCLES")
+METHODS = ("UNIFORM", "TABLE", "HAIRIS_CYCLES_SAMPLING", "HAIRIS_CYCLES_EVAL", "CYCLES")
 REFERENCE_OF = {"UNIFORM": "HAIRIS", "TABLE": "HAIRIS", "HAIRIS_CYCLES_SAMPLING": "CYCLES",
+                "HAIRIS_CYCLES_EVAL": "CYCLES",
                 "CYCLES": "CYCLES"}
 START = time.monotonic()
 
@@ -93,8 +97,9 @@ def render(scene, method, samples, seed):
     else:
         engine = "HAIRIS"
         scene.hairis.integrator = "PATH"
-        scene.hairis.strategy = "UNIFORM" if method == "UNIFORM" else "TABLE"
-        scene.hairis.huang_sampling = ("CYCLES" if method == "HAIRIS_CYCLES_SAMPLING"
+        scene.hairis.strategy = ("UNIFORM" if method in ("UNIFORM", "HAIRIS_CYCLES_EVAL")
+                                 else "TABLE")
+        scene.hairis.huang_sampling = ("CYCLES" if method.startswith("HAIRIS_CYCLES")
                                        else "STRATEGY")
     image, seconds = helpers.render_pixels(scene, engine, seed, ARGS.workdir)
     assert np.all(np.isfinite(image)), "%s rendered non-finite pixels" % method
