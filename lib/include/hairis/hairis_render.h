@@ -216,7 +216,11 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * first hair vertex at that depth or deeper closes the path by dual scattering (0: at the
  * first hair hit, the paper's), and dual_bounce_limit = bounces (default: that vertex adds only
  * the orders of scattering the path tracer would reach within max_bounces and
- * max_transmission_bounces, as Cycles ends its paths) | none (every order, the paper's). A scene without camera is
+ * max_transmission_bounces, as Cycles ends its paths) | none (every order, the paper's).
+ * huang_sampling = strategy (default: Huang hair samples with the material's strategy and its
+ * exact density) | cycles (Cycles' own chained Huang sampler with pdf 1 for MIS, as Cycles
+ * renders Huang; its light samples are shaded with the material's baked f where its tables
+ * hold one for its parameters, else with Cycles' eval). A scene without camera is
  * refused; one without geometry renders the world (every ray misses). A scene can be rendered
  * again with other settings, also from several threads at once. The scene keeps the last
  * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
