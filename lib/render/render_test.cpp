@@ -983,36 +983,56 @@ TEST(Render, TransparentCrossingsFollowEachCyclesStorage) {
     EXPECT_EQ(transparent_crossings(TransparentLimit::Setting, 4), 4);
 }
 
-// A thin clear Huang fiber (σ = 0, α = 0.3, aspect 1, offset 2°) across the view, narrower than
-// the pixel footprint (far field), in a white world, direct light only: the radiance over the
-// alpha of the hair pixels is the far field's albedo from this view. Returns its mean over
-// `seeds` renders and the standard error of that mean.
+// A thin Huang fiber along x across an orthographic view down −z, narrower than the pixel
+// footprint (far field), shaded by `model` (no lights yet).
+SceneDesc thin_fiber_scene(std::shared_ptr<const ShadingModel> model) {
+    SceneDesc d;
+    d.materials = {HairMaterial{HairShading::create(std::move(model), std::make_shared<const UniformSampler>()).value()}};
+    d.curves = {straight_hair(0.0f, 0.0f, 0.01f, 3.0f)};  // pixels 0.025 wide: pixel_coverage 1.25
+    d.camera = ortho_down(0.05f, 0.05f, 4, 4, {0, 0, 5});
+    return d;
+}
+
+// Direct light only, transparent film: the green radiance over the alpha of the hair pixels,
+// over the whole image (mean) and per pixel covered by at least 5% (low, high).
+struct HairRadiance {
+    double mean = 0, low = 1e300, high = -1e300;
+};
+HairRadiance direct_hair_radiance(const Scene &scene, int samples, HuangSampling sampling, std::uint64_t seed) {
+    RenderSettings s;
+    s.samples = samples;
+    s.max_bounces = 0;
+    s.film_transparent = true;
+    s.huang_sampling = int(sampling);
+    s.seed = seed;
+    const auto img = render_ok(scene, s);
+    HairRadiance out;
+    double radiance = 0, alpha = 0;
+    for (std::size_t i = 0; i < img.size(); i += 4) {
+        radiance += img[i + 1];
+        alpha += img[i + 3];
+        if (img[i + 3] < 0.05f) continue;
+        const double ratio = img[i + 1] / img[i + 3];
+        out.low = std::min(out.low, ratio);
+        out.high = std::max(out.high, ratio);
+    }
+    out.mean = radiance / alpha;
+    return out;
+}
+
+// A thin clear Huang fiber (σ = 0, α = 0.3, aspect 1, offset 2°) in a white world: the radiance
+// over the alpha of the hair pixels is the far field's albedo from this view. Returns its mean
+// over `seeds` renders and the standard error of that mean.
 struct FurnaceEstimate {
     double mean = 0, standard_error = 0;
 };
-FurnaceEstimate huang_furnace(const std::shared_ptr<const HuangFiber> &fiber, int huang_sampling, int seeds) {
-    SceneDesc d;
-    d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
-    d.curves = {straight_hair(0.0f, 0.0f, 0.01f, 3.0f)};  // pixels 0.025 wide: pixel_coverage 1.25
+FurnaceEstimate huang_furnace(const std::shared_ptr<const HuangFiber> &fiber, HuangSampling huang_sampling, int seeds) {
+    SceneDesc d = thin_fiber_scene(fiber);
     d.world = {Rgb(1.0f), 1.0f};
-    d.camera = ortho_down(0.05f, 0.05f, 4, 4, {0, 0, 5});
     const Scene scene = build(std::move(d));
     std::vector<double> ratios;
-    for (int seed = 0; seed < seeds; ++seed) {
-        RenderSettings s;
-        s.samples = 4096;
-        s.max_bounces = 0;
-        s.film_transparent = true;
-        s.huang_sampling = huang_sampling;
-        s.seed = std::uint64_t(seed);
-        const auto img = render_ok(scene, s);
-        double radiance = 0, alpha = 0;
-        for (std::size_t i = 0; i < img.size(); i += 4) {
-            radiance += img[i + 1];
-            alpha += img[i + 3];
-        }
-        ratios.push_back(radiance / alpha);
-    }
+    for (int seed = 0; seed < seeds; ++seed)
+        ratios.push_back(direct_hair_radiance(scene, 4096, huang_sampling, std::uint64_t(seed)).mean);
     double mean = 0, var = 0;
     for (double r : ratios) mean += r / double(seeds);
     for (double r : ratios) var += sqr(r - mean) / double(seeds - 1);
@@ -1040,50 +1060,24 @@ TEST(Render, HuangFurnaceFollowsEvalOrCyclesSampler) {
             albedo += sin_theta.w[i] * phi.w[j] * double(far.f(wi).g);
         }
     EXPECT_GT(albedo, 1.3);  // the edges' overweight (docs/huang.md §6)
-    const FurnaceEstimate eval_mode = huang_furnace(fiber, int(HuangSampling::Strategy), 6);
+    const FurnaceEstimate eval_mode = huang_furnace(fiber, HuangSampling::Strategy, 6);
     EXPECT_NEAR(eval_mode.mean, albedo, 4.0 * eval_mode.standard_error + 0.005 * albedo)
         << "standard error " << eval_mode.standard_error;
-    const FurnaceEstimate cycles_mode = huang_furnace(fiber, int(HuangSampling::Cycles), 6);
+    const FurnaceEstimate cycles_mode = huang_furnace(fiber, HuangSampling::Cycles, 6);
     EXPECT_NEAR(cycles_mode.mean, 1.007, 4.0 * cycles_mode.standard_error + 0.01)
         << "standard error " << cycles_mode.standard_error;
 }
 
-// A thin Huang fiber across the view (far field) under a sun, direct light only: every hair
-// sample is f·E at the sun's ω_i, so radiance / alpha is f there. Per seed: that ratio over the
-// hair pixels, its least and greatest.
-struct SunlitFiber {
-    double mean = 0, low = 1e300, high = -1e300;
-};
-SunlitFiber sunlit_fiber(std::shared_ptr<const ShadingModel> model, Vec3 to_sun, HuangSampling sampling,
-                         std::uint64_t seed) {
-    SceneDesc d;
-    d.materials = {HairMaterial{HairShading::create(std::move(model), std::make_shared<const UniformSampler>()).value()}};
-    d.curves = {straight_hair(0.0f, 0.0f, 0.01f, 3.0f)};  // pixels 0.025 wide: pixel_coverage 1.25
+// The thin fiber under a sun, direct light only: every hair sample is f·E at the sun's ω_i, so
+// radiance / alpha is f there.
+HairRadiance sunlit_fiber(std::shared_ptr<const ShadingModel> model, Vec3 to_sun, HuangSampling sampling,
+                          std::uint64_t seed) {
+    SceneDesc d = thin_fiber_scene(std::move(model));
     SunLight sun;
     sun.to_sun = to_sun;
     sun.strength = 2.0f;
     d.suns = {sun};
-    d.camera = ortho_down(0.05f, 0.05f, 4, 4, {0, 0, 5});
-    const Scene scene = build(std::move(d));
-    RenderSettings s;
-    s.samples = 64;
-    s.max_bounces = 0;
-    s.film_transparent = true;
-    s.huang_sampling = int(sampling);
-    s.seed = seed;
-    const auto img = render_ok(scene, s);
-    SunlitFiber out;
-    double radiance = 0, alpha = 0;
-    for (std::size_t i = 0; i < img.size(); i += 4) {
-        radiance += img[i + 1];
-        alpha += img[i + 3];
-        if (img[i + 3] < 0.05f) continue;
-        const double ratio = img[i + 1] / img[i + 3];
-        out.low = std::min(out.low, ratio);
-        out.high = std::max(out.high, ratio);
-    }
-    out.mean = radiance / alpha;
-    return out;
+    return direct_hair_radiance(build(std::move(d)), 64, sampling, seed);
 }
 
 TEST(Render, HuangCyclesSamplingShadesLightSamplesWithTheBakedF) {
@@ -1105,14 +1099,13 @@ TEST(Render, HuangCyclesSamplingShadesLightSamplesWithTheBakedF) {
     // Lit from behind (TT), from the side (TRT and R) and from the front (R).
     for (const Vec3 to_sun : {safe_normalize(Vec3{0.2f, 0.1f, -1.0f}), safe_normalize(Vec3{0.3f, 0.9f, 0.3f}),
                               safe_normalize(Vec3{-0.4f, 0.2f, 0.9f})}) {
-        std::vector<double> cycles_means;
         for (std::uint64_t seed = 0; seed < 4; ++seed) {
-            const SunlitFiber baked = sunlit_fiber(tabulated, to_sun, HuangSampling::Cycles, seed);
-            const SunlitFiber strategy = sunlit_fiber(tabulated, to_sun, HuangSampling::Strategy, seed);
+            const HairRadiance baked = sunlit_fiber(tabulated, to_sun, HuangSampling::Cycles, seed);
+            const HairRadiance strategy = sunlit_fiber(tabulated, to_sun, HuangSampling::Strategy, seed);
             EXPECT_GT(baked.mean, 0.0) << "to_sun " << to_sun.z;
             EXPECT_NEAR(baked.low, baked.high, 1e-4 * baked.high) << "to_sun " << to_sun.z << ", seed " << seed;
             EXPECT_NEAR(baked.mean, strategy.mean, 1e-4 * strategy.mean) << "to_sun " << to_sun.z << ", seed " << seed;
-            const SunlitFiber cycles = sunlit_fiber(fiber, to_sun, HuangSampling::Cycles, seed);
+            const HairRadiance cycles = sunlit_fiber(fiber, to_sun, HuangSampling::Cycles, seed);
             EXPECT_GT(cycles.high - cycles.low, 0.02 * cycles.mean) << "to_sun " << to_sun.z << ", seed " << seed;
         }
     }
