@@ -548,10 +548,12 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
     }
     const double m = chiang::longitudinal_scattering(p.v.y, cos_theta(p.v), l.y, cos_theta(l), 4.0 * c.alpha);
     const double trrt_factor = m * kInvTwoPi * (2.0 / kPi);
+    // A chain that leaves at the edge of total internal reflection can come out a rounding
+    // error below zero (Cycles' own terms do too); a lobe is never negative.
     for (int k = 0; k < 3; ++k) {
-        tt[k] *= factor * inv_eta2;
-        trt[k] *= factor * inv_eta2;
-        trrt[k] *= factor * trrt_factor;
+        tt[k] = std::max(0.0, tt[k] * factor * inv_eta2);
+        trt[k] = std::max(0.0, trt[k] * factor * inv_eta2);
+        trrt[k] = std::max(0.0, trrt[k] * factor * trrt_factor);
     }
     out[1] = rgb_of(tt);
     out[2] = rgb_of(trt);

@@ -289,6 +289,32 @@ TEST(Huang, LobeMultipliers) {
     EXPECT_FLOAT_EQ(lobes(0, 0, 1)[3].g, all[3].g);
 }
 
+// With Secondary Reflection 0, TT is a lobe's whole transmitted part, and TT chains that
+// leave at the edge of total internal reflection sum to a rounding error below zero there (the
+// bake refused such a material as "not finite and non-negative"): no lobe is ever negative.
+TEST(Huang, LobesAreNeverNegative) {
+    HuangParams p;
+    p.secondary_reflection = 0.0f;
+    const HuangFiber fiber = HuangFiber::create(p).value();
+    HuangQuadrature rule;
+    rule.tt_order = 8;
+    // The bake's θ_o node 20 of 24 (63.8°) at φ_o = 60°, and its (θ_i, φ) cell midpoints.
+    const float theta_o = float(-kHalfPi + kPi * 20.5 / 24.0), phi_o = float(kPi / 3.0);
+    const HuangExpectation e = fiber.expectation({direction_of(theta_o, phi_o), 0.0f, 1.0f}, rule);
+    int lit = 0;
+    for (int i = 0; i < 48; ++i)
+        for (int j = 0; j < 64; ++j) {
+            const float theta_i = float(std::asin(-1.0 + (2.0 * i + 1.0) / 48.0));
+            const float phi = float(-kPi + kTwoPi * (j + 0.5) / 64.0);
+            const std::array<Rgb, 4> l = e.lobes(direction_of(theta_i, phi_o + phi));
+            for (int q = 0; q < 4; ++q)
+                for (float v : {l[std::size_t(q)].r, l[std::size_t(q)].g, l[std::size_t(q)].b})
+                    ASSERT_GE(v, 0.0f) << "lobe " << q << " at cell " << i << ", " << j;
+            lit += l[1].g > 0.0f;
+        }
+    EXPECT_GT(lit, 100);  // TT is there
+}
+
 TEST(Huang, ValidationNamesParameterAndRange) {
     auto message = [](HuangParams p) {
         const Expected<HuangFiber> f = HuangFiber::create(p);
