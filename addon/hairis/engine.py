@@ -81,10 +81,13 @@ def light_options(light):
 
 
 def render_settings(settings):
-    """The C API's render settings from ``scene.hairis``, the scene's Cycles bounce limits per
-    kind (:func:`cycles_bounce_limits`), and how the running Blender's Cycles traces curves
-    (:func:`compat.curve_backfaces`, the scene's Curves > Shape: :func:`compat.curve_shape`)
-    and limits transparent crossings (:func:`compat.transparent_limit`)."""
+    """The C API's render settings from ``scene.hairis``, the scene's Film > Transparent and
+    Cycles bounce limits per kind (:func:`cycles_bounce_limits`), and how the running Blender's
+    Cycles traces curves (:func:`compat.curve_backfaces`, the scene's Curves > Shape:
+    :func:`compat.curve_shape`) and limits transparent crossings
+    (:func:`compat.transparent_limit`)."""
+    scene = getattr(settings, "id_data", None)
+    render = getattr(scene, "render", None)
     return {"integrator": settings.integrator.lower(),
             "samples": int(settings.samples), "max_bounces": int(settings.max_bounces),
             "max_transparent_bounces": int(settings.max_transparent_bounces),
@@ -97,8 +100,9 @@ def render_settings(settings):
             "multiple_weight": float(settings.multiple_weight), "n_h": int(settings.n_h),
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces(),
-            "curve_shape": compat.curve_shape(getattr(settings, "id_data", None))[0],
-            **cycles_bounce_limits(getattr(settings, "id_data", None))}
+            "curve_shape": compat.curve_shape(scene)[0],
+            "film_transparent": bool(getattr(render, "film_transparent", False)),
+            **cycles_bounce_limits(scene)}
 
 
 def cycles_bounce_limits(scene):

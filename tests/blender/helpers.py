@@ -620,8 +620,9 @@ def machine_info():
     }
 
 
-def render_pixels(scene, engine, seed, workdir, name=None):
-    """Renders with ``engine``; returns (linear RGB float64 array (height, width, 3), seconds).
+def render_pixels(scene, engine, seed, workdir, name=None, alpha=False):
+    """Renders with ``engine``; returns (linear RGB float64 array (height, width, 3), seconds),
+    RGBA (height, width, 4) with ``alpha``.
 
     The seconds are the wall time of ``bpy.ops.render.render()`` alone; the image is read
     back from a 32-bit EXR written to ``workdir``.
@@ -642,7 +643,7 @@ def render_pixels(scene, engine, seed, workdir, name=None):
     image.pixels.foreach_get(pixels)
     bpy.data.images.remove(image)
     os.remove(path)
-    return pixels.reshape(height, width, 4)[..., :3].astype(np.float64), seconds
+    return pixels.reshape(height, width, 4)[..., :4 if alpha else 3].astype(np.float64), seconds
 
 
 COMPARE_SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
