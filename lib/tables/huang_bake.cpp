@@ -188,9 +188,10 @@ Expected<std::shared_ptr<const DualScattering>> huang_dual_scattering(const Huan
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto &entry : cache)
         if (entry.first == key) return entry.second;
+    // Dual scattering integrates f over directions, where the coarse rule's ripples cancel.
     HuangQuadrature rule;
-    rule.first_order = HuangBakeOptions{}.first_order;
-    rule.second_order = HuangBakeOptions{}.second_order;
+    rule.first_order = 4;
+    rule.second_order = 3;
     Expected<HuangFiber> evaluated = HuangFiber::create(fiber.params(), rule);
     if (!evaluated) return evaluated.error();
     DualScatteringParams params;

@@ -25,13 +25,16 @@ struct HuangBakeOptions {
     int points = 1;          ///< evaluation points per cell and axis (midpoints in sin θ_i and φ)
     /// "expectation" (HuangExpectation with the orders below) or "estimate" (Cycles' eval).
     std::string evaluator = "expectation";
-    int first_order = 4, second_order = 3;  ///< the expectation's rule (HuangQuadrature)
+    /// The expectation's rule (HuangQuadrature). TRT's internal reflection needs the finer
+    /// rule: with few nodes its exit lobes sum to ripples that are right on average over the
+    /// sphere but several percent off towards one light.
+    int first_order = 3, second_order = 6;
     int estimates = 1;                      ///< Cycles evals per point ("estimate")
     int threads = 0;                        ///< 0: all cores
     /// Also bake the f part (huang_f_table.h): TT, TRT and TRRT+ of the expectation at the
     /// rule below, RGB, at each cell's midpoint.
     bool f = true;
-    int f_first_order = 4, f_second_order = 3;  ///< the f part's rule (HuangQuadrature)
+    int f_first_order = 3, f_second_order = 6;  ///< the f part's rule (HuangQuadrature)
     /// TT's entry rule in both parts (HuangQuadrature::tt_order; 0: first_order): the brightest
     /// lobe needs a finer rule than TRT to be baked within a few percent at its peak.
     int f_tt_order = 8;
@@ -49,8 +52,8 @@ Expected<HuangTableSet> bake_huang_table(const HuangFiber &fiber, const HuangBak
                                          const ProgressFn &progress = {});
 
 /// The dual-scattering averages of a Huang fiber (fiber/dual_scattering.h), as its tables'
-/// multiple part and integrator=dual_scattering use them: f by the bake's expectation rule
-/// (4, 3) and a coarser quadrature than DualScatteringParams' default (16 θ nodes, 8 θ and 4 φ
+/// multiple part and integrator=dual_scattering use them: f by the expectation rule (4, 3)
+/// and a coarser quadrature than DualScatteringParams' default (16 θ nodes, 8 θ and 4 φ
 /// panels), the coarsest whose averages the default quadrature no longer changes visibly, as
 /// the default one costs too long per fiber. Runs on the calling thread's arena. Kept for the process by the
 /// fiber's parameters (the last 16 fibers), so that a bake and the renders after it in one

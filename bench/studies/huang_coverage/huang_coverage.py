@@ -15,7 +15,8 @@ For each cell and channel: the Hairis / Cycles ratio of the hair's mean over the
 
 Runs inside Blender 4.5 or 5.0 through tests/blender/run_test.py (command in README.md);
 HAIRIS_STUDY_SPP (512) samples per render, HAIRIS_STUDY_SEEDS (4) renders per engine,
-HAIRIS_STUDY_OUT (this folder) for huang_coverage.json and .md.
+HAIRIS_STUDY_OUT (this folder) for huang_coverage.json and .md; HAIRIS_STUDY_METHOD=eval
+renders Hairis without tables (Cycles' eval on light samples as well as Cycles' sampler).
 """
 
 import json
@@ -39,6 +40,7 @@ if helpers.VERSION < (4, 0, 0):
 SPP = int(os.environ.get("HAIRIS_STUDY_SPP", "512"))
 SEEDS = int(os.environ.get("HAIRIS_STUDY_SEEDS", "4"))
 OUT = os.environ.get("HAIRIS_STUDY_OUT", HERE)
+METHOD = os.environ.get("HAIRIS_STUDY_METHOD", "default")
 CELL = 48
 BLOCK = 16
 BOUNCES = 8
@@ -107,9 +109,13 @@ def make_scene():
     settings.samples = SPP
     settings.max_bounces = BOUNCES
     settings.max_transparent_bounces = BOUNCES
-    settings.strategy = "TABLE"
-    settings.auto_bake = True
     settings.huang_sampling = "CYCLES"
+    if METHOD == "eval":
+        settings.strategy = "UNIFORM"  # no tables: Cycles' eval on light samples too
+        settings.auto_bake = False
+    else:
+        settings.strategy = "TABLE"
+        settings.auto_bake = True
     settings.threads = 0
     bpy.context.view_layer.update()
     return scene
@@ -159,15 +165,16 @@ def main():
     hairis, hairis_s = render(scene, "HAIRIS")
     cycles, cycles_s = render(scene, "CYCLES")
     rows = statistics(cycles, hairis)
-    info = {"blender": bpy.app.version_string, "spp": SPP, "seeds": SEEDS, "bounces": BOUNCES,
+    info = {"blender": bpy.app.version_string, "method": METHOD, "spp": SPP, "seeds": SEEDS, "bounces": BOUNCES,
             "cycles_seconds": cycles_s, "hairis_seconds": hairis_s,
             "wall_seconds": time.monotonic() - started, "machine": helpers.machine_info(),
             "cells": rows}
     os.makedirs(OUT, exist_ok=True)
     with open(os.path.join(OUT, "huang_coverage.json"), "w") as out:
         json.dump(info, out, indent=1)
-    lines = ["Blender %s, %d seeds x %d spp per engine, %d bounces; Cycles %.0f s, Hairis %.0f s "
-             "(auto-bake included)." % (info["blender"], SEEDS, SPP, BOUNCES, cycles_s, hairis_s),
+    lines = ["Blender %s, Hairis method %s, %d seeds x %d spp per engine, %d bounces; Cycles %.0f s, "
+             "Hairis %.0f s (auto-bake included)." % (info["blender"], METHOD, SEEDS, SPP, BOUNCES,
+                                                       cycles_s, hairis_s),
              "", "| cell | Hairis / Cycles (R, G, B) | relative s.e. | z | blocks: max abs t, "
              "mean t^2 |", "|---|---|---|---|---|"]
     for r in rows:
