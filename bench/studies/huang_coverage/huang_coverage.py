@@ -72,7 +72,8 @@ def strands(name, material, center, radius, count, seed):
     points = 8
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, points)[None, :]
-    x = rng.uniform(-0.3, 0.3, (count, 1)) + 0.06 * np.sin(6.0 * t + rng.uniform(0, 6.3, (count, 1)))
+    wave = 0.06 * np.sin(6.0 * t + rng.uniform(0, 6.3, (count, 1)))
+    x = rng.uniform(-0.3, 0.3, (count, 1)) + wave
     y = rng.uniform(-0.25, 0.25, (count, 1)) + 0.1 * t * rng.uniform(-1, 1, (count, 1))
     z = -0.38 + 0.76 * t + 0.0 * x
     positions = np.stack([x + 0.0 * t, y + 0.0 * t, z + 0.0 * x], axis=-1)
@@ -165,16 +166,17 @@ def main():
     hairis, hairis_s = render(scene, "HAIRIS")
     cycles, cycles_s = render(scene, "CYCLES")
     rows = statistics(cycles, hairis)
-    info = {"blender": bpy.app.version_string, "method": METHOD, "spp": SPP, "seeds": SEEDS, "bounces": BOUNCES,
-            "cycles_seconds": cycles_s, "hairis_seconds": hairis_s,
+    info = {"blender": bpy.app.version_string, "method": METHOD, "spp": SPP, "seeds": SEEDS,
+            "bounces": BOUNCES, "cycles_seconds": cycles_s, "hairis_seconds": hairis_s,
             "wall_seconds": time.monotonic() - started, "machine": helpers.machine_info(),
             "cells": rows}
     os.makedirs(OUT, exist_ok=True)
     with open(os.path.join(OUT, "huang_coverage.json"), "w") as out:
         json.dump(info, out, indent=1)
-    lines = ["Blender %s, Hairis method %s, %d seeds x %d spp per engine, %d bounces; Cycles %.0f s, "
-             "Hairis %.0f s (auto-bake included)." % (info["blender"], METHOD, SEEDS, SPP, BOUNCES,
-                                                       cycles_s, hairis_s),
+    head = ("Blender %s, Hairis method %s, %d seeds x %d spp per engine, %d bounces; "
+            "Cycles %.0f s, Hairis %.0f s (auto-bake included)."
+            % (info["blender"], METHOD, SEEDS, SPP, BOUNCES, cycles_s, hairis_s))
+    lines = [head,
              "", "| cell | Hairis / Cycles (R, G, B) | relative s.e. | z | blocks: max abs t, "
              "mean t^2 |", "|---|---|---|---|---|"]
     for r in rows:
