@@ -2,7 +2,8 @@
 emitted from the vertices of a grid mesh): the strand spacing relative to the diameter
 decides whether the tubes overlap. A diagnostic; prints one SLAB line per render.
 
-Knobs: SLAB_GRID strands per side, SLAB_RADIUS strand radius, SLAB_BOUNCES, SLAB_SPP,
+Knobs: SLAB_GRID strands per side, SLAB_RADIUS strand radius, SLAB_TIP tip radius (a factor
+of the root's), SLAB_BOUNCES, SLAB_SPP,
 SLAB_MEL melanin, SLAB_ORDER engines (CYCLES, HAIRIS, HAIRIS:hit, HAIRIS:ignore).
 """
 import importlib
@@ -45,7 +46,8 @@ def make_scene():
     settings.hair_step = 2
     settings.render_step = 1
     settings.radius_scale = 2.0 * env("SLAB_RADIUS", "0.002")
-    settings.root_radius = settings.tip_radius = 1.0
+    settings.root_radius = 1.0
+    settings.tip_radius = env("SLAB_TIP", "1.0")
     settings.use_close_tip = False
     settings.shape = 0.0
     bounces = int(env("SLAB_BOUNCES", "8"))
