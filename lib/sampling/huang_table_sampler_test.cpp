@@ -75,6 +75,7 @@ HuangBakeOptions small_table() {
     o.theta_i_count = 16;
     o.phi_count = 24;
     o.evaluator = "estimate";
+    o.f = false;  // the sampler reads the sampling values alone
     return o;
 }
 
