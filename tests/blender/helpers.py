@@ -513,17 +513,13 @@ def make_huang_material(name, color, aspect, lobes=(1.0, 1.0, 1.0), roughness=0.
     return material
 
 
-def make_fresh_curves(scene, name, material, count, points, radius, seed, location, spread):
-    """A Curves object of `count` wavy strands, its points set before anything asks for its
-    normals (Blender keeps normals cached when positions are written through position_data)."""
+def make_curves_object(scene, name, material, positions, radius, location):
+    """A Curves object of strands with ``positions`` (count, points, 3) and one ``radius``, its
+    points set before anything asks for its normals (Blender keeps normals cached when
+    positions are written through position_data)."""
+    count, points = positions.shape[:2]
     curves = bpy.data.hair_curves.new(name)
     curves.add_curves([points] * count)
-    rng = np.random.default_rng(seed)
-    roots = rng.uniform(-spread, spread, (count, 3)) * np.array([1.0, 0.3, 1.0])
-    lean = rng.uniform(-0.4, 0.4, (count, 3)) + np.array([0.0, 0.0, 1.0])
-    t = np.linspace(0.0, 1.0, points)[None, :, None]
-    wave = 0.08 * np.sin(7.0 * t + rng.uniform(0.0, 6.3, (count, 1, 1)))
-    positions = roots[:, None, :] + 0.8 * lean[:, None, :] * t + wave * np.array([1.0, 0.5, 0.0])
     curves.position_data.foreach_set("vector", positions.astype(np.float32).reshape(-1))
     radii = curves.attributes.new("radius", "FLOAT", "POINT")
     radii.data.foreach_set("value", np.full(count * points, radius, np.float32))
@@ -532,6 +528,17 @@ def make_fresh_curves(scene, name, material, count, points, radius, seed, locati
     obj.location = location
     scene.collection.objects.link(obj)
     return obj
+
+
+def make_fresh_curves(scene, name, material, count, points, radius, seed, location, spread):
+    """A Curves object of `count` wavy strands (:func:`make_curves_object`)."""
+    rng = np.random.default_rng(seed)
+    roots = rng.uniform(-spread, spread, (count, 3)) * np.array([1.0, 0.3, 1.0])
+    lean = rng.uniform(-0.4, 0.4, (count, 3)) + np.array([0.0, 0.0, 1.0])
+    t = np.linspace(0.0, 1.0, points)[None, :, None]
+    wave = 0.08 * np.sin(7.0 * t + rng.uniform(0.0, 6.3, (count, 1, 1)))
+    positions = roots[:, None, :] + 0.8 * lean[:, None, :] * t + wave * np.array([1.0, 0.5, 0.0])
+    return make_curves_object(scene, name, material, positions, radius, location)
 
 
 def make_huang_scene(samples, bounces, huang_sampling, resolution=(64, 48)):

@@ -59,33 +59,23 @@ CELLS = [
 
 
 def huang_material(name, inputs):
-    material = helpers.make_hair_material(name, "MELANIN")
-    node = material.node_tree.nodes["Principled Hair BSDF"]
-    node.model = "HUANG"
-    for key, value in inputs.items():
-        helpers.socket(node, key).default_value = value
+    """A Principled Hair BSDF (Melanin) with the Huang model and ``inputs``."""
+    material = helpers.make_hair_material(name, "MELANIN", **inputs)
+    material.node_tree.nodes["Principled Hair BSDF"].model = "HUANG"
     return material
 
 
-def strands(name, material, center, radius, count, seed):
+def strands(scene, name, material, center, radius, count, seed):
     """Wavy strands standing in one cell (x and z within ±0.4 of its centre)."""
     points = 8
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, points)[None, :]
-    wave = 0.06 * np.sin(6.0 * t + rng.uniform(0, 6.3, (count, 1)))
-    x = rng.uniform(-0.3, 0.3, (count, 1)) + wave
+    roots = rng.uniform(-0.3, 0.3, (count, 1))  # drawn before the wave's phases, as measured
+    x = roots + 0.06 * np.sin(6.0 * t + rng.uniform(0, 6.3, (count, 1)))
     y = rng.uniform(-0.25, 0.25, (count, 1)) + 0.1 * t * rng.uniform(-1, 1, (count, 1))
-    z = -0.38 + 0.76 * t + 0.0 * x
-    positions = np.stack([x + 0.0 * t, y + 0.0 * t, z + 0.0 * x], axis=-1)
-    curves = bpy.data.hair_curves.new(name)
-    curves.add_curves([points] * count)
-    curves.position_data.foreach_set("vector", positions.astype(np.float32).reshape(-1))
-    radii = curves.attributes.new("radius", "FLOAT", "POINT")
-    radii.data.foreach_set("value", np.full(count * points, radius, np.float32))
-    curves.materials.append(material)
-    obj = bpy.data.objects.new(name, curves)
-    obj.location = center
-    bpy.context.scene.collection.objects.link(obj)
+    z = np.broadcast_to(-0.38 + 0.76 * t, (count, points))
+    positions = np.stack(np.broadcast_arrays(x, y, z), axis=-1)
+    helpers.make_curves_object(scene, name, material, positions, radius, center)
 
 
 def make_scene():
@@ -103,7 +93,7 @@ def make_scene():
     for k, (name, inputs, radius, count) in enumerate(CELLS):
         cx = -1.5 + (k % 4)
         cz = 0.5 - (k // 4)
-        strands(name, huang_material(name, inputs), (cx, 0.0, cz), radius, count, 11 + k)
+        strands(scene, name, huang_material(name, inputs), (cx, 0.0, cz), radius, count, 11 + k)
     helpers.match_cycles(scene, SPP, BOUNCES)
     scene.render.film_transparent = True
     settings = scene.hairis
