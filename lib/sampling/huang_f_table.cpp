@@ -1,6 +1,7 @@
 #include "sampling/huang_f_table.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -24,6 +25,7 @@ Expected<HuangFTable> HuangFTable::create(const HuangTableSet &set) {
     t.theta_i_count_ = set.theta_i_count;
     t.phi_count_ = set.phi_count;
     t.sin_points_ = huang_sin_theta_points(set.theta_i_count);
+    t.phi_o_nodes_ = set.phi_o_nodes;
     t.values_ = set.f;
     return t;
 }
@@ -36,35 +38,58 @@ Rgb HuangFTable::value(int q, int r, int i, int j) const {
     return {values_[3 * n], values_[3 * n + 1], values_[3 * n + 2]};
 }
 
-Rgb HuangFTable::slice(int q, int r, double sin_theta, double phi) const {
-    // θ_i: the points bracketing sin θ_i; beyond the outer points, towards 0 at the pole.
+namespace {
+
+// Cubic Hermite weights of the four values at x[0] < x[1] ≤ x < x[2] < x[3], t = (x − x[1]) /
+// (x[2] − x[1]), with the slopes at x[1] and x[2] taken from their neighbours (Catmull-Rom
+// on uneven nodes). It passes through the values and reproduces quadratics.
+std::array<float, 4> hermite_weights(const double x[4], double t) {
+    const double t2 = t * t, t3 = t2 * t;
+    const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
+    const double d = x[2] - x[1], a = d / (x[2] - x[0]), b = d / (x[3] - x[1]);
+    return {float(-h10 * a), float(h00 - h11 * b), float(h01 + h10 * a), float(h11 * b)};
+}
+
+}  // namespace
+
+HuangFTable::Stencil HuangFTable::theta_i_stencil(double sin_theta) const {
+    // Rows −1 and n_i are the poles (s = ∓1), where f·|cos θ_i| is 0. Next to a pole the value
+    // behaves like √(1 − s²), which no polynomial follows, so that interval is linear.
     const int n_i = theta_i_count_;
     const double s = std::clamp(sin_theta, -1.0, 1.0);
     int cell = int(std::floor((std::asin(s) + kHalfPi) / kPi * n_i));
     cell = std::clamp(cell, 0, n_i - 1);
     const int lower = s < sin_points_[std::size_t(cell)] ? cell - 1 : cell;  // point at or below s
-    double t;
-    if (lower < 0) {
-        t = (s + 1.0) / (sin_points_[0] + 1.0);
-    } else if (lower >= n_i - 1) {
-        t = (s - sin_points_[std::size_t(n_i - 1)]) / (1.0 - sin_points_[std::size_t(n_i - 1)]);
-    } else {
-        t = (s - sin_points_[std::size_t(lower)]) / (sin_points_[std::size_t(lower) + 1] - sin_points_[std::size_t(lower)]);
-    }
-    t = std::clamp(t, 0.0, 1.0);
-    // φ: periodic, points at the cells' centres.
+    auto x = [&](int row) { return row < 0 ? -1.0 : row >= n_i ? 1.0 : sin_points_[std::size_t(row)]; };
+    const double t = std::clamp((s - x(lower)) / (x(lower + 1) - x(lower)), 0.0, 1.0);
+    if (lower < 0 || lower >= n_i - 1) return {lower - 1, {0.0f, float(1.0 - t), float(t), 0.0f}};
+    const double nodes[4] = {x(lower - 1), x(lower), x(lower + 1), x(lower + 2)};
+    return {lower - 1, hermite_weights(nodes, t)};
+}
+
+HuangFTable::Stencil HuangFTable::phi_stencil(double phi) const {
+    // Points at the cells' centres, evenly spaced and periodic.
     const int n_j = phi_count_;
     const double x = (phi + kPi) / kTwoPi * n_j - 0.5;
     const double fx = std::floor(x);
-    const double u = x - fx;
-    int j0 = int(fx) % n_j;
-    if (j0 < 0) j0 += n_j;
-    const int j1 = j0 + 1 == n_j ? 0 : j0 + 1;
-    auto row = [&](int i) -> Rgb {
-        if (i < 0 || i >= n_i) return {};  // a pole
-        return value(q, r, i, j0) * float(1.0 - u) + value(q, r, i, j1) * float(u);
-    };
-    return row(lower) * float(1.0 - t) + row(lower + 1) * float(t);
+    const double even[4] = {-1.0, 0.0, 1.0, 2.0};
+    int first = (int(fx) - 1) % n_j;
+    if (first < 0) first += n_j;
+    return {first, hermite_weights(even, x - fx)};
+}
+
+Rgb HuangFTable::slice(int q, int r, const Stencil &rows, const Stencil &columns) const {
+    Rgb sum;
+    for (int a = 0; a < 4; ++a) {
+        const int i = rows.first + a;
+        if (rows.w[std::size_t(a)] == 0.0f || i < 0 || i >= theta_i_count_) continue;  // a pole
+        Rgb row;
+        for (int b = 0; b < 4; ++b) {
+            row += value(q, r, i, (columns.first + b) % phi_count_) * columns.w[std::size_t(b)];
+        }
+        sum += row * rows.w[std::size_t(a)];
+    }
+    return sum;
 }
 
 Rgb HuangFTable::f_cos(const HuangTableQuery &q, Vec3 wi) const {
@@ -72,19 +97,50 @@ Rgb HuangFTable::f_cos(const HuangTableQuery &q, Vec3 wi) const {
     const float y = q.sign_y * wi.y, z = q.sign_z * wi.z;
     const double phi = std::atan2(z * q.cos_phi_o - y * q.sin_phi_o, y * q.cos_phi_o + z * q.sin_phi_o);
     const double theta_i = std::asin(double(wi.x));
+    // Across φ_o, four nodes: beyond the fold's edges (0 and π/2) the nodes continue as mirror
+    // images, where f is f of the mirrored node at −φ. One node (a round fiber): that node.
+    struct Node {
+        int index;
+        bool mirrored;
+        float weight;
+    };
+    const int n_q = int(phi_o_nodes_.size());
+    Node nodes[4] = {{0, false, 1.0f}, {0, false, 0.0f}, {0, false, 0.0f}, {0, false, 0.0f}};
+    if (n_q > 1) {
+        double x[4];
+        for (int m = 0; m < 4; ++m) {
+            int index = q.phi.lower + m - 1;
+            bool mirrored = false;
+            double at;
+            if (index < 0) {  // mirrored about φ_o = 0: the first node not at 0
+                index = phi_o_nodes_[0] > 0.0f ? 0 : std::min(1, n_q - 1);
+                at = -double(phi_o_nodes_[std::size_t(index)]);
+                mirrored = true;
+            } else if (index >= n_q) {  // mirrored about φ_o = π/2
+                index = phi_o_nodes_[std::size_t(n_q - 1)] < float(kHalfPi) ? n_q - 1 : std::max(n_q - 2, 0);
+                at = kPi - double(phi_o_nodes_[std::size_t(index)]);
+                mirrored = true;
+            } else {
+                at = phi_o_nodes_[std::size_t(index)];
+            }
+            x[m] = at;
+            nodes[m] = {index, mirrored, 0.0f};
+        }
+        const std::array<float, 4> w = hermite_weights(x, q.phi.t);
+        for (int m = 0; m < 4; ++m) nodes[m].weight = w[std::size_t(m)];
+    }
+    const Stencil columns = phi_stencil(phi), mirrored_columns = phi_stencil(-phi);
     Rgb sum;
     for (int k = 0; k < 2; ++k) {
         const float wk = k ? q.theta.t : 1.0f - q.theta.t;
         if (!(wk > 0.0f)) continue;
         const int r = q.theta.lower + k;
-        const double s = std::sin(q.warp[k].to_node(theta_i));
-        for (int m = 0; m < 2; ++m) {
-            const float wm = m ? q.phi.t : 1.0f - q.phi.t;
-            if (!(wm > 0.0f)) continue;
-            sum += slice(q.phi.lower + m, r, s, phi) * (wk * wm);
-        }
+        const Stencil rows = theta_i_stencil(std::sin(q.warp[k].to_node(theta_i)));
+        for (const Node &m : nodes)
+            if (m.weight != 0.0f) sum += slice(m.index, r, rows, m.mirrored ? mirrored_columns : columns) * (wk * m.weight);
     }
-    return sum;
+    // The cubic overshoots a little next to sharp features; f is never negative.
+    return {std::max(sum.r, 0.0f), std::max(sum.g, 0.0f), std::max(sum.b, 0.0f)};
 }
 
 }  // namespace hairis

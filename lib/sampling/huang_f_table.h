@@ -6,15 +6,18 @@
 // per cell of the sampling table: the midpoint in sin θ_i and in φ = φ_i − φ_o of cell (i, j)
 // of θ_o node r and φ_o node q, in the sampling table's frame and fold.
 //
-// Interpolation. A value is a point sample, so the grid is read multilinearly: bilinear in
-// (sin θ_i, φ) within a slice (φ periodic; f·|cos θ_i| is 0 at the poles, which close the
-// θ_i axis), blended across θ_o nodes through the sampling table's warp (the lobes follow the
-// specular cone θ_i = −θ_o, so slices are read at aligned θ_i, as the sampler reads them) and
-// linearly across φ_o nodes. Between nodes the result is therefore an interpolation of the
-// expectation, not the expectation: its error is a bias, measured against HuangExpectation in
-// the tests.
+// Interpolation. A value is a point sample of a smooth function, so the grid is read with
+// cubic (Catmull-Rom) weights where its neighbours allow: bicubic in (sin θ_i, φ) within a
+// slice (φ periodic; f·|cos θ_i| is 0 at the poles, which close the θ_i axis, linearly next to
+// them), cubic across φ_o nodes (continued beyond the fold's edges by mirror images), and
+// linear across θ_o nodes through the sampling table's warp (the lobes follow the specular
+// cone θ_i = −θ_o, so slices are read at aligned θ_i, as the sampler reads them). Linear
+// reading would blur the lobes between points, which the cubic mostly avoids at the same size.
+// Between points the result is still an interpolation of the expectation, not the
+// expectation: its error is a bias, measured against HuangExpectation in the tests.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -39,12 +42,20 @@ class HuangFTable {
     std::size_t memory_bytes() const { return values_.size() * sizeof(float) + sin_points_.size() * sizeof(double); }
 
   private:
+    // Four neighbouring points of one axis, from index `first`, and their weights.
+    struct Stencil {
+        int first;
+        std::array<float, 4> w;
+    };
     HuangFTable() = default;
-    // Bilinear in (sin θ_i, φ) within slice (q, r).
-    Rgb slice(int q, int r, double sin_theta, double phi) const;
+    Stencil theta_i_stencil(double sin_theta) const;  // rows −1 and theta_i_count are the poles
+    Stencil phi_stencil(double phi) const;            // columns wrap around
+    // Bicubic in (sin θ_i, φ) within slice (q, r).
+    Rgb slice(int q, int r, const Stencil &rows, const Stencil &columns) const;
 
     int theta_o_count_ = 0, theta_i_count_ = 0, phi_count_ = 0;
     std::vector<double> sin_points_;  // the θ_i cells' points
+    std::vector<float> phi_o_nodes_;
     std::vector<float> values_;
 };
 
