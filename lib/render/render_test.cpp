@@ -1169,7 +1169,7 @@ TEST(Render, ImageIsWrittenBottomRowFirst) {
         }
 }
 
-Scene hair_tuft_scene(int width, int height, int curves = 64) {
+SceneDesc hair_tuft_desc(int width, int height, int curves = 64) {
     const auto fiber = fiber_with(Rgb(0.3f, 0.6f, 1.2f));
     SceneDesc d;
     d.materials = {hair(fiber, std::make_shared<const AnalyticSampler>(fiber)),
@@ -1191,7 +1191,34 @@ Scene hair_tuft_scene(int width, int height, int curves = 64) {
                          0, 0, 0, 1};
     c.camera_to_world = Mat4::from_row_major(v);
     d.camera = c;
-    return build(std::move(d));
+    return d;
+}
+
+Scene hair_tuft_scene(int width, int height, int curves = 64) { return build(hair_tuft_desc(width, height, curves)); }
+
+// New materials, lights and world on a built scene render what a build of the whole new scene
+// renders, to the bit.
+TEST(Render, SetShadingRendersAsABuildOfTheNewScene) {
+    SceneDesc changed = hair_tuft_desc(24, 20);
+    const auto blond = fiber_with(Rgb(0.1f, 0.2f, 0.4f));
+    changed.materials = {hair(blond, std::make_shared<const AnalyticSampler>(blond)),
+                         DiffuseMaterial{Rgb(0.3f), Rgb(1.0f, 0.5f, 0.2f)}};  // the quad glows now
+    changed.world = {Rgb(0.05f, 0.1f, 0.2f), 2.0f};
+    changed.suns[0].strength = 1.0f;
+    changed.point_lights.clear();
+    const Scene fresh = build(changed);
+    Scene updated = hair_tuft_scene(24, 20);
+    RenderSettings s;
+    s.samples = 4;
+    s.threads = 2;
+    const std::vector<float> before = render_ok(updated, s);
+    const Status st = updated.set_shading(changed);
+    ASSERT_FALSE(st) << st->message;
+    EXPECT_EQ(updated.stats().emissive_triangles, fresh.stats().emissive_triangles);
+    EXPECT_EQ(updated.stats().lamps, fresh.stats().lamps);
+    const std::vector<float> after = render_ok(updated, s), want = render_ok(fresh, s);
+    EXPECT_TRUE(same_bits(after, want));
+    EXPECT_FALSE(same_bits(after, before));
 }
 
 TEST(Render, BitIdenticalWhateverTheThreadCount) {

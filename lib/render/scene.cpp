@@ -37,6 +37,7 @@ struct CurveGeometry {
     std::vector<std::uint32_t> curve_of;  // the curve of each segment
     std::uint32_t material = 0;
     std::vector<CurveInput> inputs;       // of the kept curves and their points only
+    std::size_t set = 0;                  // its index in SceneDesc::curves
 };
 
 struct MeshGeometry {
@@ -46,6 +47,8 @@ struct MeshGeometry {
     std::vector<std::uint8_t> emissive;     // 1 per kept triangle: in the light set
     std::vector<Vec3> normals;              // 3 per kept triangle, or none
     std::vector<float> uvs;                 // 6 per kept triangle, or none
+    std::size_t mesh = 0;                   // its index in SceneDesc::meshes
+    unsigned geometry_id = 0;               // Embree's
 };
 
 struct GeometryInfo {
@@ -160,28 +163,6 @@ int components_of(const CurveInput &in) {
     return in.closure_weight >= 0 ? 1 : hair_input_info(in.input).components;
 }
 
-// A curve set's closure weights: one per closure of the material's mixture at most, sized for
-// its curves or points, finite and >= 0.
-Status check_closure_weight(const CurveInput &in, const std::string &set, const HairMaterial *hair,
-                            std::size_t curves, std::size_t points, std::uint32_t &seen) {
-    const std::string name = set + ", closure " + std::to_string(in.closure_weight) + "'s weight";
-    const int closures = hair && hair->mixture ? hair->mixture->size() : 0;
-    if (in.closure_weight >= closures)
-        return Error{name + ": the material has " + std::to_string(closures) +
-                     " mixed hair closure(s); a weight per strand needs a closure of a hair mixture"};
-    if ((seen >> unsigned(in.closure_weight)) & 1u) return Error{name + ": given twice"};
-    seen |= 1u << unsigned(in.closure_weight);
-    const std::size_t n = in.per_point ? points : curves;
-    if (in.values.size() != n)
-        return Error{name + ": has " + std::to_string(in.values.size()) + " values; " + std::to_string(n) +
-                     (in.per_point ? " points" : " curves") + " need " + std::to_string(n)};
-    for (std::size_t i = 0; i < n; ++i)
-        if (!std::isfinite(in.values[i]) || in.values[i] < 0.0f)
-            return Error{name + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": " +
-                         std::to_string(in.values[i]) + " (weights must be finite and >= 0)"};
-    return std::nullopt;
-}
-
 // Whether some closure of a hair material reads `input` per strand.
 bool any_closure_reads(const HairMaterial &hair, HairInput input) {
     const int count = hair.mixture ? hair.mixture->size() : 1;
@@ -200,43 +181,94 @@ void linear(const Float4 &p1, const Float4 &p2, float t, Float4 &value, Float4 &
              p1.w + t * derivative.w};
 }
 
-// A curve set's inputs: known once each, sized for its curves or points, in range, read by
-// the material's node (some closure's, for a mixture), on a material that varies per strand.
-Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
-    if (hc.inputs.empty()) return std::nullopt;
+// Whether a curve set's inputs fit its material: each known once, closure weights on a
+// mixture with that closure, node inputs on a material that varies per strand and reads them
+// (some closure does, for a mixture).
+Status check_inputs_fit(const std::vector<CurveInput> &inputs, const std::string &set, std::uint32_t index,
+                        const Material &material) {
     const auto *hair = std::get_if<HairMaterial>(&material);
-    const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
-    std::uint32_t seen_weights = 0;
-    for (const CurveInput &in : hc.inputs)
-        if (in.closure_weight >= 0)
-            if (auto e = check_closure_weight(in, set, hair, curves, points, seen_weights)) return e;
+    const int closures = hair && hair->mixture ? hair->mixture->size() : 0;
     const ShadingModel *model = hair ? hair->shading.model() : nullptr;
     const StrandInputReader *strands = model ? model->strand_inputs() : nullptr;
-    std::uint32_t seen = 0;
-    for (const CurveInput &in : hc.inputs) {
-        if (in.closure_weight >= 0) continue;
+    std::uint32_t seen_weights = 0, seen = 0;
+    for (const CurveInput &in : inputs) {
+        if (in.closure_weight >= 0) {
+            const std::string name = set + ", closure " + std::to_string(in.closure_weight) + "'s weight";
+            if (in.closure_weight >= closures)
+                return Error{name + ": the material has " + std::to_string(closures) +
+                             " mixed hair closure(s); a weight per strand needs a closure of a hair mixture"};
+            if ((seen_weights >> unsigned(in.closure_weight)) & 1u) return Error{name + ": given twice"};
+            seen_weights |= 1u << unsigned(in.closure_weight);
+            continue;
+        }
         if (!strands)
-            return Error{set + ": has curve inputs, but its material " + std::to_string(hc.material) +
+            return Error{set + ": has curve inputs, but its material " + std::to_string(index) +
                          " does not vary per strand (it needs a hair material made for curve inputs, e.g. "
                          "ChiangStrands or HuangStrands)"};
         if (int(in.input) >= kHairInputCount)
             return Error{set + ": a curve input is not a node input (" + std::to_string(int(in.input)) + ")"};
-        const HairInputInfo &info = hair_input_info(in.input);
-        const std::string name = set + ", input " + info.name;
+        const std::string name = set + ", input " + hair_input_info(in.input).name;
         if ((seen >> unsigned(in.input)) & 1u) return Error{name + ": given twice"};
         seen |= 1u << unsigned(in.input);
         if (!any_closure_reads(*hair, in.input))
             return Error{name + ": the material's parametrization does not read it"};
-        const std::size_t k = std::size_t(info.components), n = in.per_point ? points : curves;
+    }
+    return std::nullopt;
+}
+
+// A curve set's inputs: fit for its material, sized for its curves or points, in range.
+Status check_curve_inputs(const HairCurves &hc, const std::string &set, const Material &material) {
+    if (auto e = check_inputs_fit(hc.inputs, set, hc.material, material)) return e;
+    const std::size_t curves = hc.first.size() - 1, points = hc.points.size();
+    for (const CurveInput &in : hc.inputs) {
+        const bool weight = in.closure_weight >= 0;
+        const std::string name = weight ? set + ", closure " + std::to_string(in.closure_weight) + "'s weight"
+                                        : set + ", input " + hair_input_info(in.input).name;
+        const std::size_t k = std::size_t(components_of(in)), n = in.per_point ? points : curves;
         if (in.values.size() != n * k)
             return Error{name + ": has " + std::to_string(in.values.size()) + " values; " + std::to_string(n) +
-                         (in.per_point ? " points" : " curves") + " of " + std::to_string(k) + " need " +
-                         std::to_string(n * k)};
-        for (std::size_t i = 0; i < n; ++i)
-            if (Status bad = check_hair_input(in.input, in.values.data() + i * k,
-                                              set + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": "))
+                         (in.per_point ? " points" : " curves") + (weight ? "" : " of " + std::to_string(k)) +
+                         " need " + std::to_string(n * k)};
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::string where = set + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": ";
+            if (weight) {
+                if (!std::isfinite(in.values[i]) || in.values[i] < 0.0f)
+                    return Error{name + (in.per_point ? ", point " : ", curve ") + std::to_string(i) + ": " +
+                                 std::to_string(in.values[i]) + " (weights must be finite and >= 0)"};
+            } else if (Status bad = check_hair_input(in.input, in.values.data() + i * k, where)) {
                 return bad;
+            }
+        }
     }
+    return std::nullopt;
+}
+
+// Each material's own values: hair materials have a fiber, diffuse ones an albedo in [0, 1]
+// and a non-negative emission.
+Status check_materials(const std::vector<Material> &materials) {
+    for (std::size_t m = 0; m < materials.size(); ++m) {
+        if (const auto *hair = std::get_if<HairMaterial>(&materials[m])) {
+            if (!hair->shading.model())
+                return Error{"material " + std::to_string(m) + ": hair material has no fiber"};
+        } else if (const auto *d = std::get_if<DiffuseMaterial>(&materials[m])) {
+            const std::string name = "material " + std::to_string(m);
+            for (int i = 0; i < 3; ++i) {
+                if (auto e = check::in_range((name + ": albedo").c_str(), d->albedo[i], 0.0, 1.0)) return *e;
+                if (auto e = check::non_negative((name + ": emission").c_str(), d->emission[i])) return *e;
+            }
+        }
+    }
+    return std::nullopt;
+}
+
+// A material index of `what`: in range, and a surface material where `surface`.
+Status check_material_index(const std::vector<Material> &materials, const std::string &what, std::uint32_t m,
+                            bool surface) {
+    if (m >= materials.size())
+        return Error{what + ": material index " + std::to_string(m) + " is out of range (the scene has " +
+                     std::to_string(materials.size()) + " materials)"};
+    if (surface && is_hair(materials[m]))
+        return Error{what + ": material " + std::to_string(m) + " is a hair material; meshes need a surface material"};
     return std::nullopt;
 }
 
@@ -260,6 +292,9 @@ struct Scene::Impl {
     SceneStats stats;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
+
+    std::vector<std::string> geometry_warnings;  // the build's, before the lights'
+    std::size_t geometry_bytes = 0;              // stats.scene_bytes without the lights
 
     std::atomic<long long> embree_bytes{0};
     std::atomic<long long> embree_peak{0};
@@ -286,6 +321,55 @@ struct Scene::Impl {
         if (self->embree_error.empty())
             self->embree_error = "Embree error " + std::to_string(int(code)) + ": " +
                                  (message ? message : "(no message)");
+    }
+
+    // The materials, lights and world of `desc` (its geometry is not read): checked against
+    // the geometry's material indices and curve inputs, then the emissive triangles and the
+    // light set made again. Leaves everything as it was when it refuses.
+    Status set_shading(SceneDesc &desc) {
+        if (auto e = check_materials(desc.materials)) return e;
+        for (const CurveGeometry &geo : curves) {
+            const std::string set = "curve set " + std::to_string(geo.set);
+            if (auto e = check_material_index(desc.materials, set, geo.material, false)) return e;
+            if (auto e = check_inputs_fit(geo.inputs, set, geo.material, desc.materials[geo.material])) return e;
+        }
+        for (const MeshGeometry &geo : meshes)
+            for (std::uint32_t m : geo.materials)
+                if (auto e = check_material_index(desc.materials, "mesh " + std::to_string(geo.mesh), m, true)) return e;
+        std::vector<EmissiveTriangle> emissive;
+        std::vector<std::vector<std::uint8_t>> flags(meshes.size());
+        for (std::size_t i = 0; i < meshes.size(); ++i) {
+            const MeshGeometry &geo = meshes[i];
+            flags[i].assign(geo.materials.size(), 0);
+            for (std::size_t t = 0; t < geo.materials.size(); ++t) {
+                const Rgb radiance = material_emission(desc.materials[geo.materials[t]]);
+                if (radiance.is_black()) continue;
+                flags[i][t] = 1;
+                auto vertex = [&](std::uint32_t k) {
+                    return Vec3{geo.vertices[3 * k], geo.vertices[3 * k + 1], geo.vertices[3 * k + 2]};
+                };
+                EmissiveTriangle et;
+                et.p0 = vertex(geo.indices[3 * t]);
+                et.p1 = vertex(geo.indices[3 * t + 1]);
+                et.p2 = vertex(geo.indices[3 * t + 2]);
+                et.radiance = radiance;
+                et.geometry = geo.geometry_id;
+                et.primitive = std::uint32_t(t);
+                emissive.push_back(et);
+            }
+        }
+        std::vector<std::string> warnings = geometry_warnings;
+        const std::size_t emissive_count = emissive.size();
+        Expected<LightSet> made = LightSet::build(lights_of(desc), std::move(emissive), &warnings);
+        if (!made) return made.error();
+        for (std::size_t i = 0; i < meshes.size(); ++i) meshes[i].emissive = std::move(flags[i]);
+        lights = std::move(made).value();
+        materials = std::move(desc.materials);
+        stats.warnings = std::move(warnings);
+        stats.emissive_triangles = emissive_count;
+        stats.lamps = std::size_t(lights.lamp_count());
+        stats.scene_bytes = geometry_bytes + lights.memory_bytes();
+        return std::nullopt;
     }
 
     Status embree_status(const char *what) {
@@ -329,30 +413,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                      std::to_string(int(desc.curve_shape)) + ")"};
     impl->curve_shape = desc.curve_shape;
 
-    // Materials.
-    for (std::size_t m = 0; m < desc.materials.size(); ++m) {
-        if (const auto *hair = std::get_if<HairMaterial>(&desc.materials[m])) {
-            if (!hair->shading.model())
-                return Error{"material " + std::to_string(m) + ": hair material has no fiber"};
-        } else if (const auto *d_ptr = std::get_if<DiffuseMaterial>(&desc.materials[m])) {
-            const DiffuseMaterial &d = *d_ptr;
-            for (int i = 0; i < 3; ++i) {
-                const std::string name = "material " + std::to_string(m);
-                if (auto e = check::in_range((name + ": albedo").c_str(), d.albedo[i], 0.0, 1.0))
-                    return *e;
-                if (auto e = check::non_negative((name + ": emission").c_str(), d.emission[i]))
-                    return *e;
-            }
-        }
-    }
-    const std::size_t material_count = desc.materials.size();
-    auto material_error = [&](const std::string &what, std::uint32_t m) -> Status {
-        if (m >= material_count)
-            return Error{what + ": material index " + std::to_string(m) +
-                         " is out of range (the scene has " + std::to_string(material_count) +
-                         " materials)"};
-        return std::nullopt;
-    };
+    if (auto e = check_materials(desc.materials)) return *e;
 
     // Lights: validated now (cheap) so that a bad light fails before the BVH is built; the
     // light set itself is built at the end, with the emissive triangles.
@@ -372,7 +433,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     for (std::size_t s = 0; s < desc.curves.size(); ++s) {
         HairCurves &hc = desc.curves[s];
         const std::string set = "curve set " + std::to_string(s);
-        if (auto e = material_error(set, hc.material)) return *e;
+        if (auto e = check_material_index(desc.materials, set, hc.material, false)) return *e;
         if (hc.radii.size() != hc.points.size())
             return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
                          " entries but points has " + std::to_string(hc.points.size()) +
@@ -393,6 +454,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                              describe(hc.normals[k]) + ")"};
         CurveGeometry geo;
         geo.material = hc.material;
+        geo.set = s;
         for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}, in.closure_weight});
         std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
         const std::size_t curve_count = hc.first.size() - 1;
@@ -472,8 +534,6 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     }
 
     // Meshes.
-    std::vector<EmissiveTriangle> emissive;
-    std::vector<std::size_t> mesh_geometry_ids;
     for (std::size_t s = 0; s < desc.meshes.size(); ++s) {
         TriangleMesh &tm = desc.meshes[s];
         const std::string name = "mesh " + std::to_string(s);
@@ -489,12 +549,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             if (!finite3(tm.positions[v]))
                 return Error{name + ", vertex " + std::to_string(v) +
                              ": position must be finite (got " + describe(tm.positions[v]) + ")"};
-        for (std::uint32_t m : tm.materials) {
-            if (auto e = material_error(name, m)) return *e;
-            if (is_hair(desc.materials[m]))
-                return Error{name + ": material " + std::to_string(m) +
-                             " is a hair material; meshes need a surface material"};
-        }
+        for (std::uint32_t m : tm.materials)
+            if (auto e = check_material_index(desc.materials, name, m, true)) return *e;
         if (!tm.normals.empty() && tm.normals.size() != tm.indices.size())
             return Error{name + ": normals has " + std::to_string(tm.normals.size()) +
                          " entries; it needs one per triangle corner (" +
@@ -511,6 +567,7 @@ Expected<Scene> Scene::build(SceneDesc desc) {
             if (!std::isfinite(tm.uvs[k]))
                 return Error{name + ", corner " + std::to_string(k / 2) + ": uv must be finite"};
         MeshGeometry geo;
+        geo.mesh = s;
         std::size_t degenerate = 0;
         for (std::size_t t = 0; t < tri_count; ++t) {
             const std::uint32_t i0 = tm.indices[3 * t], i1 = tm.indices[3 * t + 1],
@@ -525,11 +582,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
                 ++degenerate;
                 continue;
             }
-            const std::uint32_t m = tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t];
-            const Rgb emission = material_emission(desc.materials[m]);
             geo.indices.insert(geo.indices.end(), {i0, i1, i2});
-            geo.materials.push_back(m);
-            geo.emissive.push_back(emission.is_black() ? 0 : 1);
+            geo.materials.push_back(tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t]);
             if (!tm.normals.empty())
                 for (int k = 0; k < 3; ++k) geo.normals.push_back(safe_normalize(tm.normals[3 * t + k]));
             if (!tm.uvs.empty()) geo.uvs.insert(geo.uvs.end(), &tm.uvs[6 * t], &tm.uvs[6 * t] + 6);
@@ -606,37 +660,14 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         rtcReleaseGeometry(g);
         if (impl->geometries.size() <= id) impl->geometries.resize(id + 1);
         impl->geometries[id] = {false, std::uint32_t(i)};
-        for (std::size_t t = 0; t < geo.materials.size(); ++t) {
-            if (!geo.emissive[t]) continue;
-            auto vertex = [&](std::uint32_t k) {
-                return Vec3{geo.vertices[3 * k], geo.vertices[3 * k + 1], geo.vertices[3 * k + 2]};
-            };
-            EmissiveTriangle et;
-            et.p0 = vertex(geo.indices[3 * t]);
-            et.p1 = vertex(geo.indices[3 * t + 1]);
-            et.p2 = vertex(geo.indices[3 * t + 2]);
-            et.radiance = material_emission(desc.materials[geo.materials[t]]);
-            et.geometry = id;
-            et.primitive = std::uint32_t(t);
-            emissive.push_back(et);
-        }
+        geo.geometry_id = id;
     }
     rtcCommitScene(impl->rtc_scene);
     if (auto e = impl->embree_status("building the BVH")) return *e;
 
-    // Lights.
-    stats.emissive_triangles = emissive.size();
-    {
-        auto lights = LightSet::build(lights_of(desc), std::move(emissive), &stats.warnings);
-        if (!lights) return lights.error();
-        impl->lights = std::move(lights).value();
-    }
-    stats.lamps = std::size_t(impl->lights.lamp_count());
-    impl->materials = std::move(desc.materials);
-
-    // Memory.
-    std::size_t bytes = sizeof(Impl) + impl->lights.memory_bytes() +
-                        impl->geometries.capacity() * sizeof(GeometryInfo);
+    // Materials and lights, as set_shading sets them again.
+    impl->geometry_warnings = stats.warnings;
+    std::size_t bytes = sizeof(Impl) + impl->geometries.capacity() * sizeof(GeometryInfo);
     for (const auto &c : impl->curves) {
         bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
                  c.curve_of.capacity() * 4 + c.normals.capacity() * sizeof(Vec3);
@@ -644,9 +675,10 @@ Expected<Scene> Scene::build(SceneDesc desc) {
     }
     for (const auto &m : impl->meshes)
         bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
-                 m.materials.capacity() * 4 + m.emissive.capacity() +
+                 m.materials.capacity() * 4 + m.materials.size() +
                  m.normals.capacity() * sizeof(Vec3) + m.uvs.capacity() * 4;
-    stats.scene_bytes = bytes;
+    impl->geometry_bytes = bytes;
+    if (auto e = impl->set_shading(desc)) return *e;
     stats.embree_peak_bytes = std::size_t(std::max(0ll, impl->embree_peak.load()));
     stats.embree_bytes = std::size_t(std::max(0ll, impl->embree_bytes.load()));
     stats.estimated_peak_bytes = stats.scene_bytes + stats.embree_peak_bytes;
@@ -654,6 +686,8 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return Scene(std::move(impl));
 }
+
+Status Scene::set_shading(SceneDesc desc) { return impl_->set_shading(desc); }
 
 namespace {
 

@@ -284,6 +284,12 @@ class Scene {
     /// Replaces the camera, refused as build() refuses one: nothing else in a built scene
     /// depends on it, so a new view needs no new BVH. Not while the scene is being rendered.
     Status set_camera(const CameraDesc &camera);
+    /// Replaces the materials, lights and world with `desc`'s (its geometry, camera and curve
+    /// settings are not read): the geometry's BVH stays. Refused as build() refuses them, and
+    /// when the geometry does not fit the new materials (an index out of range, a hair
+    /// material on a mesh, curve inputs the material does not read); a refusal changes
+    /// nothing. Not while the scene is being rendered.
+    Status set_shading(SceneDesc desc);
     const LightSet &lights() const;
     const std::vector<Material> &materials() const;
     const SceneStats &stats() const;

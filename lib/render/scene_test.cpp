@@ -627,6 +627,77 @@ TEST(Scene, InvalidCurveInputsAreRefusedByName) {
     EXPECT_NE(e.find("does not vary per strand"), std::string::npos) << e;
 }
 
+// A hair along X over a quad at z = −1 whose material 1 glows, seen from above.
+SceneDesc hair_over_glowing_quad() {
+    SceneDesc d;
+    d.materials = {hair_material(), DiffuseMaterial{Rgb(0.5f), Rgb(2.0f)}};
+    d.curves = {straight_hair()};
+    d.meshes = {quad(-1.0f, 1)};
+    d.camera = small_camera();
+    return d;
+}
+
+TEST(Scene, SetShadingReplacesMaterialsAndLightsAndKeepsTheGeometry) {
+    Scene scene = build_ok(hair_over_glowing_quad());
+    EXPECT_EQ(scene.stats().emissive_triangles, 2u);
+    const auto quad_hit = scene.intersect({0.5f, 0.5f, 5}, {0, 0, -1}, 0.0f, 100.0f);
+    ASSERT_TRUE(quad_hit);
+    EXPECT_TRUE(scene.surface_point({0.5f, 0.5f, 5}, {0, 0, -1}, *quad_hit).is_light);
+
+    SceneDesc shading;
+    shading.materials = {hair_material(), DiffuseMaterial{Rgb(0.25f), Rgb(0.0f)}};
+    shading.suns = {SunLight{}};
+    shading.curves = {straight_hair(), straight_hair()};  // geometry is not read
+    ASSERT_FALSE(scene.set_shading(std::move(shading)));
+    EXPECT_EQ(scene.stats().emissive_triangles, 0u);
+    EXPECT_EQ(scene.stats().lamps, 1u);
+    EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials()[1]).albedo.r, 0.25f);
+    EXPECT_EQ(scene.stats().curves, 1u);
+    EXPECT_EQ(scene.stats().triangles, 2u);
+    const auto again = scene.intersect({0.5f, 0.5f, 5}, {0, 0, -1}, 0.0f, 100.0f);
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->t, quad_hit->t);
+    EXPECT_FALSE(scene.surface_point({0.5f, 0.5f, 5}, {0, 0, -1}, *again).is_light);
+    const auto hair_hit = scene.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, 100.0f);
+    ASSERT_TRUE(hair_hit);
+    EXPECT_NEAR(hair_hit->t, 4.9f, 1e-3f);
+}
+
+TEST(Scene, SetShadingRefusesMaterialsTheGeometryCannotUseAndKeepsItsOwn) {
+    Scene scene = build_ok(hair_over_glowing_quad());
+    auto refusal = [&](std::vector<Material> materials) {
+        SceneDesc shading;
+        shading.materials = std::move(materials);
+        const Status s = scene.set_shading(std::move(shading));
+        return s ? s->message : std::string("accepted");
+    };
+    std::string e = refusal({hair_material()});
+    EXPECT_NE(e.find("mesh 0: material index 1 is out of range (the scene has 1 materials)"), std::string::npos) << e;
+    e = refusal({hair_material(), hair_material()});
+    EXPECT_NE(e.find("mesh 0: material 1 is a hair material; meshes need a surface material"), std::string::npos) << e;
+    e = refusal({hair_material(), DiffuseMaterial{Rgb(1.5f), Rgb(0.0f)}});
+    EXPECT_NE(e.find("material 1: albedo"), std::string::npos) << e;
+    SceneDesc bad_light;
+    bad_light.materials = {hair_material(), DiffuseMaterial{}};
+    bad_light.suns = {SunLight{Vec3{0, 0, 0}}};
+    EXPECT_TRUE(scene.set_shading(std::move(bad_light)));
+    // Nothing changed: the quad still glows with its own material.
+    EXPECT_EQ(scene.stats().emissive_triangles, 2u);
+    EXPECT_EQ(std::get<DiffuseMaterial>(scene.materials()[1]).emission.r, 2.0f);
+
+    SceneDesc with_inputs;
+    with_inputs.materials = {strands_material()};
+    with_inputs.curves = {hairs_with_inputs()};
+    with_inputs.camera = small_camera();
+    Scene strands = build_ok(std::move(with_inputs));
+    SceneDesc plain;
+    plain.materials = {hair_material()};
+    const Status s = strands.set_shading(std::move(plain));
+    ASSERT_TRUE(s);
+    EXPECT_NE(s->message.find("curve set 0: has curve inputs, but its material 0 does not vary per strand"),
+              std::string::npos) << s->message;
+}
+
 // Curves (by default straight_hair, a straight hair along +X) as a scene of the given shape.
 Scene curve_scene(CurveShape shape, HairCurves curves = straight_hair(),
                   CurveBackfaces backfaces = CurveBackfaces::Ignore) {
