@@ -116,6 +116,7 @@ PROTOTYPES = {
     "hairis_scene_set_world": (c_int, [c_void_p, c_char_p]),
     "hairis_scene_set_world_pixels": (c_int, [c_void_p, c_char_p, _F, c_size_t, c_size_t,
                                               c_int]),
+    "hairis_scene_reset_shading": (c_int, [c_void_p]),
     "hairis_scene_set_camera": (c_int, [c_void_p, c_char_p]),
     "hairis_render": (c_int, [c_void_p, c_char_p, _F, PROGRESS_FN, c_void_p]),
     "hairis_render_progressive": (c_int, [c_void_p, c_char_p, _F, _F, UPDATE_FN, c_void_p]),
@@ -864,6 +865,13 @@ class Scene(_Handle):
         status = self._library.raw.hairis_scene_set_world_pixels(
             self, options(values).encode(), _ptr(pixels, c_float), width, height, channels)
         self._library._status("hairis_scene_set_world_pixels", status)
+
+    def reset_shading(self):
+        """Removes the materials, textures, lights and world, keeping the geometry and its
+        BVH: add them again, materials in their first order, to render an edit of them."""
+        status = self._library.raw.hairis_scene_reset_shading(self)
+        self._library._status("hairis_scene_reset_shading", status)
+        self._tables = []
 
     def set_camera(self, camera):
         """Sets the camera from camera options (a dict: matrix, orthographic, frame, width,

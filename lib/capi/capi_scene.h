@@ -389,18 +389,24 @@ void describe(Fields &f, RenderOptions &o) {
 
 /// A scene under construction: materials, and a SceneDesc whose geometry, lights, world and
 /// camera are filled in by the hairis_scene_* calls; its materials are made by hairis_render.
-/// The last render's built scene is kept for the next render with the same build settings:
-/// every hairis_scene_* call that changes anything but the camera must call forget_build(),
-/// and hairis_scene_set_camera counts camera_revision up.
+/// The last render's built scene is kept for the next render: whole with the same render
+/// settings, its geometry (BVH) with others. A hairis_scene_* call that changes the geometry
+/// must call forget_build(), one that changes materials, textures, lights or the world
+/// forget_shading(); hairis_scene_set_camera counts camera_revision up.
 struct hairis_scene {
     void forget_build() {
         std::lock_guard<std::mutex> lock(build_mutex);
         built.reset();
         built_key.clear();
     }
-    std::mutex build_mutex;                ///< guards the four fields below
+    void forget_shading() {
+        std::lock_guard<std::mutex> lock(build_mutex);
+        built_key.clear();
+    }
+    std::mutex build_mutex;                ///< guards the five fields below
     std::shared_ptr<hairis::Scene> built;  ///< the last render's scene (BVH, lights, materials)
-    std::string built_key;                 ///< the render settings it was built for
+    std::string built_key;                 ///< the render settings its shading was made for ("": stale)
+    std::string built_geometry_key;        ///< the render settings its BVH was built for
     unsigned camera_revision = 0;          ///< hairis_scene_set_camera calls so far
     unsigned built_camera = 0;             ///< the camera_revision `built` has
     std::vector<hairis::capi::SceneMaterial> materials;

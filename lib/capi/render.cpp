@@ -161,72 +161,114 @@ using namespace hairis::capi;
 
 namespace {
 
-// What a built scene depends on among the render settings: the sampler (the materials), the
-// integrator and Huang sampling (the shading), the curves' backfaces and shape (the BVH).
-std::string build_key(const RenderOptions &o) {
-    return write_options(o.sampler) + ";integrator=" + std::to_string(o.render.integrator) +
-           ";huang_sampling=" + std::to_string(o.render.huang_sampling) + ";curve_backfaces=" +
-           std::to_string(int(o.curve_backfaces)) + ";curve_shape=" + std::to_string(int(o.curve_shape));
+// What a built scene's BVH depends on among the render settings: the curves' backfaces and
+// shape.
+std::string geometry_key(const RenderOptions &o) {
+    return "curve_backfaces=" + std::to_string(int(o.curve_backfaces)) + ";curve_shape=" +
+           std::to_string(int(o.curve_shape));
 }
 
-// The scene built with this render's materials, and whether it is the last render's: render
-// settings the same as its keep its build (only the camera is set again, when no other
-// render is using it).
-std::pair<std::shared_ptr<Scene>, bool> built_scene(hairis_scene &scene, const RenderOptions &o) {
-    const std::string key = build_key(o);
-    unsigned camera = 0;
-    {
-        std::lock_guard<std::mutex> lock(scene.build_mutex);
-        camera = scene.camera_revision;
-        if (scene.built && scene.built_key == key) {
-            if (scene.built_camera == camera) return {scene.built, true};
-            if (scene.built.use_count() == 1) {
-                ok_or_invalid(scene.built->set_camera(scene.desc.camera), "camera: ");
-                scene.built_camera = camera;
-                return {scene.built, true};
-            }
-        }
-        // Free the old build before making the new one (a render using it keeps it alive).
-        scene.built.reset();
-        scene.built_key.clear();
-    }
-    // The scene description with this render's materials. The handle keeps its own copy
-    // of the geometry so that it can be rendered again with other settings.
-    if (o.render.integrator == int(Integrator::DualScattering))
+// What its shading depends on besides: the sampler (the materials), the integrator and Huang
+// sampling.
+std::string build_key(const RenderOptions &o) {
+    return write_options(o.sampler) + ";integrator=" + std::to_string(o.render.integrator) +
+           ";huang_sampling=" + std::to_string(o.render.huang_sampling) + ";" + geometry_key(o);
+}
+
+// The scene's materials as this render's settings make them.
+std::vector<Material> render_materials(hairis_scene &scene, const RenderOptions &o) {
+    const bool dual = o.render.integrator == int(Integrator::DualScattering);
+    if (dual)
         for (size_t m = 0; m < scene.materials.size(); ++m)
             if (const auto *hair = std::get_if<SceneHairMaterial>(&scene.materials[m]); hair && !hair->closures.empty())
                 invalid("material " + std::to_string(m) + " (hair mixture): integrator=dual_scattering shades "
                         "one Principled Hair BSDF per material, and this material mixes " +
                         std::to_string(hair->closures.size()) + " (a Mix or Add Shader of hair closures); "
                         "render with integrator=path");
-    SceneDesc desc = scene.desc;
-    desc.curve_backfaces = o.curve_backfaces;
-    desc.curve_shape = o.curve_shape;
-    desc.materials.reserve(scene.materials.size());
+    std::vector<Material> materials;
+    materials.reserve(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m) {
         if (const auto *hair = std::get_if<SceneHairMaterial>(&scene.materials[m])) {
-            // Dual scattering samples Huang with its tables: its MIS needs the sampler's
-            // density, which Cycles' own Huang sampler does not have.
-            const bool dual = o.render.integrator == int(Integrator::DualScattering);
             if (!hair->closures.empty()) {
-                desc.materials.push_back(hair_mixture(scene, *hair, m, o.sampler));
+                materials.push_back(hair_mixture(scene, *hair, m, o.sampler));
                 continue;
             }
+            // Dual scattering samples Huang with its tables: its MIS needs the sampler's
+            // density, which Cycles' own Huang sampler does not have.
             HairMaterial material{hair_shading(*hair, m, o.sampler,
                                                o.render.huang_sampling == int(HuangSampling::Cycles) && !dual)};
             if (dual) add_dual_scattering(material, *hair, m);
-            desc.materials.push_back(std::move(material));
+            materials.push_back(std::move(material));
         } else
-            desc.materials.push_back(std::get<SurfaceMaterial>(scene.materials[m]));
+            materials.push_back(std::get<SurfaceMaterial>(scene.materials[m]));
     }
-    Expected<Scene> made = Scene::build(std::move(desc));
-    if (!made) invalid("scene: " + made.error().message);
-    auto built = std::make_shared<Scene>(std::move(made).value());
+    return materials;
+}
+
+// A built scene for a render: whether it is the last render's whole (only the camera set
+// again) or with its BVH kept (new materials, lights and world), and the seconds spent making it.
+struct BuiltScene {
+    std::shared_ptr<Scene> scene;
+    bool reused = false, geometry_reused = false;
+    double seconds = 0;
+};
+
+// The scene built with this render's materials. The last render's build is reused whole when
+// the render settings and everything but the camera are the same (the camera is set again
+// when no other render is using it), and its BVH when only the shading changed.
+BuiltScene built_scene(hairis_scene &scene, const RenderOptions &o) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string key = build_key(o);
+    unsigned camera = 0;
+    std::shared_ptr<Scene> kept;  // the last build, taken out of the handle while it is shaded anew
+    {
+        std::lock_guard<std::mutex> lock(scene.build_mutex);
+        camera = scene.camera_revision;
+        if (scene.built && scene.built_key == key) {
+            if (scene.built_camera == camera) return {scene.built, true, true, 0.0};
+            if (scene.built.use_count() == 1) {
+                ok_or_invalid(scene.built->set_camera(scene.desc.camera), "camera: ");
+                scene.built_camera = camera;
+                return {scene.built, true, true, 0.0};
+            }
+        }
+        if (scene.built && scene.built.use_count() == 1 && scene.built_geometry_key == geometry_key(o))
+            kept = std::move(scene.built);
+        // Free the old build before making the new one (a render using it keeps it alive).
+        scene.built.reset();
+        scene.built_key.clear();
+    }
+    SceneDesc shading;
+    shading.materials = render_materials(scene, o);
+    shading.suns = scene.desc.suns;
+    shading.point_lights = scene.desc.point_lights;
+    shading.spot_lights = scene.desc.spot_lights;
+    shading.area_lights = scene.desc.area_lights;
+    shading.world = scene.desc.world;
+    std::shared_ptr<Scene> built;
+    const bool geometry_reused = kept != nullptr;
+    if (kept) {
+        ok_or_invalid(kept->set_shading(std::move(shading)), "scene: ");
+        ok_or_invalid(kept->set_camera(scene.desc.camera), "camera: ");
+        built = std::move(kept);
+    } else {
+        // The scene description with this render's materials. The handle keeps its own copy
+        // of the geometry so that it can be rendered again with other settings.
+        SceneDesc desc = scene.desc;
+        desc.materials = std::move(shading.materials);
+        desc.curve_backfaces = o.curve_backfaces;
+        desc.curve_shape = o.curve_shape;
+        Expected<Scene> made = Scene::build(std::move(desc));
+        if (!made) invalid("scene: " + made.error().message);
+        built = std::make_shared<Scene>(std::move(made).value());
+    }
     std::lock_guard<std::mutex> lock(scene.build_mutex);
     scene.built = built;
     scene.built_key = key;
+    scene.built_geometry_key = geometry_key(o);
     scene.built_camera = camera;
-    return {built, false};
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return {built, false, geometry_reused, seconds};
 }
 
 // hairis_render and hairis_render_progressive: the scene built with this render's materials,
@@ -241,14 +283,15 @@ int render_scene(const char *function, hairis_scene *scene, const char *settings
         read_options(settings, "render settings", o);
         if (!scene->has_camera) invalid("scene has no camera: call hairis_scene_set_camera before " + std::string(function));
 
-        const auto [built, reused] = built_scene(*scene, o);
+        const BuiltScene built = built_scene(*scene, o);
 
         RenderStats stats;
-        const Status status = render_progressive(*built, o.render, rgba, passes, update, &stats, schedule);
+        const Status status = render_progressive(*built.scene, o.render, rgba, passes, update, &stats, schedule);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         t_last_stats = format_options({{"seconds", format_number(seconds)},
-                                       {"build_seconds", format_number(reused ? 0.0 : built->stats().build_seconds)},
-                                       {"scene_reused", reused ? "1" : "0"},
+                                       {"build_seconds", format_number(built.seconds)},
+                                       {"scene_reused", built.reused ? "1" : "0"},
+                                       {"geometry_reused", built.geometry_reused ? "1" : "0"},
                                        {"camera_rays", std::to_string(stats.camera_rays)},
                                        {"rays", std::to_string(stats.rays)},
                                        {"shadow_rays", std::to_string(stats.shadow_rays)},

@@ -401,7 +401,7 @@ HAIRIS_API void hairis_scene_destroy(hairis_scene *scene) {
 HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_fiber *fiber,
                                               const hairis_tables *tables) {
     return guard_value<int>("hairis_scene_add_hair_material", -1, [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         require(fiber, "fiber");
         if (!fiber->chiang && !fiber->huang)
@@ -419,7 +419,7 @@ HAIRIS_API int hairis_scene_add_hair_material(hairis_scene *scene, const hairis_
 HAIRIS_API int hairis_scene_add_hair_mixture(hairis_scene *scene, size_t count, const int *materials,
                                              const float *weights) {
     return guard_value<int>("hairis_scene_add_hair_mixture", -1, [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         if (count < 1 || count > size_t(kMaxHairClosures))
             invalid("hair mixture: count must be in [1, " + std::to_string(kMaxHairClosures) + "] (got " +
@@ -451,7 +451,7 @@ HAIRIS_API int hairis_scene_add_hair_mixture(hairis_scene *scene, size_t count, 
 
 HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char *options) {
     return guard_value<int>("hairis_scene_add_surface_material", -1, [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         return add_material(*scene, surface_material(*scene, options));
     });
@@ -459,7 +459,7 @@ HAIRIS_API int hairis_scene_add_surface_material(hairis_scene *scene, const char
 
 HAIRIS_API int hairis_scene_add_texture(hairis_scene *scene, const char *options) {
     return guard_value<int>("hairis_scene_add_texture", -1, [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         const TextureOptions o = read_texture_options(options, false);
         Expected<EnvironmentImage> image = load_environment_image(o.image, ImageColorSpace(o.color_space));
@@ -472,7 +472,7 @@ HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *
                                                const float *pixels, size_t width, size_t height,
                                                int channels) {
     return guard_value<int>("hairis_scene_add_texture_pixels", -1, [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         const TextureOptions o = read_texture_options(options, true);
         const long long count = checked_pixels("texture", int(o.color_space), pixels, width, height, channels);
@@ -486,7 +486,7 @@ HAIRIS_API int hairis_scene_add_texture_pixels(hairis_scene *scene, const char *
 HAIRIS_API int hairis_scene_set_mesh_attribute(hairis_scene *scene, const char *options,
                                                const float *values, size_t count) {
     return guard_status("hairis_scene_set_mesh_attribute", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_build();  // new geometry needs a new BVH
         require(scene, "scene");
         MeshAttributeOptions o;
         read_options(options, "mesh attribute", o);
@@ -525,7 +525,7 @@ HAIRIS_API int hairis_scene_add_curves(hairis_scene *scene, int material, size_t
                                        const uint32_t *first, size_t point_count,
                                        const float *positions, const float *radii) {
     return guard_status("hairis_scene_add_curves", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_build();  // new geometry needs a new BVH
         HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
         if (curve_count > 0) add(*scene, std::move(curves));
         return HAIRIS_OK;
@@ -538,7 +538,7 @@ HAIRIS_API int hairis_scene_add_curves_with_inputs(hairis_scene *scene, int mate
                                                    const char *inputs, size_t value_count,
                                                    const float *values) {
     return guard_status("hairis_scene_add_curves_with_inputs", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_build();  // new geometry needs a new BVH
         HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
         CurveInputOptions o;
         read_options(inputs, "curve inputs", o);
@@ -609,7 +609,7 @@ HAIRIS_API int hairis_scene_add_curves_with_normals(hairis_scene *scene, int mat
                                                     const float *positions, const float *radii,
                                                     const float *normals, const char *options) {
     return guard_status("hairis_scene_add_curves_with_normals", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_build();  // new geometry needs a new BVH
         HairCurves curves = checked_curves(scene, material, curve_count, first, point_count, positions, radii);
         require_array(normals, point_count, "normals");
         CurveOptions o;
@@ -629,7 +629,7 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
                                      const float *positions, size_t triangle_count,
                                      const uint32_t *indices, const int32_t *materials) {
     return guard_status("hairis_scene_add_mesh", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_build();  // new geometry needs a new BVH
         require(scene, "scene");
         require_batch_size(vertex_count, 3, "vertex_count");
         require_batch_size(triangle_count, 3, "triangle_count");
@@ -676,7 +676,7 @@ HAIRIS_API int hairis_scene_add_mesh(hairis_scene *scene, size_t vertex_count,
 
 HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_add_light", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         const std::string what =
             "light " + std::to_string(scene->desc.suns.size() + scene->desc.point_lights.size() +
@@ -749,7 +749,7 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
 
 HAIRIS_API int hairis_scene_set_world(hairis_scene *scene, const char *options) {
     return guard_status("hairis_scene_set_world", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         WorldOptions o;
         const OptionReader reader = read_world_options(options, o, false);
@@ -772,7 +772,7 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
                                              const float *pixels, size_t width, size_t height,
                                              int channels) {
     return guard_status("hairis_scene_set_world_pixels", [&] {
-        if (scene) scene->forget_build();  // any change but the camera needs a new build
+        if (scene) scene->forget_shading();  // the BVH stays
         require(scene, "scene");
         WorldOptions o;
         const OptionReader reader = read_world_options(options, o, true);
@@ -781,6 +781,22 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
             pixels, count, int(width), int(height), channels, ImageColorSpace(o.color_space));
         if (!image) invalid("world: pixels: " + image.error().message);
         scene->desc.world = environment_world(reader, o, std::move(image).value());
+        return HAIRIS_OK;
+    });
+}
+
+HAIRIS_API int hairis_scene_reset_shading(hairis_scene *scene) {
+    return guard_status("hairis_scene_reset_shading", [&] {
+        if (scene) scene->forget_shading();  // the BVH stays
+        require(scene, "scene");
+        const SceneDesc fresh;
+        scene->materials.clear();
+        scene->textures.clear();
+        scene->desc.suns.clear();
+        scene->desc.point_lights.clear();
+        scene->desc.spot_lights.clear();
+        scene->desc.area_lights.clear();
+        scene->desc.world = fresh.world;
         return HAIRIS_OK;
     });
 }

@@ -1372,6 +1372,17 @@ int hairis_scene_set_world_pixels(hairis_scene *s, const char *text, const float
     return HAIRIS_OK;
 }
 
+int hairis_scene_reset_shading(hairis_scene *s)
+{
+    if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");
+    s->material_count = 0;
+    s->texture_count = 0;
+    s->suns = s->points = s->areas = 0;
+    for (int k = 0; k < 3; ++k) s->world[k] = 0.0f;
+    clear_error();
+    return HAIRIS_OK;
+}
+
 int hairis_scene_set_camera(hairis_scene *s, const char *text)
 {
     if (!s) return fail(HAIRIS_ERROR_INVALID_ARGUMENT, "scene must not be NULL");

@@ -1528,12 +1528,59 @@ static void test_render(void)
         CHECK(memcmp(rgba, fresh, sizeof fresh) == 0, "the reused build renders as a fresh one");
         CHECK(hairis_scene_add_light(scene, "type=point;position=0,0,1;power=40") == HAIRIS_OK, "a light");
         CHECK(hairis_render(scene, settings, again, NULL, NULL) == HAIRIS_OK, "render after the light");
-        CHECK(stat_of("scene_reused") == 0, "a changed scene builds anew: \"%s\"", hairis_last_render_stats());
+        CHECK(stat_of("scene_reused") == 0 && stat_of("geometry_reused") == 1,
+              "a new light shades anew on the same BVH: \"%s\"", hairis_last_render_stats());
         CHECK(memcmp(rgba, again, sizeof again) != 0, "and the light shows");
         CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2"), again, NULL, NULL) ==
                   HAIRIS_OK, "other strategy");
-        CHECK(stat_of("scene_reused") == 0, "another strategy builds anew");
+        CHECK(stat_of("scene_reused") == 0 && stat_of("geometry_reused") == 1,
+              "another strategy shades anew on the same BVH");
+        CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2;curve_shape=ribbons"), again,
+                            NULL, NULL) == HAIRIS_OK, "other curve shape");
+        CHECK(stat_of("geometry_reused") == 0, "another curve shape builds a new BVH");
+        CHECK(add_strands(scene, 0) == HAIRIS_OK, "more curves");
+        CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2;curve_shape=ribbons"), again,
+                            NULL, NULL) == HAIRIS_OK, "render after more curves");
+        CHECK(stat_of("geometry_reused") == 0, "new curves build a new BVH");
         hairis_scene_destroy(other);
+        hairis_scene_destroy(scene);
+        scene = make_scene("", g_tables);
+    }
+
+    /* hairis_scene_reset_shading keeps the geometry and its BVH: new materials, lights and world
+     * render as a fresh scene made with them, bit for bit; materials that do not fit the
+     * geometry are refused, naming what does not fit. */
+    {
+        static float fresh[W * H * 4];
+        const char *settings = tiny_settings(s, "table", ";seed=5;threads=2");
+        const char *red = "type=diffuse;color=0.8,0.2,0.1;emission=0,0,0";
+        const char *lamp = "type=point;position=0,0,1;power=40";
+        CHECK(hairis_render(scene, settings, rgba, NULL, NULL) == HAIRIS_OK, "render before the edit");
+        CHECK(hairis_scene_reset_shading(scene) == HAIRIS_OK, "reset_shading");
+        CHECK_NO_ERROR();
+        hairis_fiber *fiber = hairis_fiber_create("");
+        CHECK(hairis_scene_add_hair_material(scene, fiber, g_tables) == 0, "hair material again at 0");
+        CHECK(hairis_scene_add_surface_material(scene, red) == 1, "another surface at 1");
+        CHECK(hairis_scene_add_light(scene, lamp) == HAIRIS_OK, "another light");
+        CHECK(hairis_scene_set_world(scene, SKY) == HAIRIS_OK, "world");
+        CHECK(hairis_render(scene, settings, again, NULL, NULL) == HAIRIS_OK, "render after the edit");
+        CHECK(stat_of("geometry_reused") == 1 && stat_of("scene_reused") == 0,
+              "the edit keeps the BVH: \"%s\"", hairis_last_render_stats());
+        hairis_scene *other = make_scene_of("", g_tables, red, lamp, SKY, CAMERA);
+        CHECK(hairis_render(other, settings, fresh, NULL, NULL) == HAIRIS_OK, "fresh scene of the edit");
+        CHECK(stat_of("geometry_reused") == 0, "a fresh scene builds its BVH");
+        CHECK(memcmp(again, fresh, sizeof fresh) == 0, "the edit renders as a fresh scene");
+        CHECK(memcmp(again, rgba, sizeof rgba) != 0, "and the edit shows");
+        hairis_scene_destroy(other);
+        CHECK(hairis_scene_reset_shading(scene) == HAIRIS_OK, "reset_shading again");
+        CHECK(hairis_scene_add_hair_material(scene, fiber, g_tables) == 0, "hair at 0");
+        CHECK(hairis_scene_add_hair_material(scene, fiber, g_tables) == 1, "hair at 1, where the floor's was");
+        CHECK(hairis_render(scene, settings, again, NULL, NULL) == HAIRIS_ERROR_INVALID_ARGUMENT &&
+                  strstr(hairis_last_error(), "mesh 0: material 1 is a hair material") != NULL,
+              "a floor on a hair material is refused: \"%s\"", hairis_last_error());
+        CHECK(hairis_scene_reset_shading(NULL) == HAIRIS_ERROR_INVALID_ARGUMENT &&
+                  strstr(hairis_last_error(), "scene") != NULL, "reset_shading(NULL)");
+        hairis_fiber_destroy(fiber);
         hairis_scene_destroy(scene);
         scene = make_scene("", g_tables);
     }

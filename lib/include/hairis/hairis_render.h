@@ -194,6 +194,16 @@ HAIRIS_API int hairis_scene_set_world_pixels(hairis_scene *scene, const char *op
  * orthographic (0 | 1), frame (Camera.view_frame's 4 corners in camera space, 12 numbers: top
  * right, bottom right, bottom left, top left), width and height in pixels.
  */
+/**
+ * Removes the scene's materials, textures, lights and world, keeping its curves, meshes, mesh
+ * attributes and camera, so that an edit of materials or lights is sent without the geometry:
+ * add the materials again in their first order (curves and meshes keep the material indices
+ * they were added with), then textures, lights and world. The next render keeps the BVH built
+ * for the geometry (see hairis_render) and checks the new materials against it as it checks a
+ * new scene: a mesh on a hair material, a material index out of range or curve inputs the new
+ * material does not read are refused (HAIRIS_ERROR_INVALID_ARGUMENT, naming them).
+ */
+HAIRIS_API int hairis_scene_reset_shading(hairis_scene *scene);
 HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options);
 /**
  * Renders into rgba (width·height·4 floats, bottom row first, as Blender's render result
@@ -226,7 +236,10 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
  * sampler, integrator, huang_sampling, curve_backfaces and curve_shape are the last render's
  * reuses it with the current camera (build_seconds 0, scene_reused 1), so a new view costs no
- * new BVH; any other hairis_scene_* call frees it. hairis_scene_destroy frees it too.
+ * new BVH. While its curves and meshes stay and no other render uses it, its BVH is kept for a
+ * render with other materials, textures, lights or world (hairis_scene_reset_shading) or other
+ * settings with the same curve_backfaces and curve_shape (geometry_reused 1); adding curves,
+ * meshes or mesh attributes frees it. hairis_scene_destroy frees it too.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
                              hairis_progress_fn progress, void *user);
@@ -284,10 +297,10 @@ typedef int (*hairis_update_fn)(void *user, float progress, int samples_done, in
 HAIRIS_API int hairis_render_progressive(hairis_scene *scene, const char *settings, float *rgba,
                                          float *passes, hairis_update_fn update, void *user);
 /** What the calling thread's last hairis_render or hairis_render_progressive did, as options:
- * seconds (the whole call), build_seconds (the scene and BVH build within it, 0 when
- * scene_reused is 1: the last render's build with a new camera), camera_rays,
- * rays, shadow_rays, dropped_samples, peak_memory_bytes, threads, cancelled, samples,
- * converged_pixels; "" before any render. */
+ * seconds (the whole call), build_seconds (making the scene within it, 0 when scene_reused
+ * is 1: the last render's build with a new camera), geometry_reused (1 when the BVH was the
+ * last render's), camera_rays, rays, shadow_rays, dropped_samples, peak_memory_bytes, threads,
+ * cancelled, samples, converged_pixels; "" before any render. */
 HAIRIS_API const char *hairis_last_render_stats(void);
 
 #ifdef __cplusplus
