@@ -266,6 +266,52 @@ def add_surface_nodes(scene, nodes, texture_index):
     return added[-1]
 
 
+def _add_materials(scene, data, hair_tables):
+    """Adds ``data``'s materials (and the textures they use) to ``scene`` in their order."""
+    textures = {}  # position in data.textures → the library's texture index
+
+    def texture_index(position):
+        if position not in textures:
+            texture = data.textures[position]
+            values = texture.options()
+            if texture.path is not None:
+                textures[position] = scene.add_texture(dict(values, image=texture.path))
+            else:
+                textures[position] = scene.add_texture(values, texture.pixels)
+        return textures[position]
+
+    indices = []
+    for i, material in enumerate(data.materials):
+        try:
+            if material.kind == "HAIR":
+                indices.append(scene.add_hair_material(material.hair.as_dict(),
+                                                       hair_tables.get(i)))
+            elif material.kind == "HAIR_MIX":
+                indices.append(scene.add_hair_mixture(
+                    [indices[k] for k in material.mixture.closures],
+                    material.mixture.material_weights()))
+            elif material.kind == "SURFACE":
+                indices.append(add_surface_nodes(scene, material.nodes, texture_index))
+            else:
+                indices.append(scene.add_diffuse_material(material.albedo, material.emission))
+        except native.HairisError as error:
+            raise RenderFailed("material %r: %s" % (material.name, error.message)) from error
+    return np.array(indices or [0], dtype=np.int32)
+
+
+def _add_lights_and_world(scene, data):
+    """Adds ``data``'s lights and sets its world."""
+    for light in data.lights:
+        scene.add_light(light_options(light))
+    environment = data.world_environment
+    if environment is None:
+        scene.set_world(data.world_color, data.world_strength)
+    elif environment.path is not None:
+        scene.set_world_options(dict(environment.options(), image=environment.path))
+    else:
+        scene.set_world_pixels(environment.options(), environment.pixels)
+
+
 def build_native_scene(library, data, hair_tables):
     """A ``native.Scene`` holding everything in ``data`` (SceneData).
 
@@ -275,44 +321,7 @@ def build_native_scene(library, data, hair_tables):
     """
     scene = library.scene()
     try:
-        indices = []
-        textures = {}  # position in data.textures → the library's texture index
-
-        def texture_index(position):
-            if position not in textures:
-                texture = data.textures[position]
-                values = texture.options()
-                if texture.path is not None:
-                    textures[position] = scene.add_texture(dict(values, image=texture.path))
-                else:
-                    textures[position] = scene.add_texture(values, texture.pixels)
-            return textures[position]
-
-        for i, material in enumerate(data.materials):
-            if material.kind == "HAIR":
-                try:
-                    indices.append(scene.add_hair_material(material.hair.as_dict(),
-                                                           hair_tables.get(i)))
-                except native.HairisError as error:
-                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
-                        from error
-            elif material.kind == "HAIR_MIX":
-                try:
-                    indices.append(scene.add_hair_mixture(
-                        [indices[k] for k in material.mixture.closures],
-                        material.mixture.material_weights()))
-                except native.HairisError as error:
-                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
-                        from error
-            elif material.kind == "SURFACE":
-                try:
-                    indices.append(add_surface_nodes(scene, material.nodes, texture_index))
-                except native.HairisError as error:
-                    raise RenderFailed("material %r: %s" % (material.name, error.message)) \
-                        from error
-            else:
-                indices.append(scene.add_diffuse_material(material.albedo, material.emission))
-        remap = np.array(indices or [0], dtype=np.int32)
+        remap = _add_materials(scene, data, hair_tables)
         for curves in data.curves:
             if curves.inputs:
                 scene.add_curves_with_inputs(int(remap[curves.material]), curves.first,
@@ -326,15 +335,7 @@ def build_native_scene(library, data, hair_tables):
                 scene.set_mesh_attribute("normal", mesh.normals)
             if mesh.uvs is not None:
                 scene.set_mesh_attribute("uv", mesh.uvs)
-        for light in data.lights:
-            scene.add_light(light_options(light))
-        environment = data.world_environment
-        if environment is None:
-            scene.set_world(data.world_color, data.world_strength)
-        elif environment.path is not None:
-            scene.set_world_options(dict(environment.options(), image=environment.path))
-        else:
-            scene.set_world_pixels(environment.options(), environment.pixels)
+        _add_lights_and_world(scene, data)
         if data.camera is not None:
             scene.set_camera(camera_options(data.camera))
     except BaseException:
@@ -343,20 +344,53 @@ def build_native_scene(library, data, hair_tables):
     return scene
 
 
-def _needs_export(depsgraph):
-    """True when a depsgraph update changed the scene the viewport renders (geometry,
-    transforms, materials, lights, the world); the scene itself and cameras do not count,
-    since view_draw follows the view and the render settings."""
+def reshade_native_scene(scene, data, hair_tables):
+    """Gives ``scene`` (built from a SceneData of the same geometry) ``data``'s materials,
+    lights and world; the library keeps the BVH it built."""
+    scene.reset_shading()
+    _add_materials(scene, data, hair_tables)
+    _add_lights_and_world(scene, data)
+
+
+SHADING_DATA = ("Material", "World", "Light", "ShaderNodeTree", "Image", "Texture")
+"""bpy.types of the data blocks whose edits change the viewport's shading but no geometry."""
+
+
+def _update_kind(depsgraph):
+    """What a depsgraph update changed in the scene the viewport renders: None (nothing: the
+    scene's settings and cameras count as nothing, since view_draw follows the view and the
+    render settings), 'shading' (materials, lights, the world) or 'geometry' (anything else).
+    An edit of a material also flags the objects using it as changed in geometry (materials
+    can displace), so that flag counts only when no shading data changed with it."""
+    shading_types = tuple(getattr(bpy.types, name) for name in SHADING_DATA)
+    kind, reshaped = None, False
     for update in depsgraph.updates:
         data = update.id
-        if isinstance(data, bpy.types.Object) and data.type == "CAMERA":
-            continue  # the viewport renders the view, not the scene camera
-        if isinstance(data, bpy.types.Scene) and not (
-                update.is_updated_geometry or update.is_updated_transform
-                or update.is_updated_shading):
-            continue  # a setting: view_draw compares the render settings
-        return True
-    return False
+        if isinstance(data, bpy.types.Object):
+            if data.type == "CAMERA":
+                continue  # the viewport renders the view, not the scene camera
+            if data.type != "LIGHT":
+                if update.is_updated_transform:
+                    return "geometry"
+                reshaped = reshaped or update.is_updated_geometry
+            kind = "shading"
+        elif isinstance(data, bpy.types.Scene):
+            if update.is_updated_geometry or update.is_updated_transform:
+                return "geometry"
+            if update.is_updated_shading:
+                kind = "shading"
+            # else a setting: view_draw compares the render settings
+        elif isinstance(data, shading_types):
+            kind = "shading"
+        elif update.is_updated_geometry or update.is_updated_transform:
+            return "geometry"  # object data: a mesh, curves, particle settings, ...
+        elif update.is_updated_shading:
+            kind = "shading"
+        else:
+            return "geometry"
+    if reshaped and not any(isinstance(u.id, shading_types) for u in depsgraph.updates):
+        return "geometry"
+    return kind
 
 
 class _ViewExporter(export._Exporter):
@@ -519,10 +553,12 @@ class HairisRenderEngine(bpy.types.RenderEngine):
     # -- viewport --
 
     def view_update(self, context, depsgraph):
-        """Exports the scene for the viewport when it is new or its data changed (materials,
-        lights, objects, the world); view changes alone are :meth:`view_draw`'s."""
+        """Exports the scene for the viewport when it is new or its data changed: an edit of
+        materials, lights or the world alone exports only those, and the worker keeps the
+        geometry it built; view changes alone are :meth:`view_draw`'s."""
         render = getattr(self, "_viewport", None)
-        if render is not None and not _needs_export(depsgraph):
+        kind = _update_kind(depsgraph) if render is not None else "geometry"
+        if kind is None:
             return
         try:
             problem = compat.version_problem()
@@ -537,7 +573,16 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                     library, lambda: redraw() is not None and redraw()())
                 self._display = viewport.Display()
                 self._view_key = None
-            render.set_scene(self._scene_job(render.library, depsgraph))
+            shown = getattr(self, "_viewport_job", None)
+            job = None
+            if kind == "shading" and shown is not None:
+                data = export.export_shading(depsgraph, shown.data)
+                if data is not None:
+                    job = self._scene_job(render.library, depsgraph, data, shown.geometry)
+            if job is None:
+                job = self._scene_job(render.library, depsgraph)
+            render.set_scene(job)
+            self._viewport_job = job
             self._viewport_error = None
         except (RenderFailed, export.ExportError, tables.TableError,
                 native.HairisError) as error:
@@ -585,10 +630,12 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         except ReferenceError:  # the engine is being freed
             pass
 
-    def _scene_job(self, library, depsgraph):
+    def _scene_job(self, library, depsgraph, data=None, geometry=None):
         """The viewport's :class:`viewport.SceneJob`: the scene exported now (without a
-        camera), current or cached tables, and what the worker must bake."""
-        data = _export_view(depsgraph)
+        camera) or ``data`` (an update of the materials, lights and world of the job whose
+        ``geometry`` it keeps), current or cached tables, and what the worker must bake."""
+        if data is None:
+            data = _export_view(depsgraph)
         settings = depsgraph.scene.hairis
         bakes = []
 
@@ -605,12 +652,13 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             return None
 
         found = self._resolve_tables(library, data, settings, bake_later)
-        return viewport.SceneJob(data, found, bakes)
+        return viewport.SceneJob(data, found, bakes, geometry=geometry)
 
     def free_viewport(self):
         """Stops the viewport's worker thread (the view closed or the engine goes)."""
         render = getattr(self, "_viewport", None)
         self._viewport = None
+        self._viewport_job = None
         if render is not None:
             render.stop()
 

@@ -30,7 +30,7 @@ negative lobe multipliers as 0, and all three ≤ 0 as no closure at all (black,
 
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import bpy
 import numpy as np
@@ -305,6 +305,11 @@ class SceneData:
     """Set when the world is an Environment Texture (then world_color is not used)."""
     camera: CameraData = None
     warnings: list = field(default_factory=list)
+    material_calls: list = field(default_factory=list)
+    """(material name_full or None, for_hair) of each first request of a material, in order: the
+    order :func:`export_shading` asks for them again (None, None: the default material)."""
+    slot_signature: tuple = None
+    """:func:`slot_signature` of the exported depsgraph."""
 
     def warn(self, message):
         """Records a warning once."""
@@ -785,6 +790,7 @@ class _Exporter:
         if self._default_index is None:
             self._default_index = len(self.data.materials)
             self.data.materials.append(MaterialData(name="(default)", kind="DIFFUSE"))
+            self.data.material_calls.append((None, None))
         return self._default_index
 
     def material(self, material, for_hair):
@@ -795,6 +801,7 @@ class _Exporter:
         index = self._material_index.get(key)
         if index is not None:
             return index
+        self.data.material_calls.append(key)
         node = hair_node(material)
         if node is None and for_hair and is_hair_material(material):
             index = self.hair_mixture(material)
@@ -947,6 +954,25 @@ class _Exporter:
         problem = memory_problem(self.data, available_memory_bytes())
         if problem:
             raise ExportError(problem)
+        self.data.slot_signature = slot_signature(self.depsgraph)
+        return self.data
+
+    def run_shading(self, previous):
+        """Exports the world, the lights and the materials ``previous`` (a SceneData of the
+        same depsgraph's geometry) asked for, in its order; None when a material it names is
+        gone."""
+        self.export_world()
+        for name, for_hair in previous.material_calls:
+            if for_hair is None:
+                self.default_material()
+                continue
+            material = _material_named(name, self.depsgraph) if name is not None else None
+            if name is not None and material is None:
+                return None
+            self.material(material, for_hair)
+        for instance in self.depsgraph.object_instances:
+            if instance.object.type == "LIGHT":
+                self.export_light(instance.object, _matrix(instance.matrix_world))
         return self.data
 
     def export_camera(self):
@@ -1447,6 +1473,68 @@ def memory_problem(data, available):
             "render, more than the %.1f GB of memory available: render fewer strands (fewer "
             "children or curves, or fewer points per strand)"
             % (len(data.curves), strands, points, need / 1e9, available / 1e9))
+
+
+def _material_named(name_full, depsgraph):
+    """The evaluated material whose ``name_full`` is ``name_full``, or None."""
+    for material in bpy.data.materials:
+        if material.name_full == name_full:
+            return material.evaluated_get(depsgraph)
+    return None
+
+
+def slot_signature(depsgraph):
+    """Which material each rendered object's slots and hair systems use: a changed material
+    assignment changes it (the depsgraph does not always flag it as a geometry change)."""
+    signature = []
+    for instance in depsgraph.object_instances:
+        obj = instance.object
+        if obj.type in {"LIGHT", "CAMERA"}:
+            continue
+        slots = tuple(slot.material.name_full if slot.material else None
+                      for slot in obj.material_slots)
+        systems = tuple(psys.settings.material for psys in getattr(obj, "particle_systems", ()))
+        signature.append((obj.name_full, slots, systems))
+    return tuple(signature)
+
+
+def _shading_only(material):
+    """True when a material's shading lives in the material alone: not per strand (Hair Info
+    chains, mixture weights per strand) and not along curve normals (an elliptical fiber)."""
+    if material.kind == "HAIR":
+        return not material.hair.strand_inputs and not material.hair.oriented
+    if material.kind == "HAIR_MIX":
+        return not material.mixture.strand_inputs and all(
+            w.domain == "material" for w in material.mixture.weights)
+    return True
+
+
+def export_shading(depsgraph, previous):
+    """``previous`` (the SceneData last exported from this depsgraph) with its materials,
+    textures, lights and world exported again, its geometry kept: what an edit of materials,
+    lights or the world changes. None when that is not enough and the whole scene must be
+    exported: material slots assigned otherwise, a material gone or of another kind or number
+    of closures, or a material whose strands carry values of their own (per-strand inputs or
+    weights, curve normals)."""
+    if previous.slot_signature is None or slot_signature(depsgraph) != previous.slot_signature:
+        return None
+    shading = _Exporter(depsgraph).run_shading(previous)
+    if shading is None or len(shading.materials) != len(previous.materials):
+        return None
+    for old, new in zip(previous.materials, shading.materials):
+        if old.kind != new.kind or not (_shading_only(old) and _shading_only(new)):
+            return None
+        if old.kind == "HAIR_MIX" and old.mixture.closures != new.mixture.closures:
+            return None
+    warnings = list(previous.warnings)
+    for warning in shading.warnings:
+        if warning not in warnings:
+            warnings.append(warning)
+    return replace(
+        previous, materials=shading.materials, textures=shading.textures,
+        lights=shading.lights, world_color=shading.world_color,
+        world_strength=shading.world_strength, world_environment=shading.world_environment,
+        warnings=warnings)
 
 
 def export_scene(depsgraph, camera=None):

@@ -37,13 +37,16 @@ _LIVE = weakref.WeakSet()
 class SceneJob:
     """What the worker needs to build the native scene: the exported data, the tables found on
     the main thread and the bakes left to do (``bakes``: (material index, fiber values,
-    bake options, cache path) each)."""
+    bake options, cache path) each). ``geometry`` names the geometry ``data`` holds: a job
+    whose geometry is the built scene's only gives that scene new materials, lights and world
+    (its BVH stays); a new object (the default) means new geometry."""
 
-    def __init__(self, data, hair_tables=None, bakes=(), build=None):
+    def __init__(self, data, hair_tables=None, bakes=(), build=None, geometry=None):
         self.data = data
         self.hair_tables = dict(hair_tables or {})
         self.bakes = list(bakes)
         self.build = build
+        self.geometry = geometry if geometry is not None else object()
 
     def close(self):
         """Releases the tables this job holds."""
@@ -99,6 +102,8 @@ class ViewportRender:
         """Progressive renders started (each restart is one more)."""
         self.scene_builds = 0
         """Native scenes built (a view change builds none)."""
+        self.scene_reshades = 0
+        """Built scenes given new materials, lights and world (their BVH kept)."""
         self.requested_at = None
         self.first_pixels_seconds = None
         """Seconds from the latest request to its first image."""
@@ -171,11 +176,16 @@ class ViewportRender:
                 generation, job, view = request
                 try:
                     if job is not built:
-                        if scene is not None:
-                            scene.close()
-                            scene = None
-                        built = None
-                        scene = self._build(job, generation)
+                        if scene is not None and built is not None and \
+                                job.geometry is built.geometry:
+                            built = None
+                            self._reshade(scene, job, generation)
+                        else:
+                            if scene is not None:
+                                scene.close()
+                                scene = None
+                            built = None
+                            scene = self._build(job, generation)
                         built = job
                     self._render(scene, view, generation)
                 except native.HairisCancelled:
@@ -193,6 +203,24 @@ class ViewportRender:
         """Bakes what the job still needs and builds its native scene (on the worker)."""
         from . import engine  # the engine module imports this one
 
+        self._bake(job, generation)
+        self.status = "Building scene"
+        build = job.build or engine.build_native_scene
+        scene = build(self.library, job.data, job.hair_tables)
+        self.scene_builds += 1
+        return scene
+
+    def _reshade(self, scene, job, generation):
+        """Bakes what the job still needs and gives the built scene its materials, lights and
+        world (on the worker)."""
+        from . import engine  # the engine module imports this one
+
+        self._bake(job, generation)
+        engine.reshade_native_scene(scene, job.data, job.hair_tables)
+        self.scene_reshades += 1
+
+    def _bake(self, job, generation):
+        """Bakes the tables the job still needs, writing each to its cache path."""
         for index, fiber_values, bake_options, cache_path in job.bakes:
             if index in job.hair_tables:
                 continue
@@ -206,11 +234,6 @@ class ViewportRender:
             except native.HairisError:
                 pass  # only the next viewport start bakes again
             job.hair_tables[index] = baked
-        self.status = "Building scene"
-        build = job.build or engine.build_native_scene
-        scene = build(self.library, job.data, job.hair_tables)
-        self.scene_builds += 1
-        return scene
 
     def _render(self, scene, view, generation):
         """A low-resolution pass, then the full resolution up to the view's samples."""

@@ -421,6 +421,128 @@ def test_viewport_refines_restarts_and_stops():
     assert not render.alive
 
 
+def update_kinds(edit):
+    """The viewport's reading (engine._update_kind) of the depsgraph updates ``edit()``
+    makes, one per update Blender reports."""
+    seen = []
+
+    def record(_scene, depsgraph):
+        seen.append(engine._update_kind(depsgraph))
+
+    bpy.app.handlers.depsgraph_update_post.append(record)
+    try:
+        edit()
+        bpy.context.view_layer.update()
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(record)
+    return [kind for kind in seen if kind is not None]
+
+
+def hair_node():
+    """The Principled Hair BSDF of make_scene's hair material."""
+    nodes = bpy.data.materials["Hair"].node_tree.nodes
+    return next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
+
+
+def test_edits_of_shading_are_told_from_geometry():
+    """A material, light or world edit reads as 'shading'; moving or reshaping an object as
+    'geometry'."""
+    make_scene()
+
+    def melanin():
+        helpers.socket(hair_node(), "Melanin").default_value = 0.6
+
+    def energy():
+        bpy.data.lights["Sun"].energy = 5.0
+
+    def world():
+        helpers.socket(bpy.context.scene.world.node_tree.nodes["Background"],
+                       "Strength").default_value = 2.0
+
+    def move():
+        bpy.data.objects["Sphere"].location.x += 0.1
+
+    def reshape():
+        bpy.data.objects["Sphere"].data.vertices[0].co.x += 0.1
+        bpy.data.objects["Sphere"].data.update()
+
+    for edit, want in ((melanin, "shading"), (energy, "shading"), (world, "shading"),
+                       (move, "geometry"), (reshape, "geometry")):
+        kinds = update_kinds(edit)
+        assert kinds, "%s: no update reached the handler" % edit.__name__
+        assert kinds[-1] == want, "%s read as %s" % (edit.__name__, kinds)
+
+
+def test_export_shading_keeps_geometry_and_knows_its_limits():
+    """export_shading re-reads materials, lights and world in the first export's order and
+    keeps its geometry arrays; a material assigned otherwise needs the whole export."""
+    make_scene()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    first = engine._export_view(depsgraph)
+    helpers.socket(hair_node(), "Melanin").default_value = 0.6
+    bpy.data.lights["Sun"].energy = 5.0
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    depsgraph.update()
+    shading = helpers.module("export").export_shading(depsgraph, first)
+    assert shading is not None
+    assert [m.name for m in shading.materials] == [m.name for m in first.materials]
+    hair = next(m for m in shading.materials if m.kind == "HAIR")
+    assert abs(hair.hair.melanin - 0.6) < 1e-6, hair.hair.melanin
+    assert shading.lights[0].strength == 5.0, shading.lights[0].strength
+    assert shading.curves[0].positions is first.curves[0].positions
+    whole = engine._export_view(depsgraph)
+    assert [m.hair for m in whole.materials] == [m.hair for m in shading.materials]
+    other = helpers.make_surface_material("Other", (0.1, 0.8, 0.1, 1.0))
+    bpy.data.objects["Sphere"].material_slots[0].material = other
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    depsgraph.update()
+    assert helpers.module("export").export_shading(depsgraph, first) is None
+
+
+def finished_frame(render, samples, generation, waiter, what):
+    """The worker's image of ``generation`` once it has all ``samples``."""
+    waiter.until(lambda: render.frame is not None and render.frame.generation >= generation
+                 and render.frame.rgba.shape[0] == 36 and render.frame.samples >= samples, what)
+    assert render.error is None, render.error
+    return render.frame.rgba.copy()
+
+
+def test_viewport_reshades_a_material_edit_without_a_new_bvh():
+    """A material edit gives the built scene new shading (no new build); its image is a fresh
+    build's of the edited scene, bit for bit."""
+    scene = make_scene(samples=8)
+    lib = native.load_library()
+    settings = engine.render_settings(scene.hairis)
+    camera = camera_of(scene)
+    waiter = Waiter()
+    render = viewport.ViewportRender(lib, waiter)
+    try:
+        first = viewport.SceneJob(engine._export_view(bpy.context.evaluated_depsgraph_get()))
+        render.set_scene(first)
+        render.set_view(viewport.ViewRequest(camera, 48, 36, settings, 8))
+        before = finished_frame(render, 8, 0, waiter, "the first image")
+        helpers.socket(hair_node(), "Melanin").default_value = 0.05
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        depsgraph.update()
+        data = helpers.module("export").export_shading(depsgraph, first.data)
+        generation = render._generation + 1
+        render.set_scene(viewport.SceneJob(data, geometry=first.geometry))
+        edited = finished_frame(render, 8, generation, waiter, "the edited image")
+        assert render.scene_builds == 1 and render.scene_reshades == 1, (
+            render.scene_builds, render.scene_reshades)
+        assert not np.array_equal(edited, before)
+    finally:
+        render.stop()
+    fresh_render = viewport.ViewportRender(lib, waiter)
+    try:
+        fresh_render.set_scene(viewport.SceneJob(engine._export_view(depsgraph)))
+        fresh_render.set_view(viewport.ViewRequest(camera, 48, 36, settings, 8))
+        fresh = finished_frame(fresh_render, 8, 0, waiter, "the fresh image")
+    finally:
+        fresh_render.stop()
+    assert np.array_equal(edited, fresh), np.abs(edited - fresh).max()
+
+
 def test_viewport_stop_while_rendering():
     """stop() in the middle of a long render returns promptly with the thread ended."""
     scene = make_scene(samples=64, resolution=(96, 72))
@@ -447,5 +569,8 @@ helpers.run([
     test_denoise_in_one_click,
     test_view_camera,
     test_viewport_refines_restarts_and_stops,
+    test_edits_of_shading_are_told_from_geometry,
+    test_export_shading_keeps_geometry_and_knows_its_limits,
+    test_viewport_reshades_a_material_edit_without_a_new_bvh,
     test_viewport_stop_while_rendering,
 ])
