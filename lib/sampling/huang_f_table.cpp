@@ -79,17 +79,26 @@ HuangFTable::Stencil HuangFTable::phi_stencil(double phi) const {
 }
 
 Rgb HuangFTable::slice(int q, int r, const Stencil &rows, const Stencil &columns) const {
-    Rgb sum;
+    std::size_t column[4];
+    for (int b = 0; b < 4; ++b) column[b] = 3 * std::size_t((columns.first + b) % phi_count_);
+    const std::size_t row_size = 3 * std::size_t(phi_count_);
+    const float *slice_values =
+        values_.data() + (std::size_t(q) * std::size_t(theta_o_count_) + std::size_t(r)) * std::size_t(theta_i_count_) * row_size;
+    float sum[3] = {0.0f, 0.0f, 0.0f};
     for (int a = 0; a < 4; ++a) {
         const int i = rows.first + a;
-        if (rows.w[std::size_t(a)] == 0.0f || i < 0 || i >= theta_i_count_) continue;  // a pole
-        Rgb row;
+        const float wa = rows.w[std::size_t(a)];
+        if (wa == 0.0f || i < 0 || i >= theta_i_count_) continue;  // a pole
+        const float *row = slice_values + std::size_t(i) * row_size;
         for (int b = 0; b < 4; ++b) {
-            row += value(q, r, i, (columns.first + b) % phi_count_) * columns.w[std::size_t(b)];
+            const float w = wa * columns.w[std::size_t(b)];
+            const float *v = row + column[b];
+            sum[0] += w * v[0];
+            sum[1] += w * v[1];
+            sum[2] += w * v[2];
         }
-        sum += row * rows.w[std::size_t(a)];
     }
-    return sum;
+    return {sum[0], sum[1], sum[2]};
 }
 
 Rgb HuangFTable::f_cos(const HuangTableQuery &q, Vec3 wi) const {
