@@ -7,9 +7,10 @@ Run by scripts/screenshot_viewport (under xvfb-run) as
 It installs the add-on, builds the demo head (tests/blender/helpers.make_demo_head), maximises
 the 3D view, switches it to Rendered shading and screenshots it refining (early, later), after
 an orbit (the render restarts with only the camera changed) and after the hair colour changed
-(the scene is exported again): <output>/viewport_early.png, viewport_later.png,
-viewport_orbit.png, viewport_colour.png. It prints the time to the first pixels, then closes
-the Rendered view (the worker thread must end) and quits; any failure exits with code 1.
+(its material is exported again, the built strands kept): <output>/viewport_early.png,
+viewport_later.png, viewport_orbit.png, viewport_colour.png. It prints the time to the first
+pixels, then closes the Rendered view (the worker thread must end) and quits; any failure exits
+with code 1.
 """
 import argparse
 import math
@@ -157,19 +158,25 @@ def after_orbit():
 
 @STEPS.add
 def colour():
-    """Changes the hair colour (the scene is exported again)."""
+    """Changes the hair colour (its material is exported again, the built strands stay)."""
     hair = bpy.data.materials["Hair"]
     node = next(n for n in hair.node_tree.nodes if n.bl_idname.startswith("ShaderNodeBsdfHair"))
     helpers.socket(node, "Melanin").default_value = 0.1
-    STATE["builds"] = renders()[0].scene_builds
+    render = renders()[0]
+    STATE["builds"], STATE["reshades"] = render.scene_builds, render.scene_reshades
 
 
 @STEPS.add
 def after_colour():
     """The blonde hair once it has a few samples."""
-    wait_for(lambda: renders()[0].scene_builds > STATE["builds"]
-             and renders()[0].frame.samples >= 8, "the new colour")
-    STEPS.queue.insert(1, lambda: shoot("viewport_colour"))
+    def changed():
+        render = renders()[0]
+        return render.scene_builds + render.scene_reshades > STATE["builds"] + STATE["reshades"]
+    wait_for(lambda: changed() and renders()[0].frame.samples >= 8, "the new colour")
+    STEPS.queue.insert(1, lambda: (shoot("viewport_colour"), print(
+        "screenshot_viewport: the colour change built the scene %d times, reshaded it %d times"
+        % (renders()[0].scene_builds - STATE["builds"],
+           renders()[0].scene_reshades - STATE["reshades"]), flush=True)))
 
 
 @STEPS.add
