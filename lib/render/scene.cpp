@@ -372,6 +372,10 @@ struct Scene::Impl {
         return std::nullopt;
     }
 
+    Status add_curves(HairCurves &hc, std::size_t s, const std::vector<Material> &desc_materials);
+    Status add_mesh(TriangleMesh &tm, std::size_t s, const std::vector<Material> &desc_materials);
+    Status build_bvh();
+
     Status embree_status(const char *what) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (embree_error.empty() && device && rtcGetDeviceError(device) == RTC_ERROR_NONE)
@@ -397,6 +401,254 @@ Status Scene::set_camera(const CameraDesc &camera) {
 const LightSet &Scene::lights() const { return impl_->lights; }
 const std::vector<Material> &Scene::materials() const { return impl_->materials; }
 const SceneStats &Scene::stats() const { return impl_->stats; }
+
+// The kept curves of curve set `s` of a SceneDesc in Embree's layout, checked; the caller's
+// buffers are freed.
+Status Scene::Impl::add_curves(HairCurves &hc, std::size_t s, const std::vector<Material> &desc_materials) {
+    const std::string set = "curve set " + std::to_string(s);
+    if (auto e = check_material_index(desc_materials, set, hc.material, false)) return *e;
+    if (hc.radii.size() != hc.points.size())
+        return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
+                     " entries but points has " + std::to_string(hc.points.size()) +
+                     " (one radius per point)"};
+    if (hc.first.empty() || hc.first.front() != 0 || hc.first.back() != hc.points.size())
+        return Error{set + ": first must start at 0 and end at the point count (" +
+                     std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
+    if (hc.points.size() > (std::size_t(1) << 31))
+        return Error{set + ": too many points (at most 2^31)"};
+    if (auto e = check_curve_inputs(hc, set, desc_materials[hc.material])) return *e;
+    if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
+        return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
+                     " entries but points has " + std::to_string(hc.points.size()) +
+                     " (one normal per point, or none)"};
+    for (std::size_t k = 0; k < hc.normals.size(); ++k)
+        if (!finite3(hc.normals[k]))
+            return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
+                         describe(hc.normals[k]) + ")"};
+    CurveGeometry geo;
+    geo.material = hc.material;
+    geo.set = s;
+    for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}, in.closure_weight});
+    std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
+    const std::size_t curve_count = hc.first.size() - 1;
+    for (std::size_t c = 0; c < curve_count; ++c) {
+        const std::uint32_t b = hc.first[c], e = hc.first[c + 1];
+        if (e < b)
+            return Error{set + ": first must not decrease (curve " + std::to_string(c) + ")"};
+        const std::uint32_t n = e - b;
+        if (n < 2)
+            return Error{set + ", curve " + std::to_string(c) + ": has " + std::to_string(n) +
+                         " point(s); a curve needs at least 2"};
+        float max_step = 0, max_radius = 0;
+        for (std::uint32_t k = b; k < e; ++k) {
+            if (!finite3(hc.points[k]))
+                return Error{set + ", curve " + std::to_string(c) + ", point " +
+                             std::to_string(k - b) + ": position must be finite (got " +
+                             describe(hc.points[k]) + ")"};
+            const float r = hc.radii[k];
+            if (!std::isfinite(r) || r < 0.0f)
+                return Error{set + ", curve " + std::to_string(c) + ", point " +
+                             std::to_string(k - b) + ": radius must be finite and >= 0 (got " +
+                             std::to_string(r) + ")"};
+            max_radius = std::max(max_radius, r);
+            if (k > b) max_step = std::max(max_step, length(hc.points[k] - hc.points[k - 1]));
+        }
+        if (!(max_step > 0.0f)) {
+            ++zero_length;
+            continue;
+        }
+        if (!(max_radius > 0.0f)) {
+            ++zero_radius;
+            continue;
+        }
+        const std::uint32_t base = std::uint32_t(geo.cvs.size());
+        auto cv = [&](std::uint32_t k) {
+            return Float4{hc.points[k].x, hc.points[k].y, hc.points[k].z, hc.radii[k]};
+        };
+        geo.cvs.push_back(cv(b));
+        for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
+        geo.cvs.push_back(cv(e - 1));
+        if (!hc.normals.empty()) {
+            geo.normals.push_back(hc.normals[b]);
+            geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
+            geo.normals.push_back(hc.normals[e - 1]);
+        }
+        const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
+        for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
+            const std::size_t k = std::size_t(components_of(hc.inputs[i]));
+            const std::vector<float> &from = hc.inputs[i].values;
+            const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
+            const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
+            geo.inputs[i].values.insert(geo.inputs[i].values.end(), from.begin() + std::ptrdiff_t(begin),
+                                        from.begin() + std::ptrdiff_t(end));
+        }
+        for (std::uint32_t k = 0; k + 1 < n; ++k) {
+            geo.segments.push_back(base + k);
+            geo.curve_of.push_back(curve_index);
+        }
+        ++stats.curves;
+        stats.curve_points += n;
+    }
+    if (zero_length)
+        stats.warnings.push_back(set + ": skipped " + std::to_string(zero_length) +
+                                 " curve(s) of zero length");
+    if (zero_radius)
+        stats.warnings.push_back(set + ": skipped " + std::to_string(zero_radius) +
+                                 " curve(s) of zero radius");
+    stats.skipped_curves += zero_length + zero_radius;
+    stats.curve_segments += geo.segments.size();
+    // Free the caller's copy early: the scene keeps its own Embree layout.
+    hc.points = {};
+    hc.radii = {};
+    hc.first = {};
+    hc.inputs = {};
+    hc.normals = {};
+    if (!geo.segments.empty()) curves.push_back(std::move(geo));
+    return std::nullopt;
+}
+
+// The kept triangles of mesh `s` of a SceneDesc, checked; the caller's buffers are freed.
+Status Scene::Impl::add_mesh(TriangleMesh &tm, std::size_t s, const std::vector<Material> &desc_materials) {
+    const std::string name = "mesh " + std::to_string(s);
+    if (tm.indices.size() % 3 != 0)
+        return Error{name + ": indices has " + std::to_string(tm.indices.size()) +
+                     " entries, not a multiple of 3"};
+    const std::size_t tri_count = tm.indices.size() / 3;
+    if (tm.materials.size() != 1 && tm.materials.size() != tri_count)
+        return Error{name + ": materials must hold 1 entry or one per triangle (" +
+                     std::to_string(tri_count) + "), got " +
+                     std::to_string(tm.materials.size())};
+    for (std::size_t v = 0; v < tm.positions.size(); ++v)
+        if (!finite3(tm.positions[v]))
+            return Error{name + ", vertex " + std::to_string(v) +
+                         ": position must be finite (got " + describe(tm.positions[v]) + ")"};
+    for (std::uint32_t m : tm.materials)
+        if (auto e = check_material_index(desc_materials, name, m, true)) return *e;
+    if (!tm.normals.empty() && tm.normals.size() != tm.indices.size())
+        return Error{name + ": normals has " + std::to_string(tm.normals.size()) +
+                     " entries; it needs one per triangle corner (" +
+                     std::to_string(tm.indices.size()) + ") or none"};
+    if (!tm.uvs.empty() && tm.uvs.size() != 2 * tm.indices.size())
+        return Error{name + ": uvs has " + std::to_string(tm.uvs.size()) +
+                     " floats; it needs a (u, v) pair per triangle corner (" +
+                     std::to_string(2 * tm.indices.size()) + " floats) or none"};
+    for (std::size_t k = 0; k < tm.normals.size(); ++k)
+        if (!finite3(tm.normals[k]) || !(length(tm.normals[k]) > 0.0f))
+            return Error{name + ", corner " + std::to_string(k) +
+                         ": normal must be finite and not zero (got " + describe(tm.normals[k]) + ")"};
+    for (std::size_t k = 0; k < tm.uvs.size(); ++k)
+        if (!std::isfinite(tm.uvs[k]))
+            return Error{name + ", corner " + std::to_string(k / 2) + ": uv must be finite"};
+    MeshGeometry geo;
+    geo.mesh = s;
+    std::size_t degenerate = 0;
+    for (std::size_t t = 0; t < tri_count; ++t) {
+        const std::uint32_t i0 = tm.indices[3 * t], i1 = tm.indices[3 * t + 1],
+                            i2 = tm.indices[3 * t + 2];
+        if (i0 >= tm.positions.size() || i1 >= tm.positions.size() ||
+            i2 >= tm.positions.size())
+            return Error{name + ", triangle " + std::to_string(t) +
+                         ": vertex index out of range (the mesh has " +
+                         std::to_string(tm.positions.size()) + " vertices)"};
+        const Vec3 p0 = tm.positions[i0], p1 = tm.positions[i1], p2 = tm.positions[i2];
+        if (!(length(cross(p1 - p0, p2 - p0)) > 0.0f)) {
+            ++degenerate;
+            continue;
+        }
+        geo.indices.insert(geo.indices.end(), {i0, i1, i2});
+        geo.materials.push_back(tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t]);
+        if (!tm.normals.empty())
+            for (int k = 0; k < 3; ++k) geo.normals.push_back(safe_normalize(tm.normals[3 * t + k]));
+        if (!tm.uvs.empty()) geo.uvs.insert(geo.uvs.end(), &tm.uvs[6 * t], &tm.uvs[6 * t] + 6);
+    }
+    if (degenerate) {
+        stats.warnings.push_back(name + ": skipped " + std::to_string(degenerate) +
+                                 " degenerate triangle(s)");
+        stats.skipped_triangles += degenerate;
+    }
+    if (geo.indices.empty()) return std::nullopt;
+    geo.vertices.reserve(3 * tm.positions.size() + 1);
+    for (const Vec3 &p : tm.positions) geo.vertices.insert(geo.vertices.end(), {p.x, p.y, p.z});
+    geo.vertices.push_back(0.0f);  // Embree reads float3 vertices with 16-byte loads
+    stats.triangles += geo.materials.size();
+    tm = {};
+    meshes.push_back(std::move(geo));
+    return std::nullopt;
+}
+
+// Embree's device, scene and BVH over the curves and meshes added, and their memory.
+Status Scene::Impl::build_bvh() {
+    device = rtcNewDevice(nullptr);
+    if (!device)
+        return Error{"scene: could not create the Embree device (error " +
+                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")"};
+    rtcSetDeviceErrorFunction(device, &Impl::error_function, this);
+    rtcSetDeviceMemoryMonitorFunction(device, &Impl::memory_monitor, this);
+    rtc_scene = rtcNewScene(device);
+    rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
+
+    const CurveShape shape = curve_shape;
+    const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE
+                                       : shape == CurveShape::ThickLinear ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                                          : RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE;
+    const RTCFilterFunctionN filter = shape == CurveShape::Ribbons       ? &curve_filter<InsideHits::NoInside>
+                                      : shape == CurveShape::ThickLinear ? &curve_filter<InsideHits::Culled>
+                                                                         : &curve_filter<InsideHits::AsContext>;
+    // Linear segments start one control point on: segment index k reads points k and k + 1
+    // past the leading duplicate.
+    const std::size_t skip = shape == CurveShape::ThickLinear ? 1 : 0;
+    for (std::size_t i = 0; i < curves.size(); ++i) {
+        CurveGeometry &geo = curves[i];
+        RTCGeometry g = rtcNewGeometry(device, curve_type);
+        rtcSetGeometryTessellationRate(g, 5.0f);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, geo.cvs.data(),
+                                   skip * sizeof(Float4), sizeof(Float4), geo.cvs.size() - skip);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                   geo.segments.data(), 0, sizeof(std::uint32_t),
+                                   geo.segments.size());
+        rtcSetGeometryUserData(g, geo.curve_of.data());
+        rtcSetGeometryIntersectFilterFunction(g, filter);
+        rtcSetGeometryOccludedFilterFunction(g, filter);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(rtc_scene, g);
+        rtcReleaseGeometry(g);
+        if (geometries.size() <= id) geometries.resize(id + 1);
+        geometries[id] = {true, std::uint32_t(i)};
+    }
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+        MeshGeometry &geo = meshes[i];
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   geo.vertices.data(), 0, 3 * sizeof(float),
+                                   (geo.vertices.size() - 1) / 3);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                   geo.indices.data(), 0, 3 * sizeof(std::uint32_t),
+                                   geo.indices.size() / 3);
+        rtcSetGeometryIntersectFilterFunction(g, &triangle_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &triangle_filter);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(rtc_scene, g);
+        rtcReleaseGeometry(g);
+        if (geometries.size() <= id) geometries.resize(id + 1);
+        geometries[id] = {false, std::uint32_t(i)};
+        geo.geometry_id = id;
+    }
+    rtcCommitScene(rtc_scene);
+    if (auto e = embree_status("building the BVH")) return e;
+    std::size_t bytes = sizeof(Impl) + geometries.capacity() * sizeof(GeometryInfo);
+    for (const auto &c : curves) {
+        bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
+                 c.curve_of.capacity() * 4 + c.normals.capacity() * sizeof(Vec3);
+        for (const CurveInput &in : c.inputs) bytes += in.values.capacity() * sizeof(float);
+    }
+    for (const auto &m : meshes)
+        bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
+                 m.materials.capacity() * 4 + m.materials.size() +
+                 m.normals.capacity() * sizeof(Vec3) + m.uvs.capacity() * 4;
+    geometry_bytes = bytes;
+    return std::nullopt;
+}
 
 Expected<Scene> Scene::build(SceneDesc desc) {
     const auto start = std::chrono::steady_clock::now();
@@ -429,255 +681,16 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         impl->camera.emplace(std::move(cam).value());
     }
 
-    // Hair curves.
-    for (std::size_t s = 0; s < desc.curves.size(); ++s) {
-        HairCurves &hc = desc.curves[s];
-        const std::string set = "curve set " + std::to_string(s);
-        if (auto e = check_material_index(desc.materials, set, hc.material, false)) return *e;
-        if (hc.radii.size() != hc.points.size())
-            return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
-                         " entries but points has " + std::to_string(hc.points.size()) +
-                         " (one radius per point)"};
-        if (hc.first.empty() || hc.first.front() != 0 || hc.first.back() != hc.points.size())
-            return Error{set + ": first must start at 0 and end at the point count (" +
-                         std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
-        if (hc.points.size() > (std::size_t(1) << 31))
-            return Error{set + ": too many points (at most 2^31)"};
-        if (auto e = check_curve_inputs(hc, set, desc.materials[hc.material])) return *e;
-        if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
-            return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
-                         " entries but points has " + std::to_string(hc.points.size()) +
-                         " (one normal per point, or none)"};
-        for (std::size_t k = 0; k < hc.normals.size(); ++k)
-            if (!finite3(hc.normals[k]))
-                return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
-                             describe(hc.normals[k]) + ")"};
-        CurveGeometry geo;
-        geo.material = hc.material;
-        geo.set = s;
-        for (const CurveInput &in : hc.inputs) geo.inputs.push_back({in.input, in.per_point, {}, in.closure_weight});
-        std::size_t zero_length = 0, zero_radius = 0, stats_curves_in_set = 0;
-        const std::size_t curve_count = hc.first.size() - 1;
-        for (std::size_t c = 0; c < curve_count; ++c) {
-            const std::uint32_t b = hc.first[c], e = hc.first[c + 1];
-            if (e < b)
-                return Error{set + ": first must not decrease (curve " + std::to_string(c) + ")"};
-            const std::uint32_t n = e - b;
-            if (n < 2)
-                return Error{set + ", curve " + std::to_string(c) + ": has " + std::to_string(n) +
-                             " point(s); a curve needs at least 2"};
-            float max_step = 0, max_radius = 0;
-            for (std::uint32_t k = b; k < e; ++k) {
-                if (!finite3(hc.points[k]))
-                    return Error{set + ", curve " + std::to_string(c) + ", point " +
-                                 std::to_string(k - b) + ": position must be finite (got " +
-                                 describe(hc.points[k]) + ")"};
-                const float r = hc.radii[k];
-                if (!std::isfinite(r) || r < 0.0f)
-                    return Error{set + ", curve " + std::to_string(c) + ", point " +
-                                 std::to_string(k - b) + ": radius must be finite and >= 0 (got " +
-                                 std::to_string(r) + ")"};
-                max_radius = std::max(max_radius, r);
-                if (k > b) max_step = std::max(max_step, length(hc.points[k] - hc.points[k - 1]));
-            }
-            if (!(max_step > 0.0f)) {
-                ++zero_length;
-                continue;
-            }
-            if (!(max_radius > 0.0f)) {
-                ++zero_radius;
-                continue;
-            }
-            const std::uint32_t base = std::uint32_t(geo.cvs.size());
-            auto cv = [&](std::uint32_t k) {
-                return Float4{hc.points[k].x, hc.points[k].y, hc.points[k].z, hc.radii[k]};
-            };
-            geo.cvs.push_back(cv(b));
-            for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
-            geo.cvs.push_back(cv(e - 1));
-            if (!hc.normals.empty()) {
-                geo.normals.push_back(hc.normals[b]);
-                geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
-                geo.normals.push_back(hc.normals[e - 1]);
-            }
-            const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
-            for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
-                const std::size_t k = std::size_t(components_of(hc.inputs[i]));
-                const std::vector<float> &from = hc.inputs[i].values;
-                const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
-                const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
-                geo.inputs[i].values.insert(geo.inputs[i].values.end(), from.begin() + std::ptrdiff_t(begin),
-                                            from.begin() + std::ptrdiff_t(end));
-            }
-            for (std::uint32_t k = 0; k + 1 < n; ++k) {
-                geo.segments.push_back(base + k);
-                geo.curve_of.push_back(curve_index);
-            }
-            ++stats.curves;
-            stats.curve_points += n;
-        }
-        if (zero_length)
-            stats.warnings.push_back(set + ": skipped " + std::to_string(zero_length) +
-                                     " curve(s) of zero length");
-        if (zero_radius)
-            stats.warnings.push_back(set + ": skipped " + std::to_string(zero_radius) +
-                                     " curve(s) of zero radius");
-        stats.skipped_curves += zero_length + zero_radius;
-        stats.curve_segments += geo.segments.size();
-        // Free the caller's copy early: the scene keeps its own Embree layout.
-        hc.points = {};
-        hc.radii = {};
-        hc.first = {};
-        hc.inputs = {};
-        hc.normals = {};
-        if (!geo.segments.empty()) impl->curves.push_back(std::move(geo));
-    }
-
-    // Meshes.
-    for (std::size_t s = 0; s < desc.meshes.size(); ++s) {
-        TriangleMesh &tm = desc.meshes[s];
-        const std::string name = "mesh " + std::to_string(s);
-        if (tm.indices.size() % 3 != 0)
-            return Error{name + ": indices has " + std::to_string(tm.indices.size()) +
-                         " entries, not a multiple of 3"};
-        const std::size_t tri_count = tm.indices.size() / 3;
-        if (tm.materials.size() != 1 && tm.materials.size() != tri_count)
-            return Error{name + ": materials must hold 1 entry or one per triangle (" +
-                         std::to_string(tri_count) + "), got " +
-                         std::to_string(tm.materials.size())};
-        for (std::size_t v = 0; v < tm.positions.size(); ++v)
-            if (!finite3(tm.positions[v]))
-                return Error{name + ", vertex " + std::to_string(v) +
-                             ": position must be finite (got " + describe(tm.positions[v]) + ")"};
-        for (std::uint32_t m : tm.materials)
-            if (auto e = check_material_index(desc.materials, name, m, true)) return *e;
-        if (!tm.normals.empty() && tm.normals.size() != tm.indices.size())
-            return Error{name + ": normals has " + std::to_string(tm.normals.size()) +
-                         " entries; it needs one per triangle corner (" +
-                         std::to_string(tm.indices.size()) + ") or none"};
-        if (!tm.uvs.empty() && tm.uvs.size() != 2 * tm.indices.size())
-            return Error{name + ": uvs has " + std::to_string(tm.uvs.size()) +
-                         " floats; it needs a (u, v) pair per triangle corner (" +
-                         std::to_string(2 * tm.indices.size()) + " floats) or none"};
-        for (std::size_t k = 0; k < tm.normals.size(); ++k)
-            if (!finite3(tm.normals[k]) || !(length(tm.normals[k]) > 0.0f))
-                return Error{name + ", corner " + std::to_string(k) +
-                             ": normal must be finite and not zero (got " + describe(tm.normals[k]) + ")"};
-        for (std::size_t k = 0; k < tm.uvs.size(); ++k)
-            if (!std::isfinite(tm.uvs[k]))
-                return Error{name + ", corner " + std::to_string(k / 2) + ": uv must be finite"};
-        MeshGeometry geo;
-        geo.mesh = s;
-        std::size_t degenerate = 0;
-        for (std::size_t t = 0; t < tri_count; ++t) {
-            const std::uint32_t i0 = tm.indices[3 * t], i1 = tm.indices[3 * t + 1],
-                                i2 = tm.indices[3 * t + 2];
-            if (i0 >= tm.positions.size() || i1 >= tm.positions.size() ||
-                i2 >= tm.positions.size())
-                return Error{name + ", triangle " + std::to_string(t) +
-                             ": vertex index out of range (the mesh has " +
-                             std::to_string(tm.positions.size()) + " vertices)"};
-            const Vec3 p0 = tm.positions[i0], p1 = tm.positions[i1], p2 = tm.positions[i2];
-            if (!(length(cross(p1 - p0, p2 - p0)) > 0.0f)) {
-                ++degenerate;
-                continue;
-            }
-            geo.indices.insert(geo.indices.end(), {i0, i1, i2});
-            geo.materials.push_back(tm.materials.size() == 1 ? tm.materials[0] : tm.materials[t]);
-            if (!tm.normals.empty())
-                for (int k = 0; k < 3; ++k) geo.normals.push_back(safe_normalize(tm.normals[3 * t + k]));
-            if (!tm.uvs.empty()) geo.uvs.insert(geo.uvs.end(), &tm.uvs[6 * t], &tm.uvs[6 * t] + 6);
-        }
-        if (degenerate) {
-            stats.warnings.push_back(name + ": skipped " + std::to_string(degenerate) +
-                                     " degenerate triangle(s)");
-            stats.skipped_triangles += degenerate;
-        }
-        if (geo.indices.empty()) continue;
-        geo.vertices.reserve(3 * tm.positions.size() + 1);
-        for (const Vec3 &p : tm.positions) geo.vertices.insert(geo.vertices.end(), {p.x, p.y, p.z});
-        geo.vertices.push_back(0.0f);  // Embree reads float3 vertices with 16-byte loads
-        stats.triangles += geo.materials.size();
-        tm = {};
-        impl->meshes.push_back(std::move(geo));
-    }
-
+    for (std::size_t s = 0; s < desc.curves.size(); ++s)
+        if (auto e = impl->add_curves(desc.curves[s], s, desc.materials)) return *e;
+    for (std::size_t s = 0; s < desc.meshes.size(); ++s)
+        if (auto e = impl->add_mesh(desc.meshes[s], s, desc.materials)) return *e;
     // A scene with no geometry left is legal, as in Cycles: every ray misses and the render
     // shows the world.
-
-    // Embree.
-    impl->device = rtcNewDevice(nullptr);
-    if (!impl->device)
-        return Error{"scene: could not create the Embree device (error " +
-                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")"};
-    rtcSetDeviceErrorFunction(impl->device, &Impl::error_function, impl.get());
-    rtcSetDeviceMemoryMonitorFunction(impl->device, &Impl::memory_monitor, impl.get());
-    impl->rtc_scene = rtcNewScene(impl->device);
-    rtcSetSceneFlags(impl->rtc_scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(impl->rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
-
-    const CurveShape shape = impl->curve_shape;
-    const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE
-                                       : shape == CurveShape::ThickLinear ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
-                                                                          : RTC_GEOMETRY_TYPE_ROUND_CATMULL_ROM_CURVE;
-    const RTCFilterFunctionN filter = shape == CurveShape::Ribbons       ? &curve_filter<InsideHits::NoInside>
-                                      : shape == CurveShape::ThickLinear ? &curve_filter<InsideHits::Culled>
-                                                                         : &curve_filter<InsideHits::AsContext>;
-    // Linear segments start one control point on: segment index k reads points k and k + 1
-    // past the leading duplicate.
-    const std::size_t skip = shape == CurveShape::ThickLinear ? 1 : 0;
-    for (std::size_t i = 0; i < impl->curves.size(); ++i) {
-        CurveGeometry &geo = impl->curves[i];
-        RTCGeometry g = rtcNewGeometry(impl->device, curve_type);
-        rtcSetGeometryTessellationRate(g, 5.0f);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, geo.cvs.data(),
-                                   skip * sizeof(Float4), sizeof(Float4), geo.cvs.size() - skip);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
-                                   geo.segments.data(), 0, sizeof(std::uint32_t),
-                                   geo.segments.size());
-        rtcSetGeometryUserData(g, geo.curve_of.data());
-        rtcSetGeometryIntersectFilterFunction(g, filter);
-        rtcSetGeometryOccludedFilterFunction(g, filter);
-        rtcCommitGeometry(g);
-        const unsigned id = rtcAttachGeometry(impl->rtc_scene, g);
-        rtcReleaseGeometry(g);
-        if (impl->geometries.size() <= id) impl->geometries.resize(id + 1);
-        impl->geometries[id] = {true, std::uint32_t(i)};
-    }
-    for (std::size_t i = 0; i < impl->meshes.size(); ++i) {
-        MeshGeometry &geo = impl->meshes[i];
-        RTCGeometry g = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                   geo.vertices.data(), 0, 3 * sizeof(float),
-                                   (geo.vertices.size() - 1) / 3);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                   geo.indices.data(), 0, 3 * sizeof(std::uint32_t),
-                                   geo.indices.size() / 3);
-        rtcSetGeometryIntersectFilterFunction(g, &triangle_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &triangle_filter);
-        rtcCommitGeometry(g);
-        const unsigned id = rtcAttachGeometry(impl->rtc_scene, g);
-        rtcReleaseGeometry(g);
-        if (impl->geometries.size() <= id) impl->geometries.resize(id + 1);
-        impl->geometries[id] = {false, std::uint32_t(i)};
-        geo.geometry_id = id;
-    }
-    rtcCommitScene(impl->rtc_scene);
-    if (auto e = impl->embree_status("building the BVH")) return *e;
+    if (auto e = impl->build_bvh()) return *e;
 
     // Materials and lights, as set_shading sets them again.
     impl->geometry_warnings = stats.warnings;
-    std::size_t bytes = sizeof(Impl) + impl->geometries.capacity() * sizeof(GeometryInfo);
-    for (const auto &c : impl->curves) {
-        bytes += c.cvs.capacity() * sizeof(Float4) + c.segments.capacity() * 4 +
-                 c.curve_of.capacity() * 4 + c.normals.capacity() * sizeof(Vec3);
-        for (const CurveInput &in : c.inputs) bytes += in.values.capacity() * sizeof(float);
-    }
-    for (const auto &m : impl->meshes)
-        bytes += m.vertices.capacity() * 4 + m.indices.capacity() * 4 +
-                 m.materials.capacity() * 4 + m.materials.size() +
-                 m.normals.capacity() * sizeof(Vec3) + m.uvs.capacity() * 4;
-    impl->geometry_bytes = bytes;
     if (auto e = impl->set_shading(desc)) return *e;
     stats.embree_peak_bytes = std::size_t(std::max(0ll, impl->embree_peak.load()));
     stats.embree_bytes = std::size_t(std::max(0ll, impl->embree_bytes.load()));
