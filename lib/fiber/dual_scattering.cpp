@@ -41,6 +41,26 @@ std::vector<double> orientations(const FiberModel &model, int count) {
 // ------------------------------------------------------------------------------------------
 // Precomputation
 
+// The rules every step of the precomputation integrates with.
+struct DualScattering::Quadrature {
+    QuadratureRule theta;     // θ over [−π/2, π/2]
+    QuadratureRule forward;   // φ over the forward half, [−π, −π/2] ∪ [π/2, π]
+    QuadratureRule backward;  // φ over the backward half, [−π/2, π/2]
+    std::vector<double> orientations;  // the azimuths an eccentric fiber is averaged over
+    double weight_scale = 0;           // energy_scale / orientation count
+
+    Quadrature(const FiberModel &model, const DualScatteringParams &q)
+        : theta(QuadratureRule::composite(-kHalfPi, kHalfPi, q.theta_panels, q.points_per_panel)),
+          forward(QuadratureRule::composite(-kPi, -kHalfPi, q.phi_panels, q.points_per_panel)),
+          backward(QuadratureRule::composite(-kHalfPi, kHalfPi, 2 * q.phi_panels, q.points_per_panel)),
+          orientations(hairis::orientations(model, q.orientation_count)),
+          weight_scale(double(q.energy_scale) / double(orientations.size())) {
+        const QuadratureRule upper = QuadratureRule::composite(kHalfPi, kPi, q.phi_panels, q.points_per_panel);
+        forward.x.insert(forward.x.end(), upper.x.begin(), upper.x.end());
+        forward.w.insert(forward.w.end(), upper.w.begin(), upper.w.end());
+    }
+};
+
 Expected<DualScattering> DualScattering::create(const FiberModel &model,
                                                 const DualScatteringParams &params) {
     const DualScatteringParams &q = params;
@@ -72,25 +92,23 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
         ds.shapes_.push_back(shape);
     }
 
-    const int K = q.theta_count;
-    const std::size_t nk = std::size_t(K);
-    const std::size_t nl = std::size_t(lobes);
-    ds.a_f_lobe_.assign(nl * nk, {});
-    ds.pass_.assign(nk, 0.0);
-    ds.a_b_lobe_.assign(nl * nk, {});
-    ds.n_g_lobe_.assign(nl * nk, {});
+    const Quadrature rules(model, q);
+    ds.integrate_albedos(model, rules);
+    ds.integrate_spread(model, rules);
+    ds.derive_terms();
+    return ds;
+}
 
-    const QuadratureRule theta_rule =
-        QuadratureRule::composite(-kHalfPi, kHalfPi, q.theta_panels, q.points_per_panel);
-    // φ quarters: [−π, −π/2] and [π/2, π] are forward, [−π/2, π/2] backward.
-    const QuadratureRule fwd_lo = QuadratureRule::composite(-kPi, -kHalfPi, q.phi_panels, q.points_per_panel);
-    const QuadratureRule fwd_hi = QuadratureRule::composite(kHalfPi, kPi, q.phi_panels, q.points_per_panel);
-    const QuadratureRule back = QuadratureRule::composite(-kHalfPi, kHalfPi, 2 * q.phi_panels, q.points_per_panel);
-    QuadratureRule fwd = fwd_lo;
-    fwd.x.insert(fwd.x.end(), fwd_hi.x.begin(), fwd_hi.x.end());
-    fwd.w.insert(fwd.w.end(), fwd_hi.w.begin(), fwd_hi.w.end());
-    const std::vector<double> orient = orientations(model, q.orientation_count);
-    const double weight_scale = double(q.energy_scale) / double(orient.size());
+// (1) Per lobe and θ node, the forward and backward albedos a_f,p and a_b,p and the share of a
+// crossing that passes unscattered; and the lobes' shapes measured from the same integrals
+// when the model's are not analytic (or DualScatteringParams::measure_lobe_shapes).
+void DualScattering::integrate_albedos(const FiberModel &model, const Quadrature &rules) {
+    const int K = params_.theta_count;
+    const std::size_t nk = std::size_t(K);
+    const std::size_t nl = std::size_t(lobe_count_);
+    a_f_lobe_.assign(nl * nk, {});
+    a_b_lobe_.assign(nl * nk, {});
+    pass_.assign(nk, 0.0);
 
     // θ_h moments of each lobe's energy, per (lobe, θ node): Σw, Σwθ_h, Σwθ_h².
     struct Moments {
@@ -101,16 +119,16 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             m2 += w * theta_h * theta_h;
         }
     };
-    ds.shapes_measured_ = q.measure_lobe_shapes || !model.lobe_shapes_analytic();
+    shapes_measured_ = params_.measure_lobe_shapes || !model.lobe_shapes_analytic();
     std::vector<Moments> moments(nl * nk);
 
     // Each task writes only its own table entries: the result does not depend on scheduling.
     tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
         std::vector<Rgbd> af(nl), ab(nl);
-        std::vector<double> lw(theta_rule.x.size());  // a separable lobe's θ weights
-        const bool measure = ds.shapes_measured_;
+        std::vector<double> lw(rules.theta.x.size());  // a separable lobe's θ weights
+        const bool measure = shapes_measured_;
         for (int k = range.begin(); k != range.end(); ++k) {
-            const double theta_k = ds.table_theta(k);
+            const double theta_k = table_theta(k);
             // (1) a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction
             // of the light from ω_L scattered into the forward half is the model's white-furnace
             // integral ∫_fwd f(ω, ω_L)|cos θ| dω with ω_L in the viewer's slot: lobe_f_cos(p, ω,
@@ -119,25 +137,25 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             std::fill(ab.begin(), ab.end(), Rgbd{});
             Moments *mk = &moments[std::size_t(k)];  // lobe p at mk[p * nk]
             double pass = 0;  // the unscattered share of the light's crossings (projected_width)
-            for (const double phi_l : orient) {
+            for (const double phi_l : rules.orientations) {
                 const std::unique_ptr<const FarFieldView> view = model.view(dir(theta_k, phi_l));
                 // f is per hit on the fiber; a crossing meets it on a fraction `width` of the
                 // curve's width and passes unscattered elsewhere.
                 const double width = std::clamp(model.projected_width(dir(theta_k, phi_l)), 0.0, 1.0);
-                pass += (1.0 - width) / double(orient.size());
-                const double lobe_scale = weight_scale * width;
+                pass += (1.0 - width) / double(rules.orientations.size());
+                const double lobe_scale = rules.weight_scale * width;
                 if (view->separable()) {
                     // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
-                    for (int p = 0; p < lobes; ++p) {
+                    for (int p = 0; p < lobe_count_; ++p) {
                         double longitudinal = 0;
-                        for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
-                            lw[m] = theta_rule.w[m] * std::cos(theta_rule.x[m]) * lobe_scale *
-                                    view->longitudinal(p, theta_rule.x[m]);
+                        for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
+                            lw[m] = rules.theta.w[m] * std::cos(rules.theta.x[m]) * lobe_scale *
+                                    view->longitudinal(p, rules.theta.x[m]);
                             longitudinal += lw[m];
                         }
                         double azimuthal_sum = 0;
                         for (int half = 0; half < 2; ++half) {
-                            const QuadratureRule &rule = half == 0 ? fwd : back;
+                            const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
                             Rgbd &acc = (half == 0 ? af : ab)[std::size_t(p)];
                             for (std::size_t n = 0; n < rule.x.size(); ++n) {
                                 const Rgb v = view->azimuthal(p, rule.x[n]);
@@ -146,23 +164,23 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                             }
                         }
                         if (measure)
-                            for (std::size_t m = 0; m < theta_rule.x.size(); ++m)
+                            for (std::size_t m = 0; m < rules.theta.x.size(); ++m)
                                 mk[std::size_t(p) * nk].add(lw[m] * azimuthal_sum,
-                                                            0.5 * (theta_rule.x[m] + theta_k));
+                                                            0.5 * (rules.theta.x[m] + theta_k));
                     }
                     continue;
                 }
-                for (std::size_t m = 0; m < theta_rule.x.size(); ++m) {
-                    const double th = theta_rule.x[m];
-                    const double wm = theta_rule.w[m] * std::cos(th) * lobe_scale;
+                for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
+                    const double th = rules.theta.x[m];
+                    const double wm = rules.theta.w[m] * std::cos(th) * lobe_scale;
                     const double theta_h = 0.5 * (th + theta_k);
                     for (int half = 0; half < 2; ++half) {
-                        const QuadratureRule &rule = half == 0 ? fwd : back;
+                        const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
                         std::vector<Rgbd> &acc = half == 0 ? af : ab;
                         for (std::size_t n = 0; n < rule.x.size(); ++n) {
                             const Vec3 w = dir(th, phi_l + rule.x[n]);
                             const double weight = wm * rule.w[n];
-                            for (int p = 0; p < lobes; ++p) {
+                            for (int p = 0; p < lobe_count_; ++p) {
                                 const Rgb v = view->lobe_f_cos(p, w);
                                 for (int ch = 0; ch < 3; ++ch) acc[std::size_t(p)].v[ch] += weight * double(v[ch]);
                                 if (measure)
@@ -174,20 +192,20 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 }
             }
             for (std::size_t p = 0; p < nl; ++p) {
-                ds.a_f_lobe_[p * nk + std::size_t(k)] = af[p];
-                ds.a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
+                a_f_lobe_[p * nk + std::size_t(k)] = af[p];
+                a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
             }
-            ds.pass_[std::size_t(k)] = pass;
+            pass_[std::size_t(k)] = pass;
         }
     });
 
     // Measured shapes: the moments pooled over θ_L with weight cos θ_L (serial, fixed order).
-    if (ds.shapes_measured_) {
+    if (shapes_measured_) {
         for (std::size_t p = 0; p < nl; ++p) {
             Moments pooled;
             for (std::size_t k = 0; k < nk; ++k) {
                 const Moments &m = moments[p * nk + k];
-                const double c = std::cos(ds.table_theta(int(k)));
+                const double c = std::cos(table_theta(int(k)));
                 pooled.m0 += c * m.m0;
                 pooled.m1 += c * m.m1;
                 pooled.m2 += c * m.m2;
@@ -195,15 +213,23 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             if (!(pooled.m0 > 0)) continue;  // a lobe with no energy keeps the model's guess
             const double alpha = pooled.m1 / pooled.m0;
             const double variance = std::max(0.0, pooled.m2 / pooled.m0 - alpha * alpha);
-            ds.shapes_[p] = {float(alpha), float(std::sqrt(variance))};
+            shapes_[p] = {float(alpha), float(std::sqrt(variance))};
         }
     }
+}
 
+// (2) Per lobe and θ node, N_p^G: the lobe's forward azimuthal spread at Marschner's
+// difference angle θ_d = θ_k.
+void DualScattering::integrate_spread(const FiberModel &model, const Quadrature &rules) {
+    const int K = params_.theta_count;
+    const std::size_t nk = std::size_t(K);
+    const std::size_t nl = std::size_t(lobe_count_);
+    n_g_lobe_.assign(nl * nk, {});
     tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
         std::vector<Rgbd> num(nl);
         std::vector<double> den(nl);
         for (int k = range.begin(); k != range.end(); ++k) {
-            const double theta_k = ds.table_theta(k);
+            const double theta_k = table_theta(k);
             // (2) N_p^G at Marschner's difference angle θ_d = θ_k.
             std::fill(num.begin(), num.end(), Rgbd{});
             std::fill(den.begin(), den.end(), 0.0);
@@ -211,25 +237,25 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             const double cos_d2 = sqr(std::cos(td));
             const double h_lo = -kHalfPi + std::fabs(td), h_hi = kHalfPi - std::fabs(td);
             const QuadratureRule h_rule =
-                QuadratureRule::composite(h_lo, h_hi, q.theta_panels, q.points_per_panel);
+                QuadratureRule::composite(h_lo, h_hi, params_.theta_panels, params_.points_per_panel);
             for (std::size_t m = 0; m < h_rule.x.size(); ++m) {
                 const double th_h = h_rule.x[m];
                 const double th_i = th_h - td, th_o = th_h + td;
                 const double cos_i = std::cos(th_i);
-                for (int p = 0; p < lobes; ++p) {
-                    const double beta = std::max(double(ds.shapes_[std::size_t(p)].beta), double(q.min_lobe_width));
+                for (int p = 0; p < lobe_count_; ++p) {
+                    const double beta = std::max(double(shapes_[std::size_t(p)].beta), double(params_.min_lobe_width));
                     den[std::size_t(p)] += h_rule.w[m] *
-                        gaussian(th_h - ds.shapes_[std::size_t(p)].alpha, beta * beta) * cos_i / cos_d2;
+                        gaussian(th_h - shapes_[std::size_t(p)].alpha, beta * beta) * cos_i / cos_d2;
                 }
-                for (const double phi_o : orient) {
+                for (const double phi_o : rules.orientations) {
                     const std::unique_ptr<const FarFieldView> view = model.view(dir(th_o, phi_o));
-                    for (int p = 0; p < lobes; ++p) {
+                    for (int p = 0; p < lobe_count_; ++p) {
                         // (1/π)∫_fwd … dφ, averaged over orientations.
                         const double longitudinal = view->separable() ? view->longitudinal(p, th_i) : 1.0;
-                        for (std::size_t n = 0; n < fwd.x.size(); ++n) {
-                            const double w = h_rule.w[m] * fwd.w[n] * kInvPi * weight_scale;
-                            const Rgb v = view->separable() ? view->azimuthal(p, fwd.x[n])
-                                                            : view->lobe_f_cos(p, dir(th_i, phi_o + fwd.x[n]));
+                        for (std::size_t n = 0; n < rules.forward.x.size(); ++n) {
+                            const double w = h_rule.w[m] * rules.forward.w[n] * kInvPi * rules.weight_scale;
+                            const Rgb v = view->separable() ? view->azimuthal(p, rules.forward.x[n])
+                                                            : view->lobe_f_cos(p, dir(th_i, phi_o + rules.forward.x[n]));
                             for (int ch = 0; ch < 3; ++ch) num[std::size_t(p)].v[ch] += w * longitudinal * double(v[ch]);
                         }
                     }
@@ -238,31 +264,35 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
             for (std::size_t p = 0; p < nl; ++p) {
                 Rgbd ng;
                 for (int ch = 0; ch < 3; ++ch) ng.v[ch] = den[p] > 0 ? num[p].v[ch] / den[p] : 0.0;
-                ds.n_g_lobe_[p * nk + std::size_t(k)] = ng;
+                n_g_lobe_[p * nk + std::size_t(k)] = ng;
             }
         }
     });
+}
 
-    // (3) Averages and the multiple-backscatter terms (cheap, serial).
-    ds.a_f_.assign(nk, {});
-    ds.a_b_.assign(nk, {});
-    ds.alpha_f_.assign(nk, {});
-    ds.alpha_b_.assign(nk, {});
-    ds.beta2_f_.assign(nk, {});
-    ds.beta2_b_.assign(nk, {});
-    ds.big_a_b_.assign(nk, {});
-    ds.delta_b_.assign(nk, {});
-    ds.sigma2_b_.assign(nk, {});
-    const double amax = q.max_series_attenuation;
-    const double db = q.d_b;
+// (3) Per θ node, the averages over lobes and the multiple-backscatter terms (cheap, serial).
+void DualScattering::derive_terms() {
+    const std::size_t nk = std::size_t(params_.theta_count);
+    const std::size_t nl = std::size_t(lobe_count_);
+    a_f_.assign(nk, {});
+    a_b_.assign(nk, {});
+    alpha_f_.assign(nk, {});
+    alpha_b_.assign(nk, {});
+    beta2_f_.assign(nk, {});
+    beta2_b_.assign(nk, {});
+    big_a_b_.assign(nk, {});
+    delta_b_.assign(nk, {});
+    sigma2_b_.assign(nk, {});
+    const double amax = params_.max_series_attenuation;
+    const double db = params_.d_b;
     for (std::size_t k = 0; k < nk; ++k) {
         for (int ch = 0; ch < 3; ++ch) {
             double sf = 0, sb = 0, alf = 0, alb = 0, bf = 0, bb = 0;
             double mean_alpha = 0, mean_beta2 = 0;
             for (std::size_t p = 0; p < nl; ++p) {
-                const double wf = std::max(0.0, ds.a_f_lobe_[p * nk + k].v[ch]);
-                const double wb = std::max(0.0, ds.a_b_lobe_[p * nk + k].v[ch]);
-                const double al = ds.shapes_[p].alpha, be2 = sqr(double(ds.shapes_[p].beta));
+                const double wf = std::max(0.0, a_f_lobe_[p * nk + k].v[ch]);
+                const double wb = std::max(0.0, a_b_lobe_[p * nk + k].v[ch]);
+                const double al = shapes_[p].alpha, be2 = sqr(double(shapes_[p].beta));
                 sf += wf;
                 sb += wb;
                 alf += wf * al;
@@ -273,20 +303,20 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                 mean_beta2 += be2 / double(nl);
             }
             // Light that passes a crossed fiber unscattered goes on forward, undeflected.
-            sf += ds.pass_[k];
+            sf += pass_[k];
             const double a_f = sf, a_b = sb;
             const double alpha_f = sf > 0 ? alf / sf : mean_alpha;
             const double alpha_b = sb > 0 ? alb / sb : mean_alpha;
             const double beta2_f = sf > 0 ? bf / sf : mean_beta2;
             const double beta2_b = sb > 0 ? bb / sb : mean_beta2;
-            ds.a_f_[k].v[ch] = a_f;
-            ds.a_b_[k].v[ch] = a_b;
-            ds.alpha_f_[k].v[ch] = alpha_f;
-            ds.alpha_b_[k].v[ch] = alpha_b;
-            ds.beta2_f_[k].v[ch] = beta2_f;
-            ds.beta2_b_[k].v[ch] = beta2_b;
+            a_f_[k].v[ch] = a_f;
+            a_b_[k].v[ch] = a_b;
+            alpha_f_[k].v[ch] = alpha_f;
+            alpha_b_[k].v[ch] = alpha_b;
+            beta2_f_[k].v[ch] = beta2_f;
+            beta2_b_[k].v[ch] = beta2_b;
 
-            if (a_f > amax || a_b > amax) ++ds.clamped_entries_;
+            if (a_f > amax || a_b > amax) ++clamped_entries_;
             const double af = std::clamp(a_f, 0.0, amax), ab = std::clamp(a_b, 0.0, amax);
             const double af2 = af * af, ab2 = ab * ab, ab3 = ab2 * ab;
             const double om = 1.0 - af2;
@@ -300,12 +330,11 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
                                   (ab * std::sqrt(2.0 * bf_ + bb_) + ab3 * std::sqrt(2.0 * bf_ + 3.0 * bb_)) /
                                   sig_den
                             : (1.0 + db * af2) * std::sqrt(2.0 * bf_ + bb_);
-            ds.big_a_b_[k].v[ch] = big_a_b;
-            ds.delta_b_[k].v[ch] = delta_b;
-            ds.sigma2_b_[k].v[ch] = sigma_b * sigma_b;
+            big_a_b_[k].v[ch] = big_a_b;
+            delta_b_[k].v[ch] = delta_b;
+            sigma2_b_[k].v[ch] = sigma_b * sigma_b;
         }
     }
-    return ds;
 }
 
 // ------------------------------------------------------------------------------------------

@@ -234,6 +234,11 @@ class DualScattering {
     Rgbd scattered_term(double theta_i, double theta_o, const Rgbd &t_f, const Rgbd &s_f2,
                         int depth) const;
     static Rgb to_rgb(const Rgbd &c);
+    // The steps of create(), in its order.
+    struct Quadrature;
+    void integrate_albedos(const FiberModel &model, const Quadrature &rules);
+    void integrate_spread(const FiberModel &model, const Quadrature &rules);
+    void derive_terms();
 
     DualScatteringParams params_;
     int lobe_count_ = 0;
