@@ -215,12 +215,22 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
 Expected<LightSet> LightSet::build(const LightsDesc &lights,
                                    std::vector<EmissiveTriangle> emissive,
                                    std::vector<std::string> *warnings) {
-    const std::vector<SunLight> &suns = lights.suns;
-    const std::vector<PointLight> &points = lights.points;
-    const std::vector<AreaLight> &areas = lights.areas;
-    const WorldLight &world = lights.world;
     LightSet set;
+    if (auto e = set.add_suns(lights.suns)) return *e;
+    if (auto e = set.add_points(lights.points)) return *e;
+    if (auto e = set.add_spots(lights.spots)) return *e;
+    if (auto e = set.add_areas(lights.areas, warnings)) return *e;
+    if (auto e = set.set_world(lights.world)) return *e;
+    set.set_triangles(emissive);
+    const bool has_lamps = !set.lamps_.empty(), has_triangles = !set.triangles_.empty();
+    set.triangle_pick_ = has_triangles ? (has_lamps ? 0.5f : 1.0f) : 0.0f;
+    set.lamp_pick_ = has_lamps ? (1.0f - set.triangle_pick_) / float(set.lamps_.size()) : 0.0f;
+    set.by_importance_ = set.lamps_.size() > 1 && set.lamps_.size() <= kMaxImportanceLamps;
+    return set;
+}
 
+// Sun lamps, checked; black ones left out.
+Status LightSet::add_suns(const std::vector<SunLight> &suns) {
     for (std::size_t i = 0; i < suns.size(); ++i) {
         const SunLight &s = suns[i];
         const std::string name = "sun light " + std::to_string(i);
@@ -249,9 +259,13 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
             lamp.one_minus_cos_half = 2.0f * h * h;
             if (s.angle > 0.0f) lamp.value = cycles_light::sun_radiance_cycles45(s.color, s.strength, s.angle);
         }
-        set.lamps_.push_back(lamp);
+        lamps_.push_back(lamp);
     }
+    return std::nullopt;
+}
 
+// Point lamps, checked; black ones left out.
+Status LightSet::add_points(const std::vector<PointLight> &points) {
     for (std::size_t i = 0; i < points.size(); ++i) {
         const PointLight &p = points[i];
         const std::string name = "point light " + std::to_string(i);
@@ -271,11 +285,15 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
                                      : cycles_light::point_intensity(p.color, p.power);
         lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
-        set.lamps_.push_back(lamp);
+        lamps_.push_back(lamp);
     }
+    return std::nullopt;
+}
 
-    for (std::size_t i = 0; i < lights.spots.size(); ++i) {
-        const SpotLight &p = lights.spots[i];
+// Spot lamps, checked; black ones left out.
+Status LightSet::add_spots(const std::vector<SpotLight> &spots) {
+    for (std::size_t i = 0; i < spots.size(); ++i) {
+        const SpotLight &p = spots[i];
         const std::string name = "spot light " + std::to_string(i);
         if (!p.light_to_world.finite())
             return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
@@ -309,9 +327,13 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
         lamp.cos_half = std::cos(0.5f * p.spot_size);
         lamp.smooth = (1.0f - lamp.cos_half) * p.spot_blend;
-        set.lamps_.push_back(lamp);
+        lamps_.push_back(lamp);
     }
+    return std::nullopt;
+}
 
+// Area lamps, checked; black and empty ones left out (an empty one with a warning).
+Status LightSet::add_areas(const std::vector<AreaLight> &areas, std::vector<std::string> *warnings) {
     for (std::size_t i = 0; i < areas.size(); ++i) {
         const AreaLight &a = areas[i];
         const std::string name = "area light " + std::to_string(i);
@@ -352,9 +374,13 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
         lamp.invarea = 1.0f / area;
         lamp.value = cycles_light::area_radiance(a.color, a.power, area, a.cycles);
         lamp.importance = luminance(lamp.value) * area;  // its intensity along the normal
-        set.lamps_.push_back(lamp);
+        lamps_.push_back(lamp);
     }
+    return std::nullopt;
+}
 
+// The world: a constant colour, or an environment that is a lamp unless it is not sampled.
+Status LightSet::set_world(const WorldLight &world) {
     if (auto e = check_color("world:", world.color)) return *e;
     if (auto e = check::non_negative("world: strength", world.strength)) return *e;
     // A constant world is not light-sampled (as in Cycles 3.4): BSDF sampling alone finds it,
@@ -363,41 +389,38 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
     if (world.environment) {
         // An environment is a lamp (Cycles' background light) unless its Sampling is None or
         // it is black: then BSDF sampling alone finds it.
-        set.environment_ = world.environment;
-        set.environment_sampled_ = world.light_sampled && !world.environment->black();
-        if (set.environment_sampled_) {
+        environment_ = world.environment;
+        environment_sampled_ = world.light_sampled && !world.environment->black();
+        if (environment_sampled_) {
             Lamp lamp;
             lamp.type = LampType::Environment;
             lamp.importance = float(world.environment->luminance_integral() / 4.0);  // πL̄
-            set.lamps_.push_back(lamp);
+            lamps_.push_back(lamp);
         }
     } else {
-        set.world_ = world.color * world.strength;
+        world_ = world.color * world.strength;
     }
+    return std::nullopt;
+}
 
-    // Emissive triangles, by area.
-    set.triangle_cdf_.push_back(0.0f);
+// Emissive triangles, picked by area; degenerate and black ones left out.
+void LightSet::set_triangles(const std::vector<EmissiveTriangle> &emissive) {
+    triangle_cdf_.push_back(0.0f);
     double total = 0;
     for (const EmissiveTriangle &t : emissive) {
         const float area = 0.5f * length(cross(t.p1 - t.p0, t.p2 - t.p0));
         if (!(area > 0.0f) || t.radiance.is_black()) continue;
-        set.triangles_.push_back(t);
+        triangles_.push_back(t);
         total += area;
-        set.triangle_cdf_.push_back(float(total));
+        triangle_cdf_.push_back(float(total));
     }
-    if (!set.triangles_.empty()) {
-        for (float &c : set.triangle_cdf_) c = float(c / total);
-        set.triangle_cdf_.back() = 1.0f;
-        set.triangle_area_ = float(total);
+    if (!triangles_.empty()) {
+        for (float &c : triangle_cdf_) c = float(c / total);
+        triangle_cdf_.back() = 1.0f;
+        triangle_area_ = float(total);
     } else {
-        set.triangle_cdf_.clear();
+        triangle_cdf_.clear();
     }
-
-    const bool has_lamps = !set.lamps_.empty(), has_triangles = !set.triangles_.empty();
-    set.triangle_pick_ = has_triangles ? (has_lamps ? 0.5f : 1.0f) : 0.0f;
-    set.lamp_pick_ = has_lamps ? (1.0f - set.triangle_pick_) / float(set.lamps_.size()) : 0.0f;
-    set.by_importance_ = set.lamps_.size() > 1 && set.lamps_.size() <= kMaxImportanceLamps;
-    return set;
 }
 
 // The lamps' selection probabilities seen from p; the lamps' importance total is computed when

@@ -332,6 +332,14 @@ class LightSet {
         bool solid_angle = false;  // area: rectangle with orthogonal axes, sampled by solid angle
     };
 
+    // The steps of build(), in its order.
+    Status add_suns(const std::vector<SunLight> &suns);
+    Status add_points(const std::vector<PointLight> &points);
+    Status add_spots(const std::vector<SpotLight> &spots);
+    Status add_areas(const std::vector<AreaLight> &areas, std::vector<std::string> *warnings);
+    Status set_world(const WorldLight &world);
+    void set_triangles(const std::vector<EmissiveTriangle> &emissive);
+
     // The spot's attenuation for light leaving it in unit direction n (towards the receiver).
     static float spot_factor(const Lamp &lamp, Vec3 n);
     // The cosine spot_factor compares with the cone: of n and the axis (3.4), of the light's
