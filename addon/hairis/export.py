@@ -1489,8 +1489,8 @@ def slot_signature(depsgraph):
     signature = []
     for instance in depsgraph.object_instances:
         obj = instance.object
-        if obj.type in {"LIGHT", "CAMERA"}:
-            continue
+        if obj.type not in GEOMETRY_TYPES and obj.type != "CURVES":
+            continue  # no slots to read (Blender 3.4 crashes on an empty's)
         slots = tuple(slot.material.name_full if slot.material else None
                       for slot in obj.material_slots)
         systems = tuple(psys.settings.material for psys in getattr(obj, "particle_systems", ()))
