@@ -352,8 +352,9 @@ def reshade_native_scene(scene, data, hair_tables):
     _add_lights_and_world(scene, data)
 
 
-SHADING_DATA = ("Material", "World", "Light", "ShaderNodeTree", "Image", "Texture")
-"""bpy.types of the data blocks whose edits change the viewport's shading but no geometry."""
+SHADING_DATA = ("Material", "World", "Light", "ShaderNodeTree", "Image")
+"""bpy.types of the data blocks whose edits change the viewport's shading but no geometry
+(bpy.types.Texture is not one: modifiers displace with it)."""
 
 
 def _update_kind(depsgraph):
@@ -361,7 +362,7 @@ def _update_kind(depsgraph):
     scene's settings and cameras count as nothing, since view_draw follows the view and the
     render settings), 'shading' (materials, lights, the world) or 'geometry' (anything else).
     An edit of a material also flags the objects using it as changed in geometry (materials
-    can displace), so that flag counts only when no shading data changed with it."""
+    can displace), so that flag counts only when no material changed with it."""
     shading_types = tuple(getattr(bpy.types, name) for name in SHADING_DATA)
     kind, reshaped = None, False
     for update in depsgraph.updates:
@@ -388,7 +389,8 @@ def _update_kind(depsgraph):
             kind = "shading"
         else:
             return "geometry"
-    if reshaped and not any(isinstance(u.id, shading_types) for u in depsgraph.updates):
+    materials = (bpy.types.Material, bpy.types.ShaderNodeTree)
+    if reshaped and not any(isinstance(u.id, materials) for u in depsgraph.updates):
         return "geometry"
     return kind
 

@@ -445,8 +445,8 @@ def hair_node():
 
 
 def test_edits_of_shading_are_told_from_geometry():
-    """A material, light or world edit reads as 'shading'; moving or reshaping an object as
-    'geometry'."""
+    """A material, light or world edit reads as 'shading'; moving or reshaping an object, or
+    editing a texture a modifier displaces with, as 'geometry'."""
     make_scene()
 
     def melanin():
@@ -466,8 +466,16 @@ def test_edits_of_shading_are_told_from_geometry():
         bpy.data.objects["Sphere"].data.vertices[0].co.x += 0.1
         bpy.data.objects["Sphere"].data.update()
 
+    def displace():
+        modifier = bpy.data.objects["Sphere"].modifiers.new("Displace", "DISPLACE")
+        modifier.texture = bpy.data.textures.new("Bumps", "CLOUDS")
+
+    def bumps():  # a texture a modifier displaces with is geometry, not shading
+        bpy.data.textures["Bumps"].noise_scale = 0.5
+
     for edit, want in ((melanin, "shading"), (energy, "shading"), (world, "shading"),
-                       (move, "geometry"), (reshape, "geometry")):
+                       (move, "geometry"), (reshape, "geometry"), (displace, "geometry"),
+                       (bumps, "geometry")):
         kinds = update_kinds(edit)
         assert kinds, "%s: no update reached the handler" % edit.__name__
         assert kinds[-1] == want, "%s read as %s" % (edit.__name__, kinds)
