@@ -16,6 +16,7 @@ import os
 import platform
 import subprocess
 import sys
+import threading
 import time
 import traceback
 import types
@@ -306,6 +307,19 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     return sphere
 
 
+def make_groom_head(scene, hair_material, skin_material, children, radius_scale):
+    """A head-sized sphere (radius 0.1) with 1000 hair parents of length 0.3, ``children``
+    interpolated children each (rendered), strands of ``radius_scale``; returns the particle
+    settings."""
+    sphere = make_particle_hair(scene, count=1000, children=children, location=(0.0, 0.0, 0.0),
+                                scale=0.1, hair_material=hair_material,
+                                skin_material=skin_material)
+    settings = sphere.modifiers["Hair"].particle_system.settings
+    settings.hair_length = 0.3
+    settings.radius_scale = radius_scale
+    return settings
+
+
 def add_hair_particles(obj, count, material_index, hair_length=0.4, children=None,
                        density_group=""):
     """A hair particle system on mesh ``obj`` shaded with its material slot ``material_index``
@@ -583,6 +597,24 @@ def study_settings(resolution, ref_spp, spps, seeds):
     return (tuple(int(v) for v in text.split("x")), int(env("HAIRIS_STUDY_REF_SPP", ref_spp)),
             [int(v) for v in env("HAIRIS_STUDY_SPPS", ",".join(map(str, spps))).split(",")],
             int(env("HAIRIS_STUDY_SEEDS", seeds)))
+
+
+class Waiter:
+    """A viewport worker's redraw callback: wakes whoever waits for a condition on its render."""
+
+    def __init__(self, timeout=120.0):
+        self.condition = threading.Condition()
+        self.timeout = timeout
+
+    def __call__(self):
+        with self.condition:
+            self.condition.notify_all()
+
+    def until(self, predicate, what):
+        """Waits (at most ``timeout`` seconds) until ``predicate()``; fails naming ``what``."""
+        with self.condition:
+            if not self.condition.wait_for(predicate, self.timeout):
+                raise AssertionError("timed out waiting for " + what)
 
 
 def run_script(main):

@@ -5,7 +5,6 @@ Skipped (exit 77) until the library is built into the zip.
 
 import os
 import sys
-import threading
 import types
 
 import bpy
@@ -339,23 +338,6 @@ def test_denoise_in_one_click():
 
 # ---- 4. The viewport's worker ----------------------------------------------------------------
 
-class Waiter:
-    """The worker's redraw callback: wakes a test waiting for a condition on the render."""
-
-    def __init__(self):
-        self.condition = threading.Condition()
-
-    def __call__(self):
-        with self.condition:
-            self.condition.notify_all()
-
-    def until(self, predicate, what):
-        """Waits (at most WAIT seconds) until ``predicate()``."""
-        with self.condition:
-            if not self.condition.wait_for(predicate, WAIT):
-                raise AssertionError("timed out waiting for " + what)
-
-
 def camera_of(scene):
     """The scene camera's options without the size (what a view through it gives)."""
     data = helpers.module("export").export_scene(bpy.context.evaluated_depsgraph_get())
@@ -388,7 +370,7 @@ def test_viewport_refines_restarts_and_stops():
     the thread."""
     scene = make_scene()
     lib = native.load_library()
-    waiter = Waiter()
+    waiter = helpers.Waiter(WAIT)
     render = viewport.ViewportRender(lib, waiter)
     try:
         depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -522,7 +504,7 @@ def test_viewport_reshades_a_material_edit_without_a_new_bvh():
     lib = native.load_library()
     settings = engine.render_settings(scene.hairis)
     camera = camera_of(scene)
-    waiter = Waiter()
+    waiter = helpers.Waiter(WAIT)
     render = viewport.ViewportRender(lib, waiter)
     try:
         first = viewport.SceneJob(engine._export_view(bpy.context.evaluated_depsgraph_get()))
@@ -554,7 +536,7 @@ def test_viewport_reshades_a_material_edit_without_a_new_bvh():
 def test_viewport_stop_while_rendering():
     """stop() in the middle of a long render returns promptly with the thread ended."""
     scene = make_scene(samples=64, resolution=(96, 72))
-    render = viewport.ViewportRender(native.load_library(), Waiter())
+    render = viewport.ViewportRender(native.load_library(), helpers.Waiter(WAIT))
     depsgraph = bpy.context.evaluated_depsgraph_get()
     render.set_scene(viewport.SceneJob(engine._export_view(depsgraph)))
     render.set_view(viewport.ViewRequest(camera_of(scene), 96, 72,

@@ -33,12 +33,7 @@ def make_scene():
         "Melanin": 0.15, "Melanin Redness": 0.8, "Roughness": 0.3, "Radial Roughness": 0.3,
         "Coat": 0.0, "IOR": 1.55})
     skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    sphere = helpers.make_particle_hair(scene, count=1000, children=CHILDREN,
-                                        location=(0.0, 0.0, 0.0), scale=0.1,
-                                        hair_material=hair, skin_material=skin)
-    settings = sphere.modifiers["Hair"].particle_system.settings
-    settings.hair_length = 0.3
-    settings.radius_scale = 0.006
+    helpers.make_groom_head(scene, hair, skin, CHILDREN, 0.006)
     helpers.match_engines(scene, SAMPLES, 8)
     scene.hairis.strategy = "TABLE"
     scene.hairis.auto_bake = True

@@ -21,7 +21,6 @@ first. Prints one RUN line per edit and a SUMMARY with the medians and their rat
 
 import os
 import sys
-import threading
 import time
 
 import bpy
@@ -53,12 +52,7 @@ def groom_scene():
     helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=0.05, rotation=(0.7, 0.0, 0.5))
     hair = helpers.make_hair_material("Hair", "MELANIN", **{"Melanin": 0.15, "Roughness": 0.3})
     skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    sphere = helpers.make_particle_hair(scene, count=1000, children=CHILDREN,
-                                        location=(0.0, 0.0, 0.0), scale=0.1,
-                                        hair_material=hair, skin_material=skin)
-    settings = sphere.modifiers["Hair"].particle_system.settings
-    settings.hair_length = 0.3
-    settings.radius_scale = 0.004
+    settings = helpers.make_groom_head(scene, hair, skin, CHILDREN, 0.004)
     # The viewport shows every child: the dense groom an artist looks at.
     setattr(settings, "child_percent" if bpy.app.version >= (4, 0, 0) else "child_nbr", CHILDREN)
     settings.display_step = settings.render_step
@@ -66,22 +60,6 @@ def groom_scene():
     scene.hairis.threads = 2
     bpy.context.view_layer.update()
     return scene
-
-
-class Waiter:
-    """The worker's redraw callback: wakes the study waiting for an image."""
-
-    def __init__(self):
-        self.condition = threading.Condition()
-
-    def __call__(self):
-        with self.condition:
-            self.condition.notify_all()
-
-    def until(self, predicate):
-        with self.condition:
-            if not self.condition.wait_for(predicate, WAIT):
-                raise AssertionError("timed out waiting for the viewport")
 
 
 def melanin(value):
@@ -97,7 +75,8 @@ def melanin(value):
 def first_image(render, waiter, start):
     """Seconds from ``start`` to the worker's first image of its newest request."""
     generation = render._generation
-    waiter.until(lambda: render.frame is not None and render.frame.generation >= generation)
+    waiter.until(lambda: render.frame is not None and render.frame.generation >= generation,
+                 "the viewport's image")
     if render.error:
         raise AssertionError(render.error)
     return time.monotonic() - start
@@ -105,7 +84,7 @@ def first_image(render, waiter, start):
 
 def main():
     scene = groom_scene()
-    waiter = Waiter()
+    waiter = helpers.Waiter(WAIT)
     render = viewport.ViewportRender(native.load_library(), waiter)
     try:
         depsgraph = bpy.context.evaluated_depsgraph_get()

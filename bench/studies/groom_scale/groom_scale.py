@@ -68,12 +68,7 @@ def base_scene():
 
 
 def particle_groom(scene, hair, skin, children):
-    sphere = helpers.make_particle_hair(scene, count=1000, children=children,
-                                        location=(0.0, 0.0, 0.0), scale=0.1,
-                                        hair_material=hair, skin_material=skin)
-    settings = sphere.modifiers["Hair"].particle_system.settings
-    settings.hair_length = 0.3
-    settings.radius_scale = 0.004
+    settings = helpers.make_groom_head(scene, hair, skin, children, 0.004)
     settings.tip_radius = 0.2
     settings.use_close_tip = True
     settings.shape = 0.3
