@@ -52,7 +52,7 @@ class ProgressReporter:
 
 
 def camera_options(camera):
-    """The C API's camera options from :class:`export.CameraData`."""
+    """The C API's camera options from :class:`scene_data.CameraData`."""
     return {"matrix": np.asarray(camera.camera_to_world, dtype=np.float64).reshape(-1),
             "orthographic": bool(camera.orthographic),
             "frame": np.asarray(camera.frame, dtype=np.float64).reshape(-1),
@@ -60,7 +60,7 @@ def camera_options(camera):
 
 
 def light_options(light):
-    """The C API's light options from :class:`export.LightData`."""
+    """The C API's light options from :class:`scene_data.LightData`."""
     values = {"type": light.kind.lower(), "color": light.color, "cycles": light.cycles}
     if light.kind == "SUN":
         values.update(direction=light.direction, strength=float(light.strength),

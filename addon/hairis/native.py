@@ -198,7 +198,7 @@ HUANG_ONLY = ("aspect_ratio", "reflection", "transmission", "secondary_reflectio
 
 
 def principled_options(params):
-    """Fiber options of a Principled Hair node from a dict of ``export.HairParameters``'
+    """Fiber options of a Principled Hair node from a dict of ``hair_material.HairParameters``'
     fields (model 'CHIANG' (default) or 'HUANG'; parametrization as an index into
     PARAMETRIZATIONS or a name; angles in radians). The other model's values are left out."""
     values = dict(params)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import bpy
 
-from . import export, native
+from . import hair_material, native, shader_nodes
 
 N_H_CHOICES = (1, 2, 4, 8, 16)
 """The strand counts the add-on offers (and bakes multiple-scattering tables for)."""
@@ -40,22 +40,22 @@ class TableStatus:
 
 
 def principled_struct(library, params):
-    """The Principled Hair values of :class:`export.HairParameters` for
+    """The Principled Hair values of :class:`hair_material.HairParameters` for
     ``Library.fiber_principled`` (kept as a function for the callers that pass it around)."""
     return params.as_dict()
 
 
 def material_parameters(material):
     """The material's hair parameters, or raise TableError when it is not a usable hair one."""
-    node = export.hair_node(material)
-    if node is None and export.is_hair_material(material):
+    node = shader_nodes.hair_node(material)
+    if node is None and shader_nodes.is_hair_material(material):
         raise TableError("material %r mixes Principled Hair BSDFs through a Mix or Add Shader; "
                          "its closures' tables are not stored with the material: render with "
                          "Auto Bake, or with a strategy that needs no tables" % material.name)
     if node is None:
         raise TableError("material %r has no Principled Hair BSDF connected to its output"
                          % material.name)
-    params, _warnings, error = export.read_hair_node(node, material.name)
+    params, _warnings, error = hair_material.read_hair_node(node, material.name)
     if error is not None:
         raise TableError(error)
     return params
@@ -66,7 +66,7 @@ def hair_materials(materials=None):
     Hair BSDF at its output (a Mix/Add Shader of them bakes per closure at render time)."""
     if materials is None:
         materials = [m for m in bpy.data.materials if m.users > 0]
-    return [m for m in materials if export.hair_node(m) is not None]
+    return [m for m in materials if shader_nodes.hair_node(m) is not None]
 
 
 def bake_options(library, n_h=None, threads=0, multiple=True):

@@ -11,7 +11,7 @@ and users keep editing Cycles' nodes.
 
 import bpy
 
-from . import compat, compositor, export, native, tables
+from . import compat, compositor, native, shader_nodes, tables
 
 ENGINE = "HAIRIS"
 
@@ -55,7 +55,7 @@ def draw_node_input(layout, id_data, input_name):
             layout.label(text="No node tree")
         return False
     node_tree = id_data.node_tree
-    output = export.output_node(node_tree)
+    output = shader_nodes.output_node(node_tree)
     if output is None:
         layout.label(text="No output node")
         return True
@@ -311,7 +311,7 @@ class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
         """Hair materials (a Principled Hair BSDF at the output)."""
         material = context.material
         return (material is not None and engine_is_hairis(context)
-                and export.hair_node(material) is not None)
+                and shader_nodes.hair_node(material) is not None)
 
     def draw(self, context):
         """Draws the table state and the bake button."""

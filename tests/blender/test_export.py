@@ -19,6 +19,9 @@ import helpers  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
 export = helpers.module("export")
+hair_material = helpers.module("hair_material")
+memory = helpers.module("memory")
+scene_data = helpers.module("scene_data")
 
 # Node input name → hairis_principled_hair field, written out here on purpose (not imported).
 HAIR_FIELDS = {
@@ -589,24 +592,25 @@ def stub_hair_node(model="CHIANG", leave_out=(), rename=None, values=None):
 def test_hair_node_models_and_missing_sockets():
     """An unknown model is refused naming the material; a missing socket is named with the
     version; a socket found by its identifier alone is read."""
-    params, _warnings, error = export.read_hair_node(stub_hair_node("FUTURE"), "Future")
+    params, _warnings, error = hair_material.read_hair_node(stub_hair_node("FUTURE"), "Future")
     assert params is None and "'Future'" in error and "'FUTURE' is not supported" in error, error
-    params, _warnings, error = export.read_hair_node(stub_hair_node(leave_out=("Coat",)), "Old")
+    params, _warnings, error = hair_material.read_hair_node(stub_hair_node(leave_out=("Coat",)),
+                                                            "Old")
     assert params is None, params
     assert "'Old'" in error and "'Coat'" in error and bpy.app.version_string.split()[0] in error \
         and "3.4 to 5.x" in error, error
     # A socket whose display name changed but whose identifier did not.
-    params, _warnings, error = export.read_hair_node(
+    params, _warnings, error = hair_material.read_hair_node(
         stub_hair_node(rename={"Coat": "Coating"}), "Renamed")
     compat = helpers.module("compat")
     assert error == "material 'Renamed': the Principled Hair BSDF has no 'Coat' input in " \
         "Blender %s; Hairis supports %s" % (compat.version_string(), compat.SUPPORTED_TEXT), error
     node = stub_hair_node()
     node.inputs[7].name = "Coating"  # Coat: the identifier stays "Coat"
-    params, _warnings, error = export.read_hair_node(node, "Identifier")
+    params, _warnings, error = hair_material.read_hair_node(node, "Identifier")
     assert error is None and params.coat == 0.5, (error, params)
     # Huang reads the lobes by identifier; a Huang node without one is named.
-    params, _warnings, error = export.read_hair_node(
+    params, _warnings, error = hair_material.read_hair_node(
         stub_hair_node("HUANG", leave_out=("TT lobe",)), "NoLobe")
     assert params is None and "'TT lobe'" in error and "'NoLobe'" in error, error
 
@@ -616,7 +620,7 @@ def test_huang_rules_on_stub_nodes():
     library inverts it); a negative lobe is 0 with a warning; all three <= 0: no closure
     (exported as black, opaque strands, with a warning)."""
     def read(**values):
-        return export.read_hair_node(stub_hair_node("HUANG", values=values), "H")
+        return hair_material.read_hair_node(stub_hair_node("HUANG", values=values), "H")
 
     params, warnings, error = read(**{"Aspect Ratio": 0.5, "R lobe": 1.0, "TT lobe": 0.5,
                                       "TRT lobe": 0.2})
@@ -1033,32 +1037,32 @@ def test_groom_memory_estimate():
     # The handle's and the render's copy of points and radii (16 bytes each), the control
     # points with duplicated ends (16 bytes), a segment start and curve index per segment.
     floor = strands * points * 48 + strands * (points - 1) * 8
-    estimate = export.render_bytes_estimate(strands * points, strands)
+    estimate = memory.render_bytes_estimate(strands * points, strands)
     assert floor < estimate < 16e9, (floor, estimate)
-    assert export.render_bytes_estimate(2 * strands * points, 2 * strands) == 2 * estimate
+    assert memory.render_bytes_estimate(2 * strands * points, 2 * strands) == 2 * estimate
     # Broadcast arrays: the counts of a 5M groom without its memory.
-    groom = export.CurvesData(
+    groom = scene_data.CurvesData(
         name="Groom", source="CURVES", material=0,
         first=np.broadcast_to(np.uint32(0), (strands + 1,)),
         positions=np.broadcast_to(np.zeros(3, np.float32), (strands * points, 3)),
         radii=np.broadcast_to(np.float32(0.001), (strands * points,)))
-    data = export.SceneData(curves=[groom, groom])
+    data = scene_data.SceneData(curves=[groom, groom])
     need = 2 * estimate
-    assert export.memory_problem(data, need) is None
-    assert export.memory_problem(data, None) is None
-    message = export.memory_problem(data, need - 1)
+    assert memory.memory_problem(data, need) is None
+    assert memory.memory_problem(data, None) is None
+    message = memory.memory_problem(data, need - 1)
     assert message is not None
     for part in ("2 object(s)", "%d strands" % (2 * strands), "%d points" % (2 * strands * points),
                  "%.1f GB" % (need / 1e9)):
         assert part in message, (part, message)
     helpers.make_test_scene()
     exported = export.export_context()
-    available = export.available_memory_bytes()
+    available = memory.available_memory_bytes()
     assert available is None or available > 0
-    need = export.render_bytes_estimate(sum(c.point_count for c in exported.curves),
+    need = memory.render_bytes_estimate(sum(c.point_count for c in exported.curves),
                                         sum(c.curve_count for c in exported.curves))
-    original = export.available_memory_bytes
-    export.available_memory_bytes = lambda: need - 1
+    original = memory.available_memory_bytes
+    memory.available_memory_bytes = lambda: need - 1
     try:
         export.export_context()
     except export.ExportError as error:
@@ -1066,7 +1070,7 @@ def test_groom_memory_estimate():
     else:
         raise AssertionError("a groom above the available memory was exported")
     finally:
-        export.available_memory_bytes = original
+        memory.available_memory_bytes = original
 
 
 helpers.run([
