@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hairis {
@@ -162,84 +163,23 @@ Expected<Mat4> mapping_node_transform(const MappingNode &node) {
     return a;
 }
 
-Expected<EnvironmentMap> EnvironmentMap::create(EnvironmentDesc desc) {
-    const EnvironmentImage &image = desc.image;
-    if (image.empty()) return Error{"environment image is empty (0 x 0 pixels)"};
-    if (Status s = first_error(check::non_negative("world strength", desc.strength),
-                               check::non_negative("world color R", desc.color.r),
-                               check::non_negative("world color G", desc.color.g),
-                               check::non_negative("world color B", desc.color.b)))
-        return *s;
+namespace {
 
-    // The mapping.
-    const Mat4 &m = desc.world_to_texture;
-    if (!m.finite()) return Error{"world_to_texture must be finite (it holds nan or inf)"};
-    if (m.m[0][3] != 0.0f || m.m[1][3] != 0.0f || m.m[2][3] != 0.0f)
-        return Error{"world_to_texture must not translate (column 3 is (" + describe(m.m[0][3]) +
-                     ", " + describe(m.m[1][3]) + ", " + describe(m.m[2][3]) +
-                     ")): directions are not points"};
-    if (m.m[3][0] != 0.0f || m.m[3][1] != 0.0f || m.m[3][2] != 0.0f || m.m[3][3] != 1.0f)
-        return Error{"world_to_texture must be affine (last row 0 0 0 1)"};
-    EnvironmentMap map;
-    Mat3d a, a_inv;
-    for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) a[i][k] = double(m.m[i][k]);
-    double det = 0;
-    if (!invert3(a, a_inv, det))
-        return Error{"world_to_texture is singular (determinant " + describe(det) + ")"};
-    const double condition = frobenius(a) * frobenius(a_inv);
-    if (!(condition <= kMaxConditionNumber))
-        return Error{"world_to_texture is nearly singular (condition number " +
-                     describe(condition) + " > " + describe(kMaxConditionNumber) + ")"};
-    map.identity_ = true;
-    for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k) {
-            map.a_[i][k] = float(a[i][k]);
-            map.a_inv_[i][k] = float(a_inv[i][k]);
-            map.identity_ = map.identity_ && a[i][k] == (i == k ? 1.0 : 0.0);
-        }
-    map.abs_det_ = float(std::fabs(det));
+// The cells' luminance integrals of the bilinear radiance, in texel units (du·dv scaled by w·h),
+// computed row by row in parallel; each row relative to its maximum, so that any finite radiance
+// fits a float, and its total.
+struct CellLuminance {
+    std::vector<float> relative;      // W × H, row by row
+    std::vector<double> row_integral;  // H
+};
 
-    // The map's resolution.
-    int W = desc.map_width, H = desc.map_height;
-    if (W == 0 && H == 0) {
-        W = std::min(std::max(image.width(), kMinAutoMapWidth), kMaxAutoMapWidth);
-        H = std::min(std::max(image.height(), kMinAutoMapHeight), kMaxAutoMapHeight);
-    } else {
-        if (H == 0) H = std::max(1, W / 2);
-        if (Status s = first_error(check::count_in_range("map_width", W, 1, kMaxMapWidth),
-                                   check::count_in_range("map_height", H, 1, kMaxMapHeight)))
-            return *s;
-    }
-    Expected<UniformCells> columns = UniformCells::create(0.0f, 1.0f, W);
-    if (!columns) return Error{"map_width: " + columns.error().message};
-    map.columns_ = std::move(columns).value();
-
-    // Row edges z_J = −cos(πJ/H), and the largest z a sample of each row takes (never a pole:
-    // there the azimuth, and so the cell, would be undefined).
-    map.z_edges_.resize(size_t(H) + 1);
-    for (int j = 0; j <= H; ++j) map.z_edges_[size_t(j)] = float(-std::cos(kPi * j / H));
-    map.z_edges_.front() = -1.0f;
-    map.z_edges_.back() = 1.0f;
-    map.z_last_.resize(size_t(H));
-    for (int j = 0; j < H; ++j) {
-        const float lo = j == 0 ? -kOneMinusEpsilon : map.z_edges_[size_t(j)];
-        map.z_last_[size_t(j)] = j + 1 == H ? kOneMinusEpsilon
-                                            : std::nextafter(map.z_edges_[size_t(j) + 1], -2.0f);
-        if (!(map.z_last_[size_t(j)] >= lo))
-            return Error{"map_height = " + std::to_string(H) +
-                         " leaves a row with no width in z at float precision"};
-    }
-
-    // Cell integrals of the luminance of the bilinear radiance, in texel units (du·dv scaled
-    // by w·h), row by row in parallel; the conditional rows are stored relative to their
-    // maximum so that any finite radiance fits a float.
-    map.scale_ = desc.color * desc.strength;
-    const double sr = double(map.scale_.r), sg = double(map.scale_.g), sb = double(map.scale_.b);
+Expected<CellLuminance> cell_luminance(const EnvironmentImage &image, Rgb scale, int W, int H) {
+    const double sr = double(scale.r), sg = double(scale.g), sb = double(scale.b);
     const int w = image.width(), h = image.height();
     const Taps column_taps = tent_taps(W, w), row_taps = tent_taps(H, h);
-    std::vector<float> relative(size_t(W) * size_t(H));
-    std::vector<double> row_integral(static_cast<size_t>(H));
+    CellLuminance cells;
+    cells.relative.resize(size_t(W) * size_t(H));
+    cells.row_integral.resize(size_t(H));
     // Scene-linear texels (sRGB images decoded texel by texel: the weights then follow the
     // interpolated decoded texels, a close stand-in for the decoded interpolant Cycles reads,
     // with the same support).
@@ -279,47 +219,149 @@ Expected<EnvironmentMap> EnvironmentMap::create(EnvironmentDesc desc) {
                 total += v;
                 peak = std::max(peak, v);
             }
-            row_integral[size_t(J)] = total;
-            float *out = relative.data() + size_t(J) * size_t(W);
+            cells.row_integral[size_t(J)] = total;
+            float *out = cells.relative.data() + size_t(J) * size_t(W);
             for (int I = 0; I < W; ++I)
                 out[I] = peak > 0.0 ? positive_float(acc[size_t(I)] / peak) : 0.0f;
         }
     });
+    return cells;
+}
 
+// The map's resolution: the image's within the automatic bounds, or the one asked for.
+Expected<std::pair<int, int>> map_size(const EnvironmentDesc &desc) {
+    const EnvironmentImage &image = desc.image;
+    int W = desc.map_width, H = desc.map_height;
+    if (W == 0 && H == 0) {
+        W = std::min(std::max(image.width(), EnvironmentMap::kMinAutoMapWidth),
+                     EnvironmentMap::kMaxAutoMapWidth);
+        H = std::min(std::max(image.height(), EnvironmentMap::kMinAutoMapHeight),
+                     EnvironmentMap::kMaxAutoMapHeight);
+    } else {
+        if (H == 0) H = std::max(1, W / 2);
+        if (Status s = first_error(check::count_in_range("map_width", W, 1, EnvironmentMap::kMaxMapWidth),
+                                   check::count_in_range("map_height", H, 1, EnvironmentMap::kMaxMapHeight)))
+            return *s;
+    }
+    return std::make_pair(W, H);
+}
+
+}  // namespace
+
+// The mapping: a linear world → texture map, checked to be well conditioned.
+Status EnvironmentMap::set_mapping(const Mat4 &m) {
+    if (!m.finite()) return Error{"world_to_texture must be finite (it holds nan or inf)"};
+    if (m.m[0][3] != 0.0f || m.m[1][3] != 0.0f || m.m[2][3] != 0.0f)
+        return Error{"world_to_texture must not translate (column 3 is (" + describe(m.m[0][3]) +
+                     ", " + describe(m.m[1][3]) + ", " + describe(m.m[2][3]) +
+                     ")): directions are not points"};
+    if (m.m[3][0] != 0.0f || m.m[3][1] != 0.0f || m.m[3][2] != 0.0f || m.m[3][3] != 1.0f)
+        return Error{"world_to_texture must be affine (last row 0 0 0 1)"};
+    Mat3d a, a_inv;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) a[i][k] = double(m.m[i][k]);
+    double det = 0;
+    if (!invert3(a, a_inv, det))
+        return Error{"world_to_texture is singular (determinant " + describe(det) + ")"};
+    const double condition = frobenius(a) * frobenius(a_inv);
+    if (!(condition <= kMaxConditionNumber))
+        return Error{"world_to_texture is nearly singular (condition number " +
+                     describe(condition) + " > " + describe(kMaxConditionNumber) + ")"};
+    identity_ = true;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) {
+            a_[i][k] = float(a[i][k]);
+            a_inv_[i][k] = float(a_inv[i][k]);
+            identity_ = identity_ && a[i][k] == (i == k ? 1.0 : 0.0);
+        }
+    abs_det_ = float(std::fabs(det));
+    return std::nullopt;
+}
+
+// Uniform columns in u, and rows with edges z_J = −cos(πJ/H) in z.
+Status EnvironmentMap::set_grid(int W, int H) {
+    Expected<UniformCells> columns = UniformCells::create(0.0f, 1.0f, W);
+    if (!columns) return Error{"map_width: " + columns.error().message};
+    columns_ = std::move(columns).value();
+
+    // Row edges z_J = −cos(πJ/H), and the largest z a sample of each row takes (never a pole:
+    // there the azimuth, and so the cell, would be undefined).
+    z_edges_.resize(size_t(H) + 1);
+    for (int j = 0; j <= H; ++j) z_edges_[size_t(j)] = float(-std::cos(kPi * j / H));
+    z_edges_.front() = -1.0f;
+    z_edges_.back() = 1.0f;
+    z_last_.resize(size_t(H));
+    for (int j = 0; j < H; ++j) {
+        const float lo = j == 0 ? -kOneMinusEpsilon : z_edges_[size_t(j)];
+        z_last_[size_t(j)] = j + 1 == H ? kOneMinusEpsilon
+                                        : std::nextafter(z_edges_[size_t(j) + 1], -2.0f);
+        if (!(z_last_[size_t(j)] >= lo))
+            return Error{"map_height = " + std::to_string(H) +
+                         " leaves a row with no width in z at float precision"};
+    }
+    return std::nullopt;
+}
+
+// The sampling distributions: rows by their luminance × solid angle, columns by luminance.
+Status EnvironmentMap::set_distributions(const std::vector<float> &relative,
+                                         const std::vector<double> &row_integral, int w, int h) {
+    const int W = columns_.count(), H = int(z_edges_.size()) - 1;
     // Row masses: the row's mean luminance × its solid angle (∝ Δz).
     const double cell_texels = (double(w) / W) * (double(h) / H);
     std::vector<double> row_mass(static_cast<size_t>(H));
     double integral = 0;
     for (int J = 0; J < H; ++J) {
-        const double dz = double(map.z_edges_[size_t(J) + 1]) - double(map.z_edges_[size_t(J)]);
+        const double dz = double(z_edges_[size_t(J) + 1]) - double(z_edges_[size_t(J)]);
         row_mass[size_t(J)] = row_integral[size_t(J)] * dz;
         integral += row_integral[size_t(J)] / cell_texels * dz * (kTwoPi / W);
     }
-    map.luminance_integral_ = integral;
-    map.black_ = !(integral > 0.0);
+    luminance_integral_ = integral;
+    black_ = !(integral > 0.0);
     // Nothing to sample: rows by solid angle and uniform columns, the uniform sphere.
-    if (map.black_)
+    if (black_)
         for (int J = 0; J < H; ++J)
-            row_mass[size_t(J)] =
-                double(map.z_edges_[size_t(J) + 1]) - double(map.z_edges_[size_t(J)]);
+            row_mass[size_t(J)] = double(z_edges_[size_t(J) + 1]) - double(z_edges_[size_t(J)]);
 
     Expected<DiscreteCdfs> marginal = DiscreteCdfs::create(1, H, [&](int, double *weights) {
         std::copy(row_mass.begin(), row_mass.end(), weights);
     });
     if (!marginal) return Error{"environment map rows: " + marginal.error().message};
-    map.marginal_ = std::move(marginal).value();
+    marginal_ = std::move(marginal).value();
     Expected<DiscreteCdfs> conditional = DiscreteCdfs::create(H, W, [&](int J, double *weights) {
         const float *in = relative.data() + size_t(J) * size_t(W);
         for (int I = 0; I < W; ++I) weights[I] = double(in[I]);
     });
     if (!conditional) return Error{"environment map columns: " + conditional.error().message};
-    map.conditional_ = std::move(conditional).value();
+    conditional_ = std::move(conditional).value();
 
-    map.row_factor_.resize(size_t(H));
+    row_factor_.resize(size_t(H));
     for (int J = 0; J < H; ++J) {
-        const double dz = double(map.z_edges_[size_t(J) + 1]) - double(map.z_edges_[size_t(J)]);
-        map.row_factor_[size_t(J)] = float(double(map.marginal_.pmf(0, J)) / (dz * (kTwoPi / W)));
+        const double dz = double(z_edges_[size_t(J) + 1]) - double(z_edges_[size_t(J)]);
+        row_factor_[size_t(J)] = float(double(marginal_.pmf(0, J)) / (dz * (kTwoPi / W)));
     }
+    return std::nullopt;
+}
+
+Expected<EnvironmentMap> EnvironmentMap::create(EnvironmentDesc desc) {
+    const EnvironmentImage &image = desc.image;
+    if (image.empty()) return Error{"environment image is empty (0 x 0 pixels)"};
+    if (Status s = first_error(check::non_negative("world strength", desc.strength),
+                               check::non_negative("world color R", desc.color.r),
+                               check::non_negative("world color G", desc.color.g),
+                               check::non_negative("world color B", desc.color.b)))
+        return *s;
+    EnvironmentMap map;
+    if (Status s = map.set_mapping(desc.world_to_texture)) return *s;
+    Expected<std::pair<int, int>> size = map_size(desc);
+    if (!size) return size.error();
+    const auto [W, H] = size.value();
+    if (Status s = map.set_grid(W, H)) return *s;
+    map.scale_ = desc.color * desc.strength;
+    Expected<CellLuminance> cells = cell_luminance(image, map.scale_, W, H);
+    if (!cells) return cells.error();
+    if (Status s = map.set_distributions(cells.value().relative, cells.value().row_integral,
+                                         image.width(), image.height()))
+        return *s;
     map.image_ = std::move(desc.image);
     return map;
 }

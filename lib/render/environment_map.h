@@ -145,6 +145,12 @@ class EnvironmentMap {
     std::size_t memory_bytes() const;
 
   private:
+    Status set_mapping(const Mat4 &world_to_texture);
+    Status set_grid(int width, int height);
+    Status set_distributions(const std::vector<float> &relative,
+                             const std::vector<double> &row_integral, int image_width,
+                             int image_height);
+
     struct Cell {
         int row = 0, column = 0;
     };
