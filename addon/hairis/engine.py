@@ -84,8 +84,8 @@ def render_settings(settings):
     """The C API's render settings from ``scene.hairis``, the scene's Film > Transparent and
     Cycles bounce limits per kind (:func:`cycles_bounce_limits`), and how the running Blender's
     Cycles traces curves (:func:`compat.curve_backfaces`, the scene's Curves > Shape:
-    :func:`compat.curve_shape`) and limits transparent crossings
-    (:func:`compat.transparent_limit`)."""
+    :func:`compat.curve_shape`), builds its BVH (:func:`bvh_quality`) and limits transparent
+    crossings (:func:`compat.transparent_limit`)."""
     scene = getattr(settings, "id_data", None)
     render = getattr(scene, "render", None)
     return {"integrator": settings.integrator.lower(),
@@ -101,8 +101,21 @@ def render_settings(settings):
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces(),
             "curve_shape": compat.curve_shape(scene)[0],
+            "bvh_quality": bvh_quality(scene),
             "film_transparent": bool(getattr(render, "film_transparent", False)),
             **cycles_bounce_limits(scene)}
+
+
+def viewport_settings(settings):
+    """:func:`render_settings` for the viewport: a Low BVH, as Cycles' viewport asks Embree for."""
+    return dict(render_settings(settings), bvh_quality="low")
+
+
+def bvh_quality(scene):
+    """The BVH Cycles builds for a final render: 'high' with Performance > Use Spatial Splits,
+    else 'medium' (the viewport's is 'low', as Cycles' dynamic BVH)."""
+    cycles = getattr(scene, "cycles", None)
+    return "high" if getattr(cycles, "debug_use_spatial_splits", False) else "medium"
 
 
 def cycles_bounce_limits(scene):
@@ -608,7 +621,7 @@ class HairisRenderEngine(bpy.types.RenderEngine):
             view_matrix = np.array(region3d.view_matrix, np.float64)
             window_matrix = np.array(region3d.window_matrix, np.float64)
             settings = depsgraph.scene.hairis
-            values = render_settings(settings)
+            values = viewport_settings(settings)
             key = (view_matrix.tobytes(), window_matrix.tobytes(), width, height,
                    settings.preview_samples, sorted(values.items()))
             if key != self._view_key:

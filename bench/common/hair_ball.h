@@ -83,6 +83,7 @@ struct HairBall {
     bool straight = false;   ///< strands straight along the sphere's normal (no lean or droop)
     DualScatteringParams dual;  ///< the dual-scattering averages' (the paper's d_f = d_b = 0.7)
     int size = 96;           ///< pixels a side
+    BvhQuality bvh_quality = BvhQuality::Medium;
 };
 
 /// The ball as a scene: material 0 the Principled Hair fiber sampled by `kind` (its tables,
@@ -144,6 +145,7 @@ inline Expected<Scene> hair_ball_scene(const HairBall &ball, StrategyKind kind, 
     for (Vec3 &corner : desc.camera.frame) corner = Vec3{corner.x * 0.6f, corner.y * 0.6f, -1.0f};
     desc.camera.width = ball.size;
     desc.camera.height = ball.size;
+    desc.bvh_quality = ball.bvh_quality;
     return Scene::build(std::move(desc));
 }
 

@@ -68,11 +68,13 @@ void render_sphere(benchmark::State &state) {
 // Time per ray of each query from hair points in a dense ball (12000 strands, as
 // bench/studies/dual_scattering_study/dual_scattering_study's), in directions uniform on the sphere: 0 intersect (closest
 // hit), 1 occluded, 2 trace_through_hair (every crossing), 3 strands_before_mesh (capped at
-// kMaxStrandsBehind). The counter crossings is the mean strand count per ray.
+// kMaxStrandsBehind). The counter crossings is the mean strand count per ray. The second
+// argument is the BVH's build quality (BvhQuality: 0 low, 1 medium, 2 high).
 void hair_rays(benchmark::State &state) {
     const int query = int(state.range(0));
     HairBall ball;
     ball.strands = 12000;
+    ball.bvh_quality = BvhQuality(state.range(1));
     auto scene = hair_ball_scene(ball, StrategyKind::Analytic, false);
     if (!scene) {
         state.SkipWithError(scene.error().message.c_str());
@@ -119,9 +121,10 @@ void hair_rays(benchmark::State &state) {
     }
     state.counters["crossings"] = double(strands) / double(std::max<std::size_t>(rays, 1));
     static const char *names[] = {"intersect", "occluded", "trace_through_hair", "strands_before_mesh"};
-    state.SetLabel(names[query]);
+    static const char *qualities[] = {"low", "medium", "high"};
+    state.SetLabel(std::string(names[query]) + ", " + qualities[state.range(1)] + " BVH");
 }
-BENCHMARK(hair_rays)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK(hair_rays)->ArgsProduct({{0, 1, 2, 3}, {1}})->Args({0, 0})->Args({0, 2})->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(render_sphere)
     ->Args({int(StrategyKind::Analytic), int(Integrator::Path), 1000})

@@ -3,6 +3,8 @@
 // add-on's particle hair would give them (bench/studies/export_study/export_study.py measures the whole Blender
 // path). The SceneDesc is made outside the timed region; Scene::build takes it by value.
 //
+// The second argument is the BVH's build quality (BvhQuality: 0 low, 1 medium, 2 high).
+//
 // Counters: build_s (SceneStats::build_seconds, validation + layout + BVH), embree_peak_MB
 // (Embree's peak allocation during the build), scene_MB (hairis' own buffers), peak_MB (their
 // sum: what hairis_render_stats.peak_memory_bytes counts for the scene), input_MB (the
@@ -11,6 +13,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "hair_ball.h"
 #include "render/scene.h"
@@ -20,8 +23,9 @@
 namespace hairis::bench {
 namespace {
 
-SceneDesc strand_scene(std::size_t count) {
+SceneDesc strand_scene(std::size_t count, BvhQuality quality) {
     SceneDesc desc;
+    desc.bvh_quality = quality;
     auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(ChiangParams{}).value());
     desc.materials.push_back(HairMaterial{HairShading::create(fiber, std::make_shared<const AnalyticSampler>(fiber)).value()});
     // Roots on the unit sphere, 0.4 long, radius 0.01 at the root down to 0.002 at the tip.
@@ -41,7 +45,7 @@ SceneDesc strand_scene(std::size_t count) {
 
 void scene_build_strands(benchmark::State &state) {
     const std::size_t count = std::size_t(state.range(0));
-    const SceneDesc prototype = strand_scene(count);
+    const SceneDesc prototype = strand_scene(count, BvhQuality(state.range(1)));
     const double input_bytes = double(prototype.curves[0].points.size() * sizeof(Vec3) +
                                       prototype.curves[0].radii.size() * sizeof(float) +
                                       prototype.curves[0].first.size() * sizeof(std::uint32_t));
@@ -69,13 +73,12 @@ void scene_build_strands(benchmark::State &state) {
     state.counters["peak_MB"] = double(last.estimated_peak_bytes) / MB;
     state.counters["input_MB"] = input_bytes / MB;
     state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(count));
+    static const char *qualities[] = {"low", "medium", "high"};
     state.SetLabel(std::to_string(count) + " strands x " + std::to_string(kBallStrandPoints) +
-                   " points");
+                   " points, " + qualities[state.range(1)] + " BVH");
 }
 BENCHMARK(scene_build_strands)
-    ->Arg(10000)
-    ->Arg(100000)
-    ->Arg(1000000)
+    ->ArgsProduct({{10000, 100000, 1000000}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(2);

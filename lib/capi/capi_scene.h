@@ -366,12 +366,14 @@ void describe(Fields &f, CameraOptions &o) {
 
 /// Everything hairis_render reads: the renderer's settings, the hair sampler's and how the
 /// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces;
-/// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape).
+/// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape; bvh_quality=low|medium|high,
+/// scene.h's BvhQuality).
 struct RenderOptions {
     RenderSettings render;
     SamplerOptions sampler;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
+    BvhQuality bvh_quality = BvhQuality::Medium;
 };
 template <typename Fields>
 void describe(Fields &f, RenderOptions &o) {
@@ -383,6 +385,9 @@ void describe(Fields &f, RenderOptions &o) {
     int shape = int(o.curve_shape);
     f.choice("curve_shape", shape, {"thick", "ribbons", "thick_linear"});
     o.curve_shape = CurveShape(shape);
+    int quality = int(o.bvh_quality);
+    f.choice("bvh_quality", quality, {"low", "medium", "high"});
+    o.bvh_quality = BvhQuality(quality);
 }
 
 }  // namespace hairis::capi

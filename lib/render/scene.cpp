@@ -292,6 +292,7 @@ struct Scene::Impl {
     SceneStats stats;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
+    BvhQuality bvh_quality = BvhQuality::Medium;
 
     std::vector<std::string> geometry_warnings;  // the build's, before the lights'
     std::size_t geometry_bytes = 0;              // stats.scene_bytes without the lights
@@ -585,8 +586,11 @@ Status Scene::Impl::build_bvh() {
     rtcSetDeviceErrorFunction(device, &Impl::error_function, this);
     rtcSetDeviceMemoryMonitorFunction(device, &Impl::memory_monitor, this);
     rtc_scene = rtcNewScene(device);
-    rtcSetSceneFlags(rtc_scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetSceneFlags(rtc_scene, bvh_quality == BvhQuality::Low ? RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_DYNAMIC
+                                                               : RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(rtc_scene, bvh_quality == BvhQuality::Low    ? RTC_BUILD_QUALITY_LOW
+                                       : bvh_quality == BvhQuality::High ? RTC_BUILD_QUALITY_HIGH
+                                                                         : RTC_BUILD_QUALITY_MEDIUM);
 
     const CurveShape shape = curve_shape;
     const RTCGeometryType curve_type = shape == CurveShape::Ribbons ? RTC_GEOMETRY_TYPE_FLAT_CATMULL_ROM_CURVE
@@ -664,6 +668,11 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         return Error{"curve_shape must be thick (0), ribbons (1) or thick_linear (2) (got " +
                      std::to_string(int(desc.curve_shape)) + ")"};
     impl->curve_shape = desc.curve_shape;
+    if (desc.bvh_quality != BvhQuality::Low && desc.bvh_quality != BvhQuality::Medium &&
+        desc.bvh_quality != BvhQuality::High)
+        return Error{"bvh_quality must be low (0), medium (1) or high (2) (got " +
+                     std::to_string(int(desc.bvh_quality)) + ")"};
+    impl->bvh_quality = desc.bvh_quality;
 
     if (auto e = check_materials(desc.materials)) return *e;
 

@@ -156,6 +156,11 @@ enum class CurveBackfaces : int { Ignore = 0, Hit = 1 };
 /// Cycles 5.0's "Linear 3D Curves" (round cones from point to point).
 enum class CurveShape : int { Thick = 0, Ribbons = 1, ThickLinear = 2 };
 
+/// How much work Embree spends on the BVH, as Cycles asks for it: Low (with Embree's dynamic-scene
+/// flag) for the viewport, Medium for a final render, High with Use Spatial Splits. The image does
+/// not depend on it.
+enum class BvhQuality : int { Low = 0, Medium = 1, High = 2 };
+
 /// Everything a scene is made of, as plain data.
 struct SceneDesc {
     std::vector<Material> materials;
@@ -169,6 +174,7 @@ struct SceneDesc {
     CameraDesc camera;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
+    BvhQuality bvh_quality = BvhQuality::Medium;
 };
 
 /// What the build did and what it costs.

@@ -7,6 +7,7 @@
 #include "sampling/uniform_sampler.h"
 
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "chi2.h"
@@ -751,6 +752,60 @@ TEST(Scene, RibbonsFaceEveryRayWithCyclesRoundedNormal) {
     const std::string e = build_error(std::move(bad));
     EXPECT_NE(e.find("curve_shape must be thick (0), ribbons (1) or thick_linear (2) (got 5)"), std::string::npos)
         << e;
+}
+
+// Embree's build quality changes the BVH, never what a ray hits: a tangle of bent strands built
+// at each quality gives every ray the same closest hit, bit for bit, and the same occlusion.
+TEST(Scene, EveryBvhQualityGivesTheSameHits) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    HairCurves c;
+    c.first = {0};
+    for (int strand = 0; strand < 300; ++strand) {
+        Vec3 p{u(rng), u(rng), u(rng)};
+        for (int k = 0; k < 6; ++k) {
+            c.points.push_back(p);
+            c.radii.push_back(0.01f + 0.01f * std::fabs(u(rng)));
+            p = p + Vec3{0.3f, 0.1f * u(rng), 0.1f * u(rng)};
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    std::vector<Scene> scenes;
+    for (BvhQuality quality : {BvhQuality::Low, BvhQuality::Medium, BvhQuality::High}) {
+        SceneDesc d;
+        d.materials = {hair_material()};
+        d.curves = {c};
+        d.camera = small_camera();
+        d.bvh_quality = quality;
+        scenes.push_back(build_ok(std::move(d)));
+    }
+    int hits = 0;
+    for (int ray = 0; ray < 4000; ++ray) {
+        const Vec3 from{u(rng) - 3.0f, 1.5f * u(rng), 1.5f * u(rng)};
+        const Vec3 dir = safe_normalize(Vec3{1.0f, 0.3f * u(rng), 0.3f * u(rng)});
+        const std::optional<Hit> medium = scenes[1].intersect(from, dir, 0.0f, INFINITY);
+        hits += medium.has_value();
+        for (std::size_t q : {0u, 2u}) {
+            const std::optional<Hit> other = scenes[q].intersect(from, dir, 0.0f, INFINITY);
+            ASSERT_EQ(other.has_value(), medium.has_value()) << "ray " << ray << ", quality " << q;
+            if (medium) {
+                EXPECT_EQ(other->t, medium->t) << "ray " << ray << ", quality " << q;
+                EXPECT_EQ(other->prim.primitive, medium->prim.primitive) << "ray " << ray;
+                EXPECT_EQ(other->u, medium->u) << "ray " << ray << ", quality " << q;
+            }
+            EXPECT_EQ(scenes[q].occluded(from, dir, 0.0f, 4.0f), scenes[1].occluded(from, dir, 0.0f, 4.0f))
+                << "ray " << ray << ", quality " << q;
+        }
+    }
+    EXPECT_GT(hits, 400);  // the rays meet the tangle often enough to compare
+
+    SceneDesc bad;
+    bad.materials = {hair_material()};
+    bad.curves = {straight_hair()};
+    bad.camera = small_camera();
+    bad.bvh_quality = BvhQuality(3);
+    const std::string e = build_error(std::move(bad));
+    EXPECT_NE(e.find("bvh_quality must be low (0), medium (1) or high (2) (got 3)"), std::string::npos) << e;
 }
 
 // Linear 3D curves: segment k is the straight round cone from point k to point k + 1; a

@@ -114,7 +114,7 @@ static const char *const kinds[][2] = {
                "dual_bounce_limit=bounces;time_limit=0;adaptive_threshold=0;"
                "adaptive_min_samples=0;region=0,0,0,0;passes=;strategy=table;"
                "multiple_weight=0;n_h=2;"
-               "curve_backfaces=ignore;curve_shape=thick"},
+               "curve_backfaces=ignore;curve_shape=thick;bvh_quality=medium"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
                      "absorption=material;roughness=material;radial_roughness=material;"
                      "coat=material;ior=material;offset=material;random_color=material;"
@@ -1414,8 +1414,8 @@ typedef struct render_settings {
         max_transmission_bounces, max_transparent_bounces, threads, tile_size, rr_start_bounce, n_h,
         dual_exact_bounces;
     unsigned long long seed;
-    int integrator, strategy, film_transparent, curve_backfaces, curve_shape, huang_sampling, transparent_limit,
-        dual_hair_volume, dual_bounce_limit;
+    int integrator, strategy, film_transparent, curve_backfaces, curve_shape, bvh_quality, huang_sampling,
+        transparent_limit, dual_hair_volume, dual_bounce_limit;
     double multiple_weight, time_limit, adaptive_threshold;
     long long adaptive_min_samples;
     double region[4];
@@ -1455,6 +1455,7 @@ static int read_render_settings(const char *text, render_settings *r)
     const char *flags[4] = {"0", "1", "false", "true"};
     const char *backfaces[2] = {"ignore", "hit"};
     const char *shapes[3] = {"thick", "ribbons", "thick_linear"};
+    const char *qualities[3] = {"low", "medium", "high"};
     const char *integrators[2] = {"path", "dual_scattering"};
     const char *transparent_limits[2] = {"plus_one", "setting"};
     if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
@@ -1472,6 +1473,7 @@ static int read_render_settings(const char *text, render_settings *r)
         word(&o, "film_transparent", flags, 4, &r->film_transparent) != HAIRIS_OK ||
         word(&o, "curve_backfaces", backfaces, 2, &r->curve_backfaces) != HAIRIS_OK ||
         word(&o, "curve_shape", shapes, 3, &r->curve_shape) != HAIRIS_OK ||
+        word(&o, "bvh_quality", qualities, 3, &r->bvh_quality) != HAIRIS_OK ||
         word(&o, "huang_sampling", huang_samplings, 2, &r->huang_sampling) != HAIRIS_OK ||
         word(&o, "dual_hair_volume", volumes, 2, &r->dual_hair_volume) != HAIRIS_OK ||
         integer_in(&o, "dual_exact_bounces", 0, 1024, &r->dual_exact_bounces) != HAIRIS_OK ||
@@ -1508,14 +1510,15 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
                "threads=%lld max_diffuse_bounces=%lld max_glossy_bounces=%lld max_transmission_bounces=%lld "
                "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
-               "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s\n",
+               "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s bvh_quality=%s\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_glossy_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
             r->curve_backfaces ? "hit" : "ignore", r->integrator, r->huang_sampling,
             r->transparent_limit ? "setting" : "plus_one", r->dual_hair_volume ? "unbounded" : "layer",
             r->dual_exact_bounces, r->dual_bounce_limit ? "none" : "bounces",
-            r->curve_shape == 2 ? "thick_linear" : r->curve_shape ? "ribbons" : "thick");
+            r->curve_shape == 2 ? "thick_linear" : r->curve_shape ? "ribbons" : "thick",
+            r->bvh_quality == 2 ? "high" : r->bvh_quality ? "medium" : "low");
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

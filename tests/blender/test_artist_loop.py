@@ -375,7 +375,10 @@ def test_viewport_refines_restarts_and_stops():
     try:
         depsgraph = bpy.context.evaluated_depsgraph_get()
         job = viewport.SceneJob(engine._export_view(depsgraph))
-        settings = engine.render_settings(scene.hairis)
+        settings = engine.viewport_settings(scene.hairis)
+        # The viewport builds a Low BVH, as Cycles' viewport does (F12: Medium).
+        final = engine.render_settings(scene.hairis)
+        assert settings["bvh_quality"] == "low" and final["bvh_quality"] == "medium", final
         camera = camera_of(scene)
         render.set_scene(job)
         render.set_view(viewport.ViewRequest(camera, 48, 36, settings, 64))
@@ -502,7 +505,7 @@ def test_viewport_reshades_a_material_edit_without_a_new_bvh():
     build's of the edited scene, bit for bit."""
     scene = make_scene(samples=8)
     lib = native.load_library()
-    settings = engine.render_settings(scene.hairis)
+    settings = engine.viewport_settings(scene.hairis)
     camera = camera_of(scene)
     waiter = helpers.Waiter(WAIT)
     render = viewport.ViewportRender(lib, waiter)
@@ -540,7 +543,7 @@ def test_viewport_stop_while_rendering():
     depsgraph = bpy.context.evaluated_depsgraph_get()
     render.set_scene(viewport.SceneJob(engine._export_view(depsgraph)))
     render.set_view(viewport.ViewRequest(camera_of(scene), 96, 72,
-                                         engine.render_settings(scene.hairis), 0))
+                                         engine.viewport_settings(scene.hairis), 0))
     waiter = render.redraw
     waiter.until(lambda: render.frame is not None, "the first image")
     render.stop(timeout=WAIT)

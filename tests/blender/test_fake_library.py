@@ -214,6 +214,11 @@ def test_engine_renders_scene():
     assert summary_value(summary, "transparent_limit") == limit, summary
     # The scene's Curves > Shape (Cycles' default: Rounded Ribbons).
     assert summary_value(summary, "curve_shape") == scene.cycles_curves.shape.lower(), summary
+    # Cycles' final render builds a Medium BVH, a High one with Use Spatial Splits.
+    assert summary_value(summary, "bvh_quality") == "medium", summary
+    scene.cycles.debug_use_spatial_splits = True
+    assert summary_value(render(scene)[1], "bvh_quality") == "high"
+    scene.cycles.debug_use_spatial_splits = False
     data = export.export_scene(bpy.context.evaluated_depsgraph_get())
     assert int(summary_value(summary, "curve_sets")) == 2
     curves = {c.source: c for c in data.curves}

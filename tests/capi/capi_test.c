@@ -325,6 +325,7 @@ static void test_defaults(void)
     expect_default("render", "film_transparent", "0");
     expect_default("render", "curve_backfaces", "ignore");
     expect_default("render", "curve_shape", "thick");
+    expect_default("render", "bvh_quality", "medium");
     expect_default("render", "strategy", "table");
     expect_default("render", "seed", "0");
     expect_default("render", "threads", "0");
@@ -497,6 +498,7 @@ static void test_option_strings(void)
         {"render", "film_transparent=2", "film_transparent", "true"},
         {"render", "curve_backfaces=cull", "curve_backfaces", "hit"},
         {"render", "curve_shape=RIBBONS", "curve_shape", "thick_linear"},
+        {"render", "bvh_quality=fast", "bvh_quality", "high"},
         {"camera", "orthographic=yes", "orthographic", "false"},
     };
     for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {
@@ -1535,6 +1537,21 @@ static void test_render(void)
                   HAIRIS_OK, "other strategy");
         CHECK(stat_of("scene_reused") == 0 && stat_of("geometry_reused") == 1,
               "another strategy shades anew on the same BVH");
+        {
+            /* Another BVH quality builds another BVH over the same curves: the image is the
+             * same, bit for bit, at every quality. */
+            static float other_bvh[W * H * 4];
+            const char *qualities[] = {"low", "high"};
+            for (size_t q = 0; q < 2; ++q) {
+                char with[64];
+                snprintf(with, sizeof with, ";seed=3;threads=2;bvh_quality=%s", qualities[q]);
+                CHECK(hairis_render(scene, tiny_settings(s, "uniform", with), other_bvh, NULL, NULL) ==
+                          HAIRIS_OK, "bvh_quality=%s", qualities[q]);
+                CHECK(stat_of("geometry_reused") == 0, "bvh_quality=%s builds a new BVH", qualities[q]);
+                CHECK(memcmp(again, other_bvh, sizeof again) == 0,
+                      "bvh_quality=%s renders the same image", qualities[q]);
+            }
+        }
         CHECK(hairis_render(scene, tiny_settings(s, "uniform", ";seed=3;threads=2;curve_shape=ribbons"), again,
                             NULL, NULL) == HAIRIS_OK, "other curve shape");
         CHECK(stat_of("geometry_reused") == 0, "another curve shape builds a new BVH");

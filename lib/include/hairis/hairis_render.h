@@ -213,7 +213,9 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * curve from inside its tube (it started inside another, overlapping strand) passes, as in
  * Cycles built with Embree 3 (Blender 3.4), or hits it, as in Cycles with Embree 4 (Blender's
  * builds from 3.6: 4.5, 5.0), curve_shape = thick (default) | ribbons | thick_linear: Cycles'
- * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), transparent_limit = plus_one (default) | setting: a path crosses
+ * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), bvh_quality = low | medium
+ * (default) | high: the work Embree spends on the BVH, as Cycles asks for it in the viewport, in
+ * a final render and with Use Spatial Splits (the image is the same), transparent_limit = plus_one (default) | setting: a path crosses
  * at most max_transparent_bounces + 1 transparent surfaces, as Cycles up to 4.5 (it stores the
  * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
@@ -234,11 +236,11 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * refused; one without geometry renders the world (every ray misses). A scene can be rendered
  * again with other settings, also from several threads at once. The scene keeps the last
  * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
- * sampler, integrator, huang_sampling, curve_backfaces and curve_shape are the last render's
+ * sampler, integrator, huang_sampling, curve_backfaces, curve_shape and bvh_quality are the last render's
  * reuses it with the current camera (build_seconds 0, scene_reused 1), so a new view costs no
  * new BVH. While its curves and meshes stay and no other render uses it, its BVH is kept for a
  * render with other materials, textures, lights or world (hairis_scene_reset_shading) or other
- * settings with the same curve_backfaces and curve_shape (geometry_reused 1); adding curves,
+ * settings with the same curve_backfaces, curve_shape and bvh_quality (geometry_reused 1); adding curves,
  * meshes or mesh attributes frees it. hairis_scene_destroy frees it too.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
