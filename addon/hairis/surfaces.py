@@ -139,8 +139,11 @@ def _value(socket, components):
     return _rgb(value)
 
 
-def image_source(image, where, warn):
-    """(path, pixels, colour space) of an image, or None with a warning."""
+def image_source(image, where, warn, fallback="hairis uses the input's unlinked value",
+                 clamp_negative=True):
+    """(path, pixels, colour space) of an image, or None with a warning that ends in
+    ``fallback`` (what is rendered instead). ``clamp_negative`` sets negative texels of an
+    image read as pixels to 0; without it they reach the library, which refuses them by name."""
     name = image.colorspace_settings.name
     if name in SRGB_COLOR_SPACES:
         color_space = "srgb"
@@ -150,8 +153,7 @@ def image_source(image, where, warn):
             warn("%s: image %r has the colour space %r, which hairis does not convert; it reads "
                  "the values as linear Rec.709" % (where, image.name, name))
     if image.source not in {"FILE", "GENERATED"}:
-        warn("%s: %s images are not supported; hairis uses the input's unlinked value"
-             % (where, image.source.lower()))
+        warn("%s: %s images are not supported; %s" % (where, image.source.lower(), fallback))
         return None
     if image.source == "FILE" and image.packed_file is None and not image.is_dirty:
         path = bpy.path.abspath(image.filepath, library=image.library)
@@ -161,13 +163,12 @@ def image_source(image, where, warn):
     width, height = (int(v) for v in image.size)
     channels = int(image.channels)
     if width < 1 or height < 1 or channels < 1:
-        warn("%s: image %r has no pixels (a missing file?); hairis uses the input's unlinked "
-             "value" % (where, image.name))
+        warn("%s: image %r has no pixels (a missing file?); %s" % (where, image.name, fallback))
         return None
     pixels = np.empty(width * height * channels, np.float32)
     image.pixels.foreach_get(pixels)
     pixels = pixels.reshape(height, width, channels)
-    if channels >= 3:
+    if clamp_negative and channels >= 3:
         pixels = np.maximum(pixels, 0.0)  # Blender's byte-to-float can leave -0.0
     return None, pixels, color_space
 

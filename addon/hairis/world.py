@@ -1,61 +1,21 @@
 """Worlds whose Background Color is an Environment Texture → :class:`EnvironmentData`: the
 image, its colour space, the Mapping node and the world's sampling settings."""
 
-import os
-
-import bpy
 import numpy as np
 
-from . import node_eval
+from . import node_eval, surfaces
 from .convert import matrix_of
 from .scene_data import EnvironmentData
 from .shader_nodes import find_input
 
 ENVIRONMENT_NODE_IDNAME = "ShaderNodeTexEnvironment"
 MAPPING_TYPES = {"POINT": "point", "TEXTURE": "texture", "VECTOR": "vector", "NORMAL": "normal"}
-LINEAR_COLOR_SPACES = {"Linear", "Linear Rec.709", "Non-Color", "Raw", "Linear BT.709"}
-"""Image colour spaces whose values are scene-linear Rec.709 (or data) as stored."""
-SRGB_COLOR_SPACES = {"sRGB", "sRGB 2.1"}
 SAMPLING_METHODS = {"AUTOMATIC": "auto", "MANUAL": "manual", "NONE": "none"}
 """Cycles' World > Settings > Sampling (``world.cycles.sampling_method``)."""
 
 
 def _node_label(node):
     return "%s %r" % (node.bl_label or node.bl_idname, node.name)
-
-
-def _environment_image(world, node, image, warn):
-    """(path, pixels, colour space) for an Environment Texture's image, or None."""
-    name = image.colorspace_settings.name
-    if name in SRGB_COLOR_SPACES:
-        color_space = "srgb"
-    else:
-        color_space = "linear"
-        if name not in LINEAR_COLOR_SPACES:
-            warn("world %r: image %r has the colour space %r, which hairis does not convert; it "
-                 "reads the values as linear Rec.709" % (world.name, image.name, name))
-    if image.source not in {"FILE", "GENERATED"}:
-        warn("world %r: %s: %s images are not supported; the world is rendered with the "
-             "Background's colour" % (world.name, _node_label(node), image.source.lower()))
-        return None
-    path = None
-    if image.source == "FILE" and image.packed_file is None and not image.is_dirty:
-        candidate = bpy.path.abspath(image.filepath, library=image.library)
-        if candidate and os.path.isfile(candidate) and ";" not in candidate \
-                and candidate == candidate.strip():
-            path = candidate
-    if path is not None:
-        return path, None, color_space
-    # Packed, generated, edited in memory, or a path the C API cannot take: the pixels.
-    width, height = (int(v) for v in image.size)
-    channels = int(image.channels)
-    if width < 1 or height < 1 or channels < 1:
-        warn("world %r: image %r has no pixels (a missing file?); the world is rendered with "
-             "the Background's colour" % (world.name, image.name))
-        return None
-    pixels = np.empty(width * height * channels, np.float32)
-    image.pixels.foreach_get(pixels)
-    return None, pixels.reshape(height, width, channels), color_space
 
 
 def _mapping_vector(world, node, warn):
@@ -142,7 +102,9 @@ def read_environment(world, color_socket, warn):
         warn("world %r: %s has no image; the world is rendered with the Background's colour"
              % (world.name, _node_label(node)))
         return None
-    found = _environment_image(world, node, image, warn)
+    found = surfaces.image_source(image, "world %r: %s" % (world.name, _node_label(node)), warn,
+                                  fallback="the world is rendered with the Background's colour",
+                                  clamp_negative=False)
     if found is None:
         return None
     path, pixels, color_space = found
