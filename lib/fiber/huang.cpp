@@ -477,7 +477,7 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
                 Colour trrt = residual_series(e.t1, b.r2, e.at);
                 for (double &x : trrt) x *= weight;
                 if (!b.vis) {
-                    out.tir_only_.push_back({b.wtr, trrt});
+                    out.tir_only_.push_back(-b.wtr, trrt);
                     continue;
                 }
                 for (int i = 0; i < 3; ++i) out.trrt_always_[i] += trrt[i];
@@ -494,6 +494,7 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
             }
         }
     }
+    out.group_paths();
     return out;
 }
 
@@ -536,16 +537,21 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
         if (!std::isfinite(x)) continue;
         for (int k = 0; k < 3; ++k) tt[k] += x * path.colour[k];
     }
-    for (const TrtPath &path : trt_) {
-        if (exit_tir(c, path.wtr, l)) continue;
-        const double x = path.coefficient * trt_exit(c, path.wtr, path.n3, path.m3, path.cos_m3, path.scale3, l);
-        if (!std::isfinite(x)) continue;
-        for (int k = 0; k < 3; ++k) trt[k] += x * path.colour[k];
+    // A TRT exit below cos_min from −w_tr is totally reflected (exit_tir).
+    const double cos_min = 1.0 / c.eta - kTirSlack;
+    for (const DirectionCones::Cone &cone : trt_cones_.cones()) {
+        const DirectionCones::Side side = DirectionCones::side(cone, l, cos_min);
+        if (side == DirectionCones::Side::Below) continue;
+        for (std::uint32_t j = cone.begin; j < cone.end; ++j) {
+            const TrtPath &path = trt_[j];
+            if (side == DirectionCones::Side::Mixed && exit_tir(c, path.wtr, l)) continue;
+            const double x = path.coefficient * trt_exit(c, path.wtr, path.n3, path.m3, path.cos_m3, path.scale3, l);
+            if (!std::isfinite(x)) continue;
+            for (int k = 0; k < 3; ++k) trt[k] += x * path.colour[k];
+        }
     }
-    for (const TirPath &path : tir_only_) {
-        if (!exit_tir(c, path.wtr, l)) continue;
-        for (int k = 0; k < 3; ++k) trrt[k] += path.trrt[k];
-    }
+    const std::array<double, 3> reflecting = tir_only_.sum_reflecting(l, cos_min);
+    for (int k = 0; k < 3; ++k) trrt[k] += reflecting[k];
     const double m = chiang::longitudinal_scattering(p.v.y, cos_theta(p.v), l.y, cos_theta(l), 4.0 * c.alpha);
     const double trrt_factor = m * kInvTwoPi * (2.0 / kPi);
     // A chain that leaves at the edge of total internal reflection can come out a rounding
@@ -559,6 +565,69 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
     out[2] = rgb_of(trt);
     out[3] = rgb_of(trrt);
     return out;
+}
+
+void HuangExpectation::TirPaths::push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt) {
+    x.push_back(minus_wtr.x);
+    y.push_back(minus_wtr.y);
+    z.push_back(minus_wtr.z);
+    r.push_back(trrt[0]);
+    g.push_back(trrt[1]);
+    b.push_back(trrt[2]);
+}
+
+void HuangExpectation::TirPaths::group() {
+    std::vector<Vec3d> directions(x.size());
+    for (std::size_t k = 0; k < x.size(); ++k) directions[k] = {x[k], y[k], z[k]};
+    cones = DirectionCones(directions);
+    auto permute = [&](std::vector<double> &column) {
+        std::vector<double> out(column.size());
+        for (std::size_t k = 0; k < out.size(); ++k) out[k] = column[cones.order()[k]];
+        column.swap(out);
+    };
+    for (std::vector<double> *column : {&x, &y, &z, &r, &g, &b}) permute(*column);
+    cone_sums.assign(cones.cones().size(), {0.0, 0.0, 0.0});
+    for (std::size_t c = 0; c < cone_sums.size(); ++c)
+        for (std::uint32_t k = cones.cones()[c].begin; k < cones.cones()[c].end; ++k) {
+            cone_sums[c][0] += r[k];
+            cone_sums[c][1] += g[k];
+            cone_sums[c][2] += b[k];
+        }
+}
+
+std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double cos_min) const {
+    double sr = 0.0, sg = 0.0, sb = 0.0;
+    for (std::size_t c = 0; c < cone_sums.size(); ++c) {
+        const DirectionCones::Cone &cone = cones.cones()[c];
+        switch (DirectionCones::side(cone, l, cos_min)) {
+        case DirectionCones::Side::Below:
+            sr += cone_sums[c][0];
+            sg += cone_sums[c][1];
+            sb += cone_sums[c][2];
+            break;
+        case DirectionCones::Side::AtOrAbove:
+            break;
+        case DirectionCones::Side::Mixed:
+            for (std::uint32_t k = cone.begin; k < cone.end; ++k) {
+                const double keep = x[k] * l.x + y[k] * l.y + z[k] * l.z < cos_min ? 1.0 : 0.0;
+                sr += keep * r[k];
+                sg += keep * g[k];
+                sb += keep * b[k];
+            }
+            break;
+        }
+    }
+    return {sr, sg, sb};
+}
+
+void HuangExpectation::group_paths() {
+    std::vector<Vec3d> directions(trt_.size());
+    for (std::size_t k = 0; k < trt_.size(); ++k) directions[k] = -trt_[k].wtr;
+    trt_cones_ = DirectionCones(directions);
+    std::vector<TrtPath> ordered(trt_.size());
+    for (std::size_t k = 0; k < ordered.size(); ++k) ordered[k] = trt_[trt_cones_.order()[k]];
+    trt_.swap(ordered);
+    tir_only_.group();
 }
 
 Rgb HuangExpectation::f(Vec3 wi) const {

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "core/direction_cones.h"
 #include "core/expected.h"
 #include "core/math.h"
 #include "core/vec3d.h"
@@ -132,9 +133,11 @@ class HuangExpectation {
     /// R, TT, TRT, TRRT+.
     std::array<Rgb, 4> lobes(Vec3 wi) const;
     const huang::View &view() const { return view_; }
-    /// Precomputed paths (TT exits, TRT exits), for cost studies.
+    /// Precomputed paths (TT exits, TRT exits, TRRT+ terms counted only under total internal
+    /// reflection), for cost studies.
     std::size_t tt_paths() const { return tt_.size(); }
     std::size_t trt_paths() const { return trt_.size(); }
+    std::size_t tir_paths() const { return tir_only_.x.size(); }
 
   private:
     friend class HuangFiber;
@@ -148,17 +151,28 @@ class HuangExpectation {
         double coefficient = 0, cos_m3 = 0, scale3 = 0;
         std::array<double, 3> colour{};
     };
-    struct TirPath {  // a TRRT+ term that counts only when the exit is totally reflecting
-        Vec3d wtr;
-        std::array<double, 3> trrt{};
+    /// TRRT+ terms that count only when the exit is totally reflecting, as columns grouped
+    /// by the direction −w_tr, with each cone's sum: most cones count wholly or not at all.
+    struct TirPaths {
+        std::vector<double> x, y, z;  ///< −w_tr
+        std::vector<double> r, g, b;  ///< the TRRT+ term
+        DirectionCones cones;
+        std::vector<std::array<double, 3>> cone_sums;
+        void push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt);
+        void group();
+        /// Σ of the terms whose exit towards l is totally reflecting (dot(−w_tr, l) < cos_min).
+        std::array<double, 3> sum_reflecting(Vec3d l, double cos_min) const;
     };
+    /// Orders the TRT paths by cone of −w_tr and groups the TRRT+ terms; called once built.
+    void group_paths();
     explicit HuangExpectation(const HuangFiber &fiber) : fiber_(&fiber) {}
 
     const HuangFiber *fiber_;
     huang::View view_;
     std::vector<TtPath> tt_;
     std::vector<TrtPath> trt_;
-    std::vector<TirPath> tir_only_;
+    DirectionCones trt_cones_;  ///< of −w_tr, over trt_ as ordered
+    TirPaths tir_only_;
     std::array<double, 3> trrt_always_{};
 };
 

@@ -1,0 +1,43 @@
+// Unit directions grouped into narrow cones, so that one threshold test, dot(d, l) < c, over
+// all of them decides whole cones at once and looks at single directions only near the edge
+// of the cap it cuts. Huang's TRT and TRRT+ paths use it for the total internal reflection
+// of their exits: most cones of a view lie wholly inside or outside an exit's cap.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/vec3d.h"
+
+namespace hairis {
+
+class DirectionCones {
+  public:
+    struct Cone {
+        std::uint32_t begin = 0, end = 0;       ///< the members are order()[begin, end)
+        Vec3d axis{0.0, 0.0, 1.0};              ///< unit
+        double cos_radius = 1, sin_radius = 0;  ///< no member is farther from the axis
+    };
+    /// Where a cone's members lie against the test dot(d, l) < c.
+    enum class Side { Below, AtOrAbove, Mixed };
+
+    DirectionCones() = default;
+    /// Groups unit directions by the cells of a grid of `bands` equal bands of z and
+    /// 2·`bands` sectors of longitude about z; an empty cell makes no cone.
+    explicit DirectionCones(const std::vector<Vec3d> &directions, int bands = 12);
+
+    const std::vector<Cone> &cones() const { return cones_; }
+    /// The input's indices, cone after cone, ascending within a cone.
+    const std::vector<std::uint32_t> &order() const { return order_; }
+
+    /// Below when dot(d, l) < c for every member, AtOrAbove when for none, else Mixed. A cone
+    /// is decided only with a margin far above rounding, so a decision never disagrees with
+    /// the test computed member by member (l need not be exactly unit).
+    static Side side(const Cone &cone, Vec3d l, double c);
+
+  private:
+    std::vector<Cone> cones_;
+    std::vector<std::uint32_t> order_;
+};
+
+}  // namespace hairis
