@@ -691,7 +691,9 @@ Rgb HuangPoint::albedo() const {
     const Vec3d i{dot(hit.wo, n), hit.wo.x, dot(hit.wo, z)};
     const double h = hit.h, eta = fiber_->ior();
     const double cos_i = h * i.x + std::sqrt(std::max(0.0, 1.0 - h * h)) * i.z;
-    const double f = fresnel_dielectric(cos_i, eta);
+    // Cycles' fresnel_dielectric takes |cos_i| with the same η: where an elliptic fiber's
+    // macro normal faces away from the view (cos_i < 0) it does not swap the indices.
+    const double f = fresnel(cos_i, eta);
     const double cos_t = -std::sqrt(std::max(0.0, eta * eta - 1.0 + cos_i * cos_i)) / eta;
     const double wt_y = -i.y / eta;  // the refracted view's tangent part (refract_angle)
     auto channel = [&](int c) {

@@ -397,6 +397,42 @@ TEST(Huang, PointRotatesIntoHuangFrame) {
     EXPECT_FALSE(fiber.at(side).sample_cycles(0.5f, 0.5f, 0.5f, lcg).has_value());
 }
 
+// Cycles' bsdf_hair_huang_albedo in its closure frame (N the major axis, Y the tangent, Z = N × Y):
+// the macro normal at h is (h, 0, √(1 − h²)), F is fresnel_dielectric of its cosine with ω_o,
+// which takes |cos| with the fiber's η, cos_t = −√(η² − 1 + cos²)/η, the refracted view's Y is
+// −ω_o·Y/η, A = exp(2σ cos_t / (1 − Y²)) and the albedo (A − 2FA + F)/(1 − FA). F here is
+// Cycles' fresnel_dielectric_cos form, not the library's. An elliptic fiber hit near the edge
+// whose major axis is turned away from the view has a negative cosine.
+TEST(Huang, AlbedoIsCyclesEstimate) {
+    const HuangFiber fiber = make_fiber(0.3f, 0.5f);
+    const double eta = fiber.ior();
+    for (const double axis_degrees : {70.0, 20.0, -50.0}) {
+        const double a = axis_degrees * kPi / 180.0;
+        FiberHit hit;
+        hit.wo = view_at(0.4);
+        hit.normal = {0.0f, float(std::cos(a)), float(std::sin(a))};
+        hit.h = 0.55f;
+        const HuangPoint point = fiber.at(hit);
+        ASSERT_FALSE(point.transparent()) << axis_degrees;
+        const Vec3d n{0.0, std::cos(a), std::sin(a)}, tangent{1.0, 0.0, 0.0}, z = cross(n, tangent);
+        const Vec3d wo(hit.wo);
+        const double ix = dot(wo, n), iy = dot(wo, tangent), iz = dot(wo, z), h = hit.h;
+        const double cos_i = h * ix + std::sqrt(1.0 - h * h) * iz;
+        if (axis_degrees == 70.0) {
+            ASSERT_LT(cos_i, 0.0);  // the macro normal faces away
+        }
+        const double c = std::fabs(cos_i), g = std::sqrt(eta * eta - 1.0 + c * c);
+        const double fa = (g - c) / (g + c), fb = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+        const double f = 0.5 * fa * fa * (1.0 + fb * fb);
+        const double cos_t = -g / eta, wt_y = -iy / eta;
+        const Rgb albedo = point.albedo();
+        for (int k = 0; k < 3; ++k) {
+            const double t = std::exp(2.0 * double(fiber.sigma()[std::size_t(k)]) * cos_t / (1.0 - wt_y * wt_y));
+            EXPECT_NEAR(albedo[k], (t - 2.0 * f * t + f) / (1.0 - f * t), 1e-5) << axis_degrees << " " << k;
+        }
+    }
+}
+
 // Cycles' sampler is an unbiased estimator of its own scattering: the mean weight over many
 // samples is the sampler's albedo. The reference is Cycles itself: a thin clear fiber in a white
 // world with BSDF sampling only renders the sampler's albedo (docs/huang.md §14: bpy 4.5, σ = 0,
