@@ -342,11 +342,16 @@ Expected<std::vector<int>> n_h_values_of(const OIIO::ImageSpec &spec) {
     return values;
 }
 
-// The Huang part (parts "huang"), its f part ("huang,f") and the multiple part after them
-// ("huang,multiple", "huang,f,multiple"): the layout of huang_pixels_of, sizes checked before
-// the pixels are read.
-Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, bool multiple) {
-    const OIIO::ImageSpec &spec = in.spec();
+// A Huang file's rows, as its attributes place them: the Huang part, its f part (as many rows,
+// or none) and the multiple part after them.
+struct HuangLayout {
+    int theta_o = 0, phi_o = 0, theta_r = 0;
+    long long rows = 0, f_rows = 0;  // φ_o × θ_o × θ_i each
+    long long width = 0, height = 0;
+};
+
+// A Huang file has no Chiang part, and no multiple part's attributes unless its parts name one.
+Status check_huang_parts(const OIIO::ImageSpec &spec, bool multiple) {
     for (const char *far : {"hairis:theta_r_count", "hairis:theta_i_count", "hairis:phi_count", "hairis:near"})
         if (spec.find_attribute(far))
             return file_error(std::string("a huang2022 file has no direct far-field or near-field part, but it has ") +
@@ -356,77 +361,146 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, b
             if (spec.find_attribute(part))
                 return file_error(std::string("hairis:parts is \"huang\", which has no multiple part, but the file "
                                               "has ") + part);
+    return std::nullopt;
+}
+
+// hairis:huang: the Huang part's axes, within the size limits.
+Status read_huang_axes(const OIIO::ImageSpec &spec, HuangTableSet &h, HuangLayout &layout) {
     const OIIO::ParamValue *attribute = spec.find_attribute("hairis:huang");
     if (!attribute || attribute->type() != TypeDesc::STRING)
         return file_error("hairis:parts is \"huang\" but there is no string attribute hairis:huang "
                           "(\"row=0;theta_o=...;phi_o=...;theta_i=...;phi=...\")");
     Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:huang"), "hairis:huang");
     if (!reader) return file_error(reader.error().message);
-    auto h = std::make_shared<HuangTableSet>();
-    int row = -1, theta_o = 0, phi_o = 0;
+    int row = -1;
     reader.value().field("row", row, 0, 0);
-    reader.value().field("theta_o", theta_o, 1, kMaxThetaRNodes);
-    reader.value().field("phi_o", phi_o, 1, kMaxPhiONodes);
-    reader.value().field("theta_i", h->theta_i_count, 1, kMaxTableAxisCells);
-    reader.value().field("phi", h->phi_count, 1, kMaxTableAxisCells);
+    reader.value().field("theta_o", layout.theta_o, 1, kMaxThetaRNodes);
+    reader.value().field("phi_o", layout.phi_o, 1, kMaxPhiONodes);
+    reader.value().field("theta_i", h.theta_i_count, 1, kMaxTableAxisCells);
+    reader.value().field("phi", h.phi_count, 1, kMaxTableAxisCells);
     if (Status e = reader.value().finish()) return file_error(e->message);
-    if (row != 0 || theta_o == 0 || phi_o == 0 || h->theta_i_count == 0 || h->phi_count == 0)
+    if (row != 0 || layout.theta_o == 0 || layout.phi_o == 0 || h.theta_i_count == 0 || h.phi_count == 0)
         return file_error("hairis:huang must give row=0, theta_o, phi_o, theta_i and phi");
-    const long long rows = (long long)phi_o * theta_o * h->theta_i_count;
-    if (rows * h->phi_count > kMaxTableCells ||
-        HuangTable::bytes_needed(theta_o, phi_o, h->theta_i_count, h->phi_count) > kMaxSamplingTableBytes)
-        return file_error("hairis:huang claims " + std::to_string(rows * h->phi_count) +
+    layout.rows = (long long)layout.phi_o * layout.theta_o * h.theta_i_count;
+    if (layout.rows * h.phi_count > kMaxTableCells ||
+        HuangTable::bytes_needed(layout.theta_o, layout.phi_o, h.theta_i_count, h.phi_count) > kMaxSamplingTableBytes)
+        return file_error("hairis:huang claims " + std::to_string(layout.rows * h.phi_count) +
                           " cells; a Huang table has at most " + std::to_string(kMaxTableCells) + " cells and " +
                           std::to_string(kMaxSamplingTableBytes) + " bytes");
-    const long long f_rows = with_f ? rows : 0;
+    layout.width = h.phi_count;
+    layout.height = layout.rows;
+    return std::nullopt;
+}
+
+// hairis:huang_f: there exactly when the parts name an f part, starting after the Huang part.
+Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layout) {
     if (with_f != (spec.find_attribute("hairis:huang_f") != nullptr))
         return file_error(with_f ? "hairis:parts names an f part but there is no string attribute hairis:huang_f "
                                    "(\"row=...\")"
                                  : "hairis:parts names no f part, but the file has hairis:huang_f");
-    if (with_f) {
-        Expected<OptionReader> fr = OptionReader::parse(spec.get_string_attribute("hairis:huang_f"), "hairis:huang_f");
-        if (!fr) return file_error(fr.error().message);
-        int f_row = -1;
-        fr.value().field("row", f_row, 0, kMaxTableCells);
-        if (Status e = fr.value().finish()) return file_error(e->message);
-        if (f_row != rows)
-            return file_error("hairis:huang_f must start at row " + std::to_string(rows) + ", after the Huang part");
-    }
-    long long width = h->phi_count, height = rows + f_rows;
+    if (!with_f) return std::nullopt;
+    Expected<OptionReader> fr = OptionReader::parse(spec.get_string_attribute("hairis:huang_f"), "hairis:huang_f");
+    if (!fr) return file_error(fr.error().message);
+    int f_row = -1;
+    fr.value().field("row", f_row, 0, kMaxTableCells);
+    if (Status e = fr.value().finish()) return file_error(e->message);
+    if (f_row != layout.rows)
+        return file_error("hairis:huang_f must start at row " + std::to_string(layout.rows) + ", after the Huang part");
+    layout.f_rows = layout.rows;
+    layout.height += layout.f_rows;
+    return std::nullopt;
+}
+
+// hairis:multiple with its θ_r nodes and n_h values, starting after the f part.
+Status read_huang_multiple(const OIIO::ImageSpec &spec, bool with_f, TableSet &t, HuangLayout &layout) {
+    const OIIO::ParamValue *m = spec.find_attribute("hairis:multiple");
+    if (!m || m->type() != TypeDesc::STRING)
+        return file_error("hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
+                          "(\"row=...;theta_r=...;theta_i=...\")");
+    Expected<OptionReader> mr = OptionReader::parse(spec.get_string_attribute("hairis:multiple"), "hairis:multiple");
+    if (!mr) return file_error(mr.error().message);
+    int multiple_row = -1;
+    mr.value().field("row", multiple_row, 0, kMaxTableCells);
+    mr.value().field("theta_r", layout.theta_r, 1, kMaxThetaRNodes);
+    mr.value().field("theta_i", t.theta_i_count, 2, kMaxTableAxisCells);
+    if (Status e = mr.value().finish()) return file_error(e->message);
+    const long long first = layout.rows + layout.f_rows;
+    if (multiple_row != first || layout.theta_r == 0 || t.theta_i_count == 0)
+        return file_error("hairis:multiple must give theta_r and theta_i and start at row " + std::to_string(first) +
+                          (with_f ? ", after the f part" : ", after the Huang part"));
+    Expected<std::vector<float>> nodes = float_array(spec, "hairis:theta_r_nodes", layout.theta_r);
+    if (!nodes) return nodes.error();
+    t.theta_r_nodes = std::move(nodes).value();
+    Expected<std::vector<int>> n_h = n_h_values_of(spec);
+    if (!n_h) return n_h.error();
+    t.n_h_values = std::move(n_h).value();
+    if (t.n_h_values.empty() || t.n_h_values.size() > size_t(kMaxStrandCounts))
+        return file_error("hairis:n_h_values must give 1 to " + std::to_string(kMaxStrandCounts) +
+                          " strand counts for the multiple part");
+    layout.width = std::max<long long>(layout.width, (long long)t.n_h_values.size());
+    layout.height += (long long)layout.theta_r * t.theta_i_count;
+    return std::nullopt;
+}
+
+// The pixels into the Huang part (R), its f part (RGB) and the multiple part (G per n_h), with
+// every unused channel and the padding checked.
+Status unpack_huang_pixels(const std::vector<float> &px, const HuangLayout &layout, HuangTableSet &h, TableSet &t) {
+    const size_t w = size_t(layout.width), huang_width = size_t(h.phi_count), bands = t.n_h_values.size();
+    const size_t rows = size_t(layout.rows), first_multiple = size_t(layout.rows + layout.f_rows);
+    h.values.resize(rows * huang_width);
+    if (layout.f_rows > 0) h.f.resize(3 * h.values.size());
+    t.multiple.assign(size_t(t.theta_r_count()) * bands * size_t(t.theta_i_count), 0.0f);
+    for (size_t y = 0; y < size_t(layout.height); ++y)
+        for (size_t x = 0; x < w; ++x) {
+            const float *p = &px[(y * w + x) * kChannels];
+            const bool in_huang = y < rows && x < huang_width;
+            const bool in_f = y >= rows && y < first_multiple && x < huang_width;
+            const bool in_multiple = y >= first_multiple && x < bands;
+            if (in_f) {
+                if (p[3] != 1.0f)
+                    return file_error("A must be 1 in the f part at " + pixel_name((long long)x, (long long)y));
+                const size_t n = (y - rows) * huang_width + x;
+                for (size_t c = 0; c < 3; ++c) h.f[3 * n + c] = p[c];
+            } else if (!in_huang && !in_multiple) {
+                if (Status s = check_padding(p, x, y)) return s;
+            } else if (in_huang) {
+                if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
+                    return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
+                                      pixel_name((long long)x, (long long)y));
+                h.values[y * huang_width + x] = p[0];
+            } else {
+                if (p[0] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
+                    return file_error("R and B must be 0 and A must be 1 in the multiple part at " +
+                                      pixel_name((long long)x, (long long)y));
+                const size_t r = (y - first_multiple) / size_t(t.theta_i_count);
+                const size_t i = (y - first_multiple) % size_t(t.theta_i_count);
+                t.multiple[(r * bands + x) * size_t(t.theta_i_count) + i] = p[1];
+            }
+        }
+    return std::nullopt;
+}
+
+// The Huang part (parts "huang"), its f part ("huang,f") and the multiple part after them
+// ("huang,multiple", "huang,f,multiple"): the layout of huang_pixels_of, sizes checked before
+// the pixels are read.
+Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, bool multiple) {
+    const OIIO::ImageSpec &spec = in.spec();
+    auto h = std::make_shared<HuangTableSet>();
+    HuangLayout layout;
+    if (Status s = check_huang_parts(spec, multiple)) return *s;
+    if (Status s = read_huang_axes(spec, *h, layout)) return *s;
+    if (Status s = read_huang_f(spec, with_f, layout)) return *s;
     if (multiple) {
-        const OIIO::ParamValue *m = spec.find_attribute("hairis:multiple");
-        if (!m || m->type() != TypeDesc::STRING)
-            return file_error("hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
-                              "(\"row=...;theta_r=...;theta_i=...\")");
-        Expected<OptionReader> mr = OptionReader::parse(spec.get_string_attribute("hairis:multiple"), "hairis:multiple");
-        if (!mr) return file_error(mr.error().message);
-        int multiple_row = -1, theta_r = 0;
-        mr.value().field("row", multiple_row, 0, kMaxTableCells);
-        mr.value().field("theta_r", theta_r, 1, kMaxThetaRNodes);
-        mr.value().field("theta_i", t.theta_i_count, 2, kMaxTableAxisCells);
-        if (Status e = mr.value().finish()) return file_error(e->message);
-        if (multiple_row != rows + f_rows || theta_r == 0 || t.theta_i_count == 0)
-            return file_error("hairis:multiple must give theta_r and theta_i and start at row " +
-                              std::to_string(rows + f_rows) + (with_f ? ", after the f part" : ", after the Huang part"));
-        Expected<std::vector<float>> nodes = float_array(spec, "hairis:theta_r_nodes", theta_r);
-        if (!nodes) return nodes.error();
-        t.theta_r_nodes = std::move(nodes).value();
-        Expected<std::vector<int>> n_h = n_h_values_of(spec);
-        if (!n_h) return n_h.error();
-        t.n_h_values = std::move(n_h).value();
-        if (t.n_h_values.empty() || t.n_h_values.size() > size_t(kMaxStrandCounts))
-            return file_error("hairis:n_h_values must give 1 to " + std::to_string(kMaxStrandCounts) +
-                              " strand counts for the multiple part");
-        width = std::max<long long>(width, (long long)t.n_h_values.size());
-        height += (long long)theta_r * t.theta_i_count;
+        if (Status s = read_huang_multiple(spec, with_f, t, layout)) return *s;
     }
-    if (Status s = TableImageSize{width, height}.validate()) return file_error(s->message);
-    if (spec.width != width || spec.height != height || spec.depth != 1 || spec.x != 0 || spec.y != 0)
+    if (Status s = TableImageSize{layout.width, layout.height}.validate()) return file_error(s->message);
+    if (spec.width != layout.width || spec.height != layout.height || spec.depth != 1 || spec.x != 0 || spec.y != 0)
         return file_error("image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                          " but the metadata needs " + std::to_string(width) + "x" + std::to_string(height));
-    Expected<std::vector<float>> theta_o_nodes = float_array(spec, "hairis:huang_theta_o_nodes", theta_o);
+                          " but the metadata needs " + std::to_string(layout.width) + "x" +
+                          std::to_string(layout.height));
+    Expected<std::vector<float>> theta_o_nodes = float_array(spec, "hairis:huang_theta_o_nodes", layout.theta_o);
     if (!theta_o_nodes) return theta_o_nodes.error();
-    Expected<std::vector<float>> phi_o_nodes = float_array(spec, "hairis:huang_phi_o_nodes", phi_o);
+    Expected<std::vector<float>> phi_o_nodes = float_array(spec, "hairis:huang_phi_o_nodes", layout.phi_o);
     if (!phi_o_nodes) return phi_o_nodes.error();
     h->theta_o_nodes = std::move(theta_o_nodes).value();
     h->phi_o_nodes = std::move(phi_o_nodes).value();
@@ -434,37 +508,7 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, b
     Expected<std::vector<float>> px = read_pixels(in);
     in.close();
     if (!px) return px.error();
-    const size_t w = size_t(width), huang_width = size_t(h->phi_count), bands = t.n_h_values.size();
-    h->values.resize(size_t(rows) * huang_width);
-    if (with_f) h->f.resize(3 * h->values.size());
-    t.multiple.assign(size_t(t.theta_r_count()) * bands * size_t(t.theta_i_count), 0.0f);
-    const size_t first_multiple = size_t(rows + f_rows);
-    for (size_t y = 0; y < size_t(height); ++y)
-        for (size_t x = 0; x < w; ++x) {
-            const float *p = &px.value()[(y * w + x) * kChannels];
-            const bool in_huang = y < size_t(rows) && x < huang_width;
-            const bool in_f = y >= size_t(rows) && y < first_multiple && x < huang_width;
-            const bool in_multiple = y >= first_multiple && x < bands;
-            if (in_f) {
-                if (p[3] != 1.0f)
-                    return file_error("A must be 1 in the f part at " + pixel_name((long long)x, (long long)y));
-                const size_t n = (y - size_t(rows)) * huang_width + x;
-                for (size_t c = 0; c < 3; ++c) h->f[3 * n + c] = p[c];
-            } else if (!in_huang && !in_multiple) {
-                if (Status s = check_padding(p, x, y)) return *s;
-            } else if (in_huang) {
-                if (p[1] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
-                    return file_error("G and B must be 0 and A must be 1 in the Huang part at " +
-                                      pixel_name((long long)x, (long long)y));
-                h->values[y * huang_width + x] = p[0];
-            } else {
-                if (p[0] != 0.0f || p[2] != 0.0f || p[3] != 1.0f)
-                    return file_error("R and B must be 0 and A must be 1 in the multiple part at " +
-                                      pixel_name((long long)x, (long long)y));
-                const size_t r = (y - first_multiple) / size_t(t.theta_i_count), i = (y - first_multiple) % size_t(t.theta_i_count);
-                t.multiple[(r * bands + x) * size_t(t.theta_i_count) + i] = p[1];
-            }
-        }
+    if (Status s = unpack_huang_pixels(px.value(), layout, *h, t)) return *s;
     h->parameters = t.parameters;
     t.huang = std::move(h);
     if (Status s = t.validate()) return *s;
