@@ -99,6 +99,82 @@ Expected<DualScattering> DualScattering::create(const FiberModel &model,
     return ds;
 }
 
+namespace {
+
+// θ_h moments of a lobe's energy: Σw, Σwθ_h, Σwθ_h².
+struct LobeMoments {
+    double m0 = 0, m1 = 0, m2 = 0;
+    void add(double w, double theta_h) {
+        m0 += w;
+        m1 += w * theta_h;
+        m2 += w * theta_h * theta_h;
+    }
+};
+
+}  // namespace
+
+// One θ node's integrals over the views of the light from θ_k: per lobe, the forward and
+// backward albedos and, when the shapes are measured, the θ_h moments of the lobe's energy.
+struct DualScattering::ViewAlbedos {
+    const Quadrature &rules;
+    double theta_k;
+    bool measure;
+    std::vector<Rgbd> af, ab;
+    std::vector<LobeMoments> moments;
+    std::vector<double> lw;  // a separable lobe's θ weights
+
+    ViewAlbedos(const Quadrature &r, int lobes, double theta, bool measure_shapes)
+        : rules(r), theta_k(theta), measure(measure_shapes), af(std::size_t(lobes)), ab(std::size_t(lobes)),
+          moments(std::size_t(lobes)), lw(r.theta.x.size()) {}
+
+    // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
+    void add_separable(const FarFieldView &view, double lobe_scale) {
+        for (std::size_t p = 0; p < af.size(); ++p) {
+            double longitudinal = 0;
+            for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
+                lw[m] = rules.theta.w[m] * std::cos(rules.theta.x[m]) * lobe_scale *
+                        view.longitudinal(int(p), rules.theta.x[m]);
+                longitudinal += lw[m];
+            }
+            double azimuthal_sum = 0;
+            for (int half = 0; half < 2; ++half) {
+                const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
+                Rgbd &acc = (half == 0 ? af : ab)[p];
+                for (std::size_t n = 0; n < rule.x.size(); ++n) {
+                    const Rgb v = view.azimuthal(int(p), rule.x[n]);
+                    for (int ch = 0; ch < 3; ++ch) acc.v[ch] += longitudinal * rule.w[n] * double(v[ch]);
+                    azimuthal_sum += rule.w[n] * (double(v[0]) + double(v[1]) + double(v[2]));
+                }
+            }
+            if (measure)
+                for (std::size_t m = 0; m < rules.theta.x.size(); ++m)
+                    moments[p].add(lw[m] * azimuthal_sum, 0.5 * (rules.theta.x[m] + theta_k));
+        }
+    }
+
+    // Any other view: f at every node of the product rule, the view's azimuth at φ_l.
+    void add_sampled(const FarFieldView &view, double phi_l, double lobe_scale) {
+        for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
+            const double th = rules.theta.x[m];
+            const double wm = rules.theta.w[m] * std::cos(th) * lobe_scale;
+            const double theta_h = 0.5 * (th + theta_k);
+            for (int half = 0; half < 2; ++half) {
+                const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
+                std::vector<Rgbd> &acc = half == 0 ? af : ab;
+                for (std::size_t n = 0; n < rule.x.size(); ++n) {
+                    const Vec3 w = dir(th, phi_l + rule.x[n]);
+                    const double weight = wm * rule.w[n];
+                    for (std::size_t p = 0; p < af.size(); ++p) {
+                        const Rgb v = view.lobe_f_cos(int(p), w);
+                        for (int ch = 0; ch < 3; ++ch) acc[p].v[ch] += weight * double(v[ch]);
+                        if (measure) moments[p].add(weight * (double(v[0]) + double(v[1]) + double(v[2])), theta_h);
+                    }
+                }
+            }
+        }
+    }
+};
+
 // (1) Per lobe and θ node, the forward and backward albedos a_f,p and a_b,p and the share of a
 // crossing that passes unscattered; and the lobes' shapes measured from the same integrals
 // when the model's are not analytic (or DualScatteringParams::measure_lobe_shapes).
@@ -109,112 +185,54 @@ void DualScattering::integrate_albedos(const FiberModel &model, const Quadrature
     a_f_lobe_.assign(nl * nk, {});
     a_b_lobe_.assign(nl * nk, {});
     pass_.assign(nk, 0.0);
-
-    // θ_h moments of each lobe's energy, per (lobe, θ node): Σw, Σwθ_h, Σwθ_h².
-    struct Moments {
-        double m0 = 0, m1 = 0, m2 = 0;
-        void add(double w, double theta_h) {
-            m0 += w;
-            m1 += w * theta_h;
-            m2 += w * theta_h * theta_h;
-        }
-    };
     shapes_measured_ = params_.measure_lobe_shapes || !model.lobe_shapes_analytic();
-    std::vector<Moments> moments(nl * nk);
+    std::vector<LobeMoments> moments(nl * nk);  // lobe p, θ node k at p * nk + k
 
     // Each task writes only its own table entries: the result does not depend on scheduling.
     tbb::parallel_for(tbb::blocked_range<int>(0, K), [&](const tbb::blocked_range<int> &range) {
-        std::vector<Rgbd> af(nl), ab(nl);
-        std::vector<double> lw(rules.theta.x.size());  // a separable lobe's θ weights
-        const bool measure = shapes_measured_;
         for (int k = range.begin(); k != range.end(); ++k) {
-            const double theta_k = table_theta(k);
-            // (1) a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction
-            // of the light from ω_L scattered into the forward half is the model's white-furnace
+            // a_f,p and a_b,p at light inclination θ_L = θ_k. By reciprocity the fraction of the
+            // light from ω_L scattered into the forward half is the model's white-furnace
             // integral ∫_fwd f(ω, ω_L)|cos θ| dω with ω_L in the viewer's slot: lobe_f_cos(p, ω,
             // ω_L) integrated against dω = cos θ dθ dφ.
-            std::fill(af.begin(), af.end(), Rgbd{});
-            std::fill(ab.begin(), ab.end(), Rgbd{});
-            Moments *mk = &moments[std::size_t(k)];  // lobe p at mk[p * nk]
+            ViewAlbedos sums(rules, lobe_count_, table_theta(k), shapes_measured_);
             double pass = 0;  // the unscattered share of the light's crossings (projected_width)
             for (const double phi_l : rules.orientations) {
-                const std::unique_ptr<const FarFieldView> view = model.view(dir(theta_k, phi_l));
+                const Vec3 light = dir(sums.theta_k, phi_l);
+                const std::unique_ptr<const FarFieldView> view = model.view(light);
                 // f is per hit on the fiber; a crossing meets it on a fraction `width` of the
                 // curve's width and passes unscattered elsewhere.
-                const double width = std::clamp(model.projected_width(dir(theta_k, phi_l)), 0.0, 1.0);
+                const double width = std::clamp(model.projected_width(light), 0.0, 1.0);
                 pass += (1.0 - width) / double(rules.orientations.size());
-                const double lobe_scale = rules.weight_scale * width;
-                if (view->separable()) {
-                    // The integrand factors per lobe: ∫ M_p cos θ dθ × ∫ N̄_p dφ over each half.
-                    for (int p = 0; p < lobe_count_; ++p) {
-                        double longitudinal = 0;
-                        for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
-                            lw[m] = rules.theta.w[m] * std::cos(rules.theta.x[m]) * lobe_scale *
-                                    view->longitudinal(p, rules.theta.x[m]);
-                            longitudinal += lw[m];
-                        }
-                        double azimuthal_sum = 0;
-                        for (int half = 0; half < 2; ++half) {
-                            const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
-                            Rgbd &acc = (half == 0 ? af : ab)[std::size_t(p)];
-                            for (std::size_t n = 0; n < rule.x.size(); ++n) {
-                                const Rgb v = view->azimuthal(p, rule.x[n]);
-                                for (int ch = 0; ch < 3; ++ch) acc.v[ch] += longitudinal * rule.w[n] * double(v[ch]);
-                                azimuthal_sum += rule.w[n] * (double(v[0]) + double(v[1]) + double(v[2]));
-                            }
-                        }
-                        if (measure)
-                            for (std::size_t m = 0; m < rules.theta.x.size(); ++m)
-                                mk[std::size_t(p) * nk].add(lw[m] * azimuthal_sum,
-                                                            0.5 * (rules.theta.x[m] + theta_k));
-                    }
-                    continue;
-                }
-                for (std::size_t m = 0; m < rules.theta.x.size(); ++m) {
-                    const double th = rules.theta.x[m];
-                    const double wm = rules.theta.w[m] * std::cos(th) * lobe_scale;
-                    const double theta_h = 0.5 * (th + theta_k);
-                    for (int half = 0; half < 2; ++half) {
-                        const QuadratureRule &rule = half == 0 ? rules.forward : rules.backward;
-                        std::vector<Rgbd> &acc = half == 0 ? af : ab;
-                        for (std::size_t n = 0; n < rule.x.size(); ++n) {
-                            const Vec3 w = dir(th, phi_l + rule.x[n]);
-                            const double weight = wm * rule.w[n];
-                            for (int p = 0; p < lobe_count_; ++p) {
-                                const Rgb v = view->lobe_f_cos(p, w);
-                                for (int ch = 0; ch < 3; ++ch) acc[std::size_t(p)].v[ch] += weight * double(v[ch]);
-                                if (measure)
-                                    mk[std::size_t(p) * nk].add(
-                                        weight * (double(v[0]) + double(v[1]) + double(v[2])), theta_h);
-                            }
-                        }
-                    }
-                }
+                if (view->separable())
+                    sums.add_separable(*view, rules.weight_scale * width);
+                else
+                    sums.add_sampled(*view, phi_l, rules.weight_scale * width);
             }
             for (std::size_t p = 0; p < nl; ++p) {
-                a_f_lobe_[p * nk + std::size_t(k)] = af[p];
-                a_b_lobe_[p * nk + std::size_t(k)] = ab[p];
+                a_f_lobe_[p * nk + std::size_t(k)] = sums.af[p];
+                a_b_lobe_[p * nk + std::size_t(k)] = sums.ab[p];
+                moments[p * nk + std::size_t(k)] = sums.moments[p];
             }
             pass_[std::size_t(k)] = pass;
         }
     });
 
     // Measured shapes: the moments pooled over θ_L with weight cos θ_L (serial, fixed order).
-    if (shapes_measured_) {
-        for (std::size_t p = 0; p < nl; ++p) {
-            Moments pooled;
-            for (std::size_t k = 0; k < nk; ++k) {
-                const Moments &m = moments[p * nk + k];
-                const double c = std::cos(table_theta(int(k)));
-                pooled.m0 += c * m.m0;
-                pooled.m1 += c * m.m1;
-                pooled.m2 += c * m.m2;
-            }
-            if (!(pooled.m0 > 0)) continue;  // a lobe with no energy keeps the model's guess
-            const double alpha = pooled.m1 / pooled.m0;
-            const double variance = std::max(0.0, pooled.m2 / pooled.m0 - alpha * alpha);
-            shapes_[p] = {float(alpha), float(std::sqrt(variance))};
+    if (!shapes_measured_) return;
+    for (std::size_t p = 0; p < nl; ++p) {
+        LobeMoments pooled;
+        for (std::size_t k = 0; k < nk; ++k) {
+            const LobeMoments &m = moments[p * nk + k];
+            const double c = std::cos(table_theta(int(k)));
+            pooled.m0 += c * m.m0;
+            pooled.m1 += c * m.m1;
+            pooled.m2 += c * m.m2;
         }
+        if (!(pooled.m0 > 0)) continue;  // a lobe with no energy keeps the model's guess
+        const double alpha = pooled.m1 / pooled.m0;
+        const double variance = std::max(0.0, pooled.m2 / pooled.m0 - alpha * alpha);
+        shapes_[p] = {float(alpha), float(std::sqrt(variance))};
     }
 }
 

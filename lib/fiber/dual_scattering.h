@@ -236,6 +236,7 @@ class DualScattering {
     static Rgb to_rgb(const Rgbd &c);
     // The steps of create(), in its order.
     struct Quadrature;
+    struct ViewAlbedos;
     void integrate_albedos(const FiberModel &model, const Quadrature &rules);
     void integrate_spread(const FiberModel &model, const Quadrature &rules);
     void derive_terms();
