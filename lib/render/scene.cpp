@@ -272,6 +272,79 @@ Status check_material_index(const std::vector<Material> &materials, const std::s
     return std::nullopt;
 }
 
+// A curve set's arrays: a hair material, one radius (and at most one normal) per point, the
+// curves' first points, and its per-strand inputs.
+Status check_curve_set(const HairCurves &hc, const std::string &set, const std::vector<Material> &materials) {
+    if (auto e = check_material_index(materials, set, hc.material, false)) return *e;
+    if (hc.radii.size() != hc.points.size())
+        return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
+                     " entries but points has " + std::to_string(hc.points.size()) +
+                     " (one radius per point)"};
+    if (hc.first.empty() || hc.first.front() != 0 || hc.first.back() != hc.points.size())
+        return Error{set + ": first must start at 0 and end at the point count (" +
+                     std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
+    if (hc.points.size() > (std::size_t(1) << 31))
+        return Error{set + ": too many points (at most 2^31)"};
+    if (auto e = check_curve_inputs(hc, set, materials[hc.material])) return *e;
+    if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
+        return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
+                     " entries but points has " + std::to_string(hc.points.size()) +
+                     " (one normal per point, or none)"};
+    for (std::size_t k = 0; k < hc.normals.size(); ++k)
+        if (!finite3(hc.normals[k]))
+            return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
+                         describe(hc.normals[k]) + ")"};
+    return std::nullopt;
+}
+
+// Curve c's points b..e−1: finite positions and radii >= 0; its longest step and largest radius.
+Status measure_curve(const HairCurves &hc, const std::string &set, std::size_t c, std::uint32_t b,
+                     std::uint32_t e, float &max_step, float &max_radius) {
+    max_step = 0;
+    max_radius = 0;
+    for (std::uint32_t k = b; k < e; ++k) {
+        if (!finite3(hc.points[k]))
+            return Error{set + ", curve " + std::to_string(c) + ", point " + std::to_string(k - b) +
+                         ": position must be finite (got " + describe(hc.points[k]) + ")"};
+        const float r = hc.radii[k];
+        if (!std::isfinite(r) || r < 0.0f)
+            return Error{set + ", curve " + std::to_string(c) + ", point " + std::to_string(k - b) +
+                         ": radius must be finite and >= 0 (got " + std::to_string(r) + ")"};
+        max_radius = std::max(max_radius, r);
+        if (k > b) max_step = std::max(max_step, length(hc.points[k] - hc.points[k - 1]));
+    }
+    return std::nullopt;
+}
+
+// Curve c (points b..e−1) in Embree's layout: its control points with the end points repeated
+// (a Catmull-Rom segment reads a point before and one after), its normals and inputs likewise,
+// and a segment per pair of points.
+void append_curve(CurveGeometry &geo, const HairCurves &hc, std::size_t c, std::uint32_t b, std::uint32_t e,
+                  std::uint32_t curve_index) {
+    const std::uint32_t base = std::uint32_t(geo.cvs.size());
+    auto cv = [&](std::uint32_t k) { return Float4{hc.points[k].x, hc.points[k].y, hc.points[k].z, hc.radii[k]}; };
+    geo.cvs.push_back(cv(b));
+    for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
+    geo.cvs.push_back(cv(e - 1));
+    if (!hc.normals.empty()) {
+        geo.normals.push_back(hc.normals[b]);
+        geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
+        geo.normals.push_back(hc.normals[e - 1]);
+    }
+    for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
+        const std::size_t k = std::size_t(components_of(hc.inputs[i]));
+        const std::vector<float> &from = hc.inputs[i].values;
+        const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
+        const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
+        geo.inputs[i].values.insert(geo.inputs[i].values.end(), from.begin() + std::ptrdiff_t(begin),
+                                    from.begin() + std::ptrdiff_t(end));
+    }
+    for (std::uint32_t k = 0; k + 1 < e - b; ++k) {
+        geo.segments.push_back(base + k);
+        geo.curve_of.push_back(curve_index);
+    }
+}
+
 }  // namespace
 
 Rgb material_emission(const Material &material) {
@@ -407,25 +480,7 @@ const SceneStats &Scene::stats() const { return impl_->stats; }
 // buffers are freed.
 Status Scene::Impl::add_curves(HairCurves &hc, std::size_t s, const std::vector<Material> &desc_materials) {
     const std::string set = "curve set " + std::to_string(s);
-    if (auto e = check_material_index(desc_materials, set, hc.material, false)) return *e;
-    if (hc.radii.size() != hc.points.size())
-        return Error{set + ": radii has " + std::to_string(hc.radii.size()) +
-                     " entries but points has " + std::to_string(hc.points.size()) +
-                     " (one radius per point)"};
-    if (hc.first.empty() || hc.first.front() != 0 || hc.first.back() != hc.points.size())
-        return Error{set + ": first must start at 0 and end at the point count (" +
-                     std::to_string(hc.points.size()) + ") with one entry per curve plus one"};
-    if (hc.points.size() > (std::size_t(1) << 31))
-        return Error{set + ": too many points (at most 2^31)"};
-    if (auto e = check_curve_inputs(hc, set, desc_materials[hc.material])) return *e;
-    if (!hc.normals.empty() && hc.normals.size() != hc.points.size())
-        return Error{set + ": normals has " + std::to_string(hc.normals.size()) +
-                     " entries but points has " + std::to_string(hc.points.size()) +
-                     " (one normal per point, or none)"};
-    for (std::size_t k = 0; k < hc.normals.size(); ++k)
-        if (!finite3(hc.normals[k]))
-            return Error{set + ", point " + std::to_string(k) + ": normal must be finite (got " +
-                         describe(hc.normals[k]) + ")"};
+    if (auto e = check_curve_set(hc, set, desc_materials)) return *e;
     CurveGeometry geo;
     geo.material = hc.material;
     geo.set = s;
@@ -441,19 +496,7 @@ Status Scene::Impl::add_curves(HairCurves &hc, std::size_t s, const std::vector<
             return Error{set + ", curve " + std::to_string(c) + ": has " + std::to_string(n) +
                          " point(s); a curve needs at least 2"};
         float max_step = 0, max_radius = 0;
-        for (std::uint32_t k = b; k < e; ++k) {
-            if (!finite3(hc.points[k]))
-                return Error{set + ", curve " + std::to_string(c) + ", point " +
-                             std::to_string(k - b) + ": position must be finite (got " +
-                             describe(hc.points[k]) + ")"};
-            const float r = hc.radii[k];
-            if (!std::isfinite(r) || r < 0.0f)
-                return Error{set + ", curve " + std::to_string(c) + ", point " +
-                             std::to_string(k - b) + ": radius must be finite and >= 0 (got " +
-                             std::to_string(r) + ")"};
-            max_radius = std::max(max_radius, r);
-            if (k > b) max_step = std::max(max_step, length(hc.points[k] - hc.points[k - 1]));
-        }
+        if (auto error = measure_curve(hc, set, c, b, e, max_step, max_radius)) return *error;
         if (!(max_step > 0.0f)) {
             ++zero_length;
             continue;
@@ -462,31 +505,7 @@ Status Scene::Impl::add_curves(HairCurves &hc, std::size_t s, const std::vector<
             ++zero_radius;
             continue;
         }
-        const std::uint32_t base = std::uint32_t(geo.cvs.size());
-        auto cv = [&](std::uint32_t k) {
-            return Float4{hc.points[k].x, hc.points[k].y, hc.points[k].z, hc.radii[k]};
-        };
-        geo.cvs.push_back(cv(b));
-        for (std::uint32_t k = b; k < e; ++k) geo.cvs.push_back(cv(k));
-        geo.cvs.push_back(cv(e - 1));
-        if (!hc.normals.empty()) {
-            geo.normals.push_back(hc.normals[b]);
-            geo.normals.insert(geo.normals.end(), hc.normals.begin() + b, hc.normals.begin() + e);
-            geo.normals.push_back(hc.normals[e - 1]);
-        }
-        const std::uint32_t curve_index = std::uint32_t(stats_curves_in_set++);
-        for (std::size_t i = 0; i < hc.inputs.size(); ++i) {
-            const std::size_t k = std::size_t(components_of(hc.inputs[i]));
-            const std::vector<float> &from = hc.inputs[i].values;
-            const std::size_t begin = hc.inputs[i].per_point ? b * k : c * k;
-            const std::size_t end = hc.inputs[i].per_point ? e * k : (c + 1) * k;
-            geo.inputs[i].values.insert(geo.inputs[i].values.end(), from.begin() + std::ptrdiff_t(begin),
-                                        from.begin() + std::ptrdiff_t(end));
-        }
-        for (std::uint32_t k = 0; k + 1 < n; ++k) {
-            geo.segments.push_back(base + k);
-            geo.curve_of.push_back(curve_index);
-        }
+        append_curve(geo, hc, c, b, e, std::uint32_t(stats_curves_in_set++));
         ++stats.curves;
         stats.curve_points += n;
     }
