@@ -17,6 +17,7 @@ DirectionCones::DirectionCones(const std::vector<Vec3d> &directions, int bands) 
     bands = std::max(1, bands);
     const int sectors = 2 * bands;
     auto cell_of = [&](Vec3d d) {
+        if (!(std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z))) return 0;
         const int band = std::clamp(int((std::clamp(d.z, -1.0, 1.0) + 1.0) * 0.5 * bands), 0, bands - 1);
         const double longitude = std::atan2(d.y, d.x);  // (−π, π]
         const int sector = std::clamp(int((longitude + kPi) / kTwoPi * sectors), 0, sectors - 1);
@@ -44,8 +45,11 @@ DirectionCones::DirectionCones(const std::vector<Vec3d> &directions, int bands) 
         const double len = length(sum);
         cone.axis = len > 0.0 ? sum / len : directions[order_[cone.begin]];
         double cos_radius = 1.0;
-        for (std::uint32_t k = cone.begin; k < cone.end; ++k)
-            cos_radius = std::min(cos_radius, dot(directions[order_[k]], cone.axis));
+        for (std::uint32_t k = cone.begin; k < cone.end; ++k) {
+            const double cos_member = dot(directions[order_[k]], cone.axis);
+            if (!std::isfinite(cos_member)) cone.decidable = false;
+            cos_radius = std::min(cos_radius, cos_member);
+        }
         cone.cos_radius = std::clamp(cos_radius - kMargin, -1.0, 1.0);
         cone.sin_radius = std::sqrt(1.0 - cone.cos_radius * cone.cos_radius);
         cones_.push_back(cone);
@@ -56,15 +60,17 @@ DirectionCones::Side DirectionCones::side(const Cone &cone, Vec3d l, double c) {
     // A member at angle ≤ ρ from the axis, the axis at δ from l: the member's angle to l is in
     // [max(0, δ − ρ), min(π, δ + ρ)], and dot(d, l) = |l| cos of it.
     const double len = length(l);
-    if (!(len > 0.0)) return Side::Mixed;
+    if (!cone.decidable || !(len > 0.0) || !std::isfinite(len)) return Side::Mixed;
     const double cos_delta = std::clamp(dot(cone.axis, l) / len, -1.0, 1.0);
     const double sin_delta = std::sqrt(1.0 - cos_delta * cos_delta);
     const double highest = cos_delta >= cone.cos_radius ? 1.0
                                                         : cos_delta * cone.cos_radius + sin_delta * cone.sin_radius;
     const double lowest = cos_delta <= -cone.cos_radius ? -1.0
                                                         : cos_delta * cone.cos_radius - sin_delta * cone.sin_radius;
-    if (len * highest < c - kMargin) return Side::Below;
-    if (len * lowest >= c + kMargin) return Side::AtOrAbove;
+    // The margin scales with |l|, as the rounding of dot(d, l) does.
+    const double margin = kMargin * std::max(1.0, len);
+    if (len * highest < c - margin) return Side::Below;
+    if (len * lowest >= c + margin) return Side::AtOrAbove;
     return Side::Mixed;
 }
 

@@ -17,13 +17,15 @@ class DirectionCones {
         std::uint32_t begin = 0, end = 0;       ///< the members are order()[begin, end)
         Vec3d axis{0.0, 0.0, 1.0};              ///< unit
         double cos_radius = 1, sin_radius = 0;  ///< no member is farther from the axis
+        bool decidable = true;                  ///< false when a member is not finite
     };
     /// Where a cone's members lie against the test dot(d, l) < c.
     enum class Side { Below, AtOrAbove, Mixed };
 
     DirectionCones() = default;
     /// Groups unit directions by the cells of a grid of `bands` equal bands of z and
-    /// 2·`bands` sectors of longitude about z; an empty cell makes no cone.
+    /// 2·`bands` sectors of longitude about z; an empty cell makes no cone. A direction that
+    /// is not finite goes to the first cell, whose cone is then never decided.
     explicit DirectionCones(const std::vector<Vec3d> &directions, int bands = 12);
 
     const std::vector<Cone> &cones() const { return cones_; }

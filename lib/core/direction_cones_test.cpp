@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -53,7 +54,26 @@ TEST(DirectionCones, TileTheInputAndBoundTheirMembers) {
         EXPECT_GT(cones.cones().size(), 20u);  // a grid, not one cone
     }
     EXPECT_TRUE(DirectionCones(std::vector<Vec3d>{}).cones().empty());
-    EXPECT_EQ(DirectionCones(std::vector<Vec3d>{{0, 0, 1}, {0, 1, 0}}, 0).cones().size(), 1u);  // bands < 1 means one
+    // bands < 1 means one band of two sectors: two directions in one half of the longitudes
+    // make one cone, one in each half two.
+    EXPECT_EQ(DirectionCones(std::vector<Vec3d>{{0, 0.6, 0.8}, {0, 0.8, -0.6}}, 0).cones().size(), 1u);
+    EXPECT_EQ(DirectionCones(std::vector<Vec3d>{{0, 0.6, 0.8}, {0, -0.8, -0.6}}, 0).cones().size(), 2u);
+}
+
+// A direction that is not finite leaves its cone undecided, whatever the threshold.
+TEST(DirectionCones, NonFiniteMembersAreNeverDecided) {
+    const double nan = std::nan("");
+    const DirectionCones cones(std::vector<Vec3d>{{nan, 0, 1}, {0, 0, 1}, {0, 0, -1}});
+    int undecided = 0;
+    for (const DirectionCones::Cone &cone : cones.cones()) {
+        bool has_nan = false;
+        for (std::uint32_t k = cone.begin; k < cone.end; ++k) has_nan = has_nan || cones.order()[k] == 0;
+        if (!has_nan) continue;
+        ++undecided;
+        EXPECT_EQ(DirectionCones::side(cone, {0, 0, 1}, 2.0), DirectionCones::Side::Mixed);
+        EXPECT_EQ(DirectionCones::side(cone, {0, 0, 1}, -2.0), DirectionCones::Side::Mixed);
+    }
+    EXPECT_EQ(undecided, 1);
 }
 
 // Every decided cone agrees with the test member by member, for thresholds exactly at members'
@@ -73,6 +93,19 @@ TEST(DirectionCones, DecisionsAgreeWithEveryMember) {
             if (trial % 3 == 0) c = dot(d[std::size_t(trial * 7) % d.size()], l);
             if (trial % 3 == 1) c = std::nextafter(dot(d[std::size_t(trial * 13) % d.size()], l), 2.0);
             for (const DirectionCones::Cone &cone : cones.cones()) {
+                // Also at the cone's own extreme values, where a decision is closest to wrong.
+                double low = 2.0, high = -2.0;
+                for (std::uint32_t k = cone.begin; k < cone.end; ++k) {
+                    low = std::min(low, dot(d[cones.order()[k]], l));
+                    high = std::max(high, dot(d[cones.order()[k]], l));
+                }
+                for (const double edge : {low, high, std::nextafter(low, -2.0), std::nextafter(high, 2.0)}) {
+                    const DirectionCones::Side side = DirectionCones::side(cone, l, edge);
+                    if (side == DirectionCones::Side::Mixed) continue;
+                    for (std::uint32_t k = cone.begin; k < cone.end; ++k)
+                        ASSERT_EQ(dot(d[cones.order()[k]], l) < edge, side == DirectionCones::Side::Below)
+                            << "trial " << trial << ", edge " << edge;
+                }
                 const DirectionCones::Side side = DirectionCones::side(cone, l, c);
                 members += cone.end - cone.begin;
                 if (side == DirectionCones::Side::Mixed) continue;
