@@ -82,21 +82,6 @@ int guard_status(const char *function, F &&f) noexcept {
     }
 }
 
-/// Runs f() -> T* (a new handle) at the boundary: NULL on failure.
-template <typename T, typename F>
-T *guard_handle(const char *function, F &&f) noexcept {
-    try {
-        T *handle = f();
-        clear_error();
-        return handle;
-    } catch (const Refusal &r) {
-        report_refusal(function, r);
-    } catch (...) {
-        report_exception(function, std::current_exception());
-    }
-    return nullptr;
-}
-
 /// Runs f() -> T at the boundary: `failure` when it throws.
 template <typename T, typename F>
 T guard_value(const char *function, T failure, F &&f) noexcept {
@@ -110,6 +95,12 @@ T guard_value(const char *function, T failure, F &&f) noexcept {
         report_exception(function, std::current_exception());
     }
     return failure;
+}
+
+/// Runs f() -> T* (a new handle) at the boundary: NULL on failure.
+template <typename T, typename F>
+T *guard_handle(const char *function, F &&f) noexcept {
+    return guard_value<T *>(function, nullptr, std::forward<F>(f));
 }
 
 /// Runs f() -> void at the boundary.
@@ -172,6 +163,23 @@ void require_non_negative(float value, const std::string &name);
 void require_colour(const float *rgb, const char *name);
 /// Refuses a direction that is not finite or not of unit length (within 1e-3).
 void require_unit_direction(const float *w, const char *name, size_t i);
+/// Refuses item i of a view: wo a unit direction, h NULL (the far field) or in [-1, 1].
+void require_view(const float *wo, const float *h, size_t i);
+/// Refuses a batch of n direction pairs and its output before anything is read: a size that
+/// fits in memory and no NULL array.
+void require_pair_batch(size_t n, const float *wi, const float *wo, const float *out,
+                        const char *out_name);
+/// Refuses item i of a batch of direction pairs: wi as require_unit_direction, wo and h as
+/// require_view.
+void require_pair(const float *wi, const float *wo, const float *h, size_t i);
+/// Item i of an array of 3-vectors.
+inline Vec3 vec3_at(const float *a, size_t i) { return {a[3 * i], a[3 * i + 1], a[3 * i + 2]}; }
+/// Stores c as item i of an array of RGB triples.
+inline void store_rgb(float *out, size_t i, Rgb c) {
+    out[3 * i] = c.r;
+    out[3 * i + 1] = c.g;
+    out[3 * i + 2] = c.b;
+}
 
 /// Calls f(i) for every i < n: in order for small batches, in parallel (oneTBB) for large
 /// ones. Items must be independent. Exceptions propagate to the caller.

@@ -67,25 +67,19 @@ inline constexpr double kHuge = kHugeOption;
 /// (full cone angle, radians) and spot_blend, power in W, radius (shadow_soft_size) in metres.
 struct SpotOptions {
     float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    Rgb color{1.0f};
-    float power = 10.0f;
-    float radius = 0.0f;
-    float spot_size = float(kPi / 4.0);
-    float spot_blend = 0.15f;
-    CyclesVersion cycles = CyclesVersion::V3_4;
-    bool soft_falloff = true;
+    SpotLight light;  ///< all but its light_to_world, which the matrix gives
 };
 template <typename Fields>
 void describe(Fields &f, SpotOptions &o) {
     float *matrix = o.matrix;
     f.field("matrix", matrix, 16, -kHuge, kHuge);
-    f.field("color", o.color, 0.0, kHuge);
-    f.field("power", o.power, 0.0, kHuge);
-    f.field("radius", o.radius, 0.0, kHuge);
-    f.field("spot_size", o.spot_size, kPi / 180.0, kPi);
-    f.field("spot_blend", o.spot_blend, 0.0, 1.0);
-    describe_version(f, o.cycles);
-    f.field("soft_falloff", o.soft_falloff);
+    f.field("color", o.light.color, 0.0, kHuge);
+    f.field("power", o.light.power, 0.0, kHuge);
+    f.field("radius", o.light.radius, 0.0, kHuge);
+    f.field("spot_size", o.light.spot_size, kPi / 180.0, kPi);
+    f.field("spot_blend", o.light.spot_blend, 0.0, 1.0);
+    describe_version(f, o.light.cycles);
+    f.field("soft_falloff", o.light.soft_falloff);
 }
 
 /// The world: a constant background (color × strength), or an Environment Texture read from
@@ -325,22 +319,20 @@ void describe(Fields &f, MeshAttributeOptions &o) {
 /// "type=area": the light object's matrix (row-major, with its scale), shape, sizes, power.
 struct AreaOptions {
     float matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    int shape = 0;
-    float size = 1.0f, size_y = 1.0f;
-    Rgb color{1.0f};
-    float power = 10.0f;
-    CyclesVersion cycles = CyclesVersion::V3_4;
+    AreaLight light;  ///< all but its light_to_world, which the matrix gives
 };
 template <typename Fields>
 void describe(Fields &f, AreaOptions &o) {
     float *matrix = o.matrix;
+    int shape = int(o.light.shape);
     f.field("matrix", matrix, 16, -kHuge, kHuge);
-    f.choice("shape", o.shape, {"square", "rectangle", "disk", "ellipse"});
-    f.field("size", o.size, 0.0, kHuge);
-    f.field("size_y", o.size_y, 0.0, kHuge);
-    f.field("color", o.color, 0.0, kHuge);
-    f.field("power", o.power, 0.0, kHuge);
-    describe_version(f, o.cycles);
+    f.choice("shape", shape, {"square", "rectangle", "disk", "ellipse"});
+    o.light.shape = AreaShape(shape);
+    f.field("size", o.light.size_x, 0.0, kHuge);
+    f.field("size_y", o.light.size_y, 0.0, kHuge);
+    f.field("color", o.light.color, 0.0, kHuge);
+    f.field("power", o.light.power, 0.0, kHuge);
+    describe_version(f, o.light.cycles);
 }
 
 /// The camera as Blender describes it (Camera.view_frame, matrix_world, resolution, clip).

@@ -115,30 +115,18 @@ HAIRIS_API int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const floa
                                  const float *wo, const float *h, float *rgb_out) {
     return guard_status("hairis_fiber_eval", [&] {
         require(fiber, "fiber");
-        require_batch_size(n, 3, "n");
-        require_array(wi, n, "wi");
-        require_array(wo, n, "wo");
-        require_array(rgb_out, n, "rgb_out");
+        require_pair_batch(n, wi, wo, rgb_out, "rgb_out");
         if (h && !fiber->chiang)
             invalid("h must be NULL for a " + fiber->model_name +
                     " fiber: the near field (an offset per item) is only available for "
                     "chiang2016 fibers; pass h = NULL for the far field");
         // Everything is checked before anything is written.
-        for (size_t i = 0; i < n; ++i) {
-            require_unit_direction(wi, "wi", i);
-            require_unit_direction(wo, "wo", i);
-            if (h && !(h[i] >= -1.0f && h[i] <= 1.0f))
-                invalid(indexed("h", i) + " must be finite and in [-1, 1] (got " + describe(h[i]) + ")");
-        }
+        for (size_t i = 0; i < n; ++i) require_pair(wi, wo, h, i);
         const FiberModel &model = *fiber->model;
         const ChiangFiber *chiang = fiber->chiang.get();
         for_each_item(n, [&](size_t i) {
-            const Vec3 a{wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]};
-            const Vec3 b{wo[3 * i], wo[3 * i + 1], wo[3 * i + 2]};
-            const Rgb f = h ? chiang->f_cos_near(a, b, h[i]) : model.f_cos(a, b);
-            rgb_out[3 * i] = f.r;
-            rgb_out[3 * i + 1] = f.g;
-            rgb_out[3 * i + 2] = f.b;
+            const Vec3 a = vec3_at(wi, i), b = vec3_at(wo, i);
+            store_rgb(rgb_out, i, h ? chiang->f_cos_near(a, b, h[i]) : model.f_cos(a, b));
         });
         return HAIRIS_OK;
     });

@@ -131,6 +131,25 @@ void require_unit_direction(const float *w, const char *name, size_t i) {
                 ")");
 }
 
+void require_view(const float *wo, const float *h, size_t i) {
+    require_unit_direction(wo, "wo", i);
+    if (h && !(h[i] >= -1.0f && h[i] <= 1.0f))
+        invalid(indexed("h", i) + " must be finite and in [-1, 1] (got " + describe(h[i]) + ")");
+}
+
+void require_pair_batch(size_t n, const float *wi, const float *wo, const float *out,
+                        const char *out_name) {
+    require_batch_size(n, 3, "n");
+    require_array(wi, n, "wi");
+    require_array(wo, n, "wo");
+    require_array(out, n, out_name);
+}
+
+void require_pair(const float *wi, const float *wo, const float *h, size_t i) {
+    require_unit_direction(wi, "wi", i);
+    require_view(wo, h, i);
+}
+
 }  // namespace hairis::capi
 
 extern "C" {

@@ -6,22 +6,11 @@
 
 namespace hairis::capi {
 
-namespace {
-
-// Checks wo (unit), h (NULL or in [-1, 1]) for item i.
-void check_view(const float *wo, const float *h, size_t i) {
-    require_unit_direction(wo, "wo", i);
-    if (h && !(h[i] >= -1.0f && h[i] <= 1.0f))
-        invalid(indexed("h", i) + " must be finite and in [-1, 1] (got " + describe(h[i]) + ")");
-}
-
-}  // namespace
-
 // The BSDF of one batch item (thread-local scratch: for_each_item may run in parallel).
 HairBsdf bsdf_at(const hairis_sampler &sampler, const float *wo, const float *h, size_t i) {
     thread_local ScratchBuffer scratch;
     scratch.reset();
-    return sampler.shading.at({{wo[3 * i], wo[3 * i + 1], wo[3 * i + 2]}, h ? h[i] : 0.0f}, scratch);
+    return sampler.shading.at({vec3_at(wo, i), h ? h[i] : 0.0f}, scratch);
 }
 
 }  // namespace hairis::capi
@@ -82,7 +71,7 @@ HAIRIS_API int hairis_sample(const hairis_sampler *sampler, size_t n, const floa
         require_array(wi_out, n, "wi_out");
         require_array(pdf_out, n, "pdf_out");
         for (size_t i = 0; i < n; ++i) {
-            check_view(wo, h, i);
+            require_view(wo, h, i);
             for (size_t k = 0; k < 3; ++k) {
                 const float v = u[3 * i + k];
                 if (!(v >= 0.0f && v < 1.0f))
@@ -107,16 +96,10 @@ HAIRIS_API int hairis_pdf(const hairis_sampler *sampler, size_t n, const float *
                           const float *wo, const float *h, float *pdf_out) {
     return guard_status("hairis_pdf", [&] {
         require(sampler, "sampler");
-        require_batch_size(n, 3, "n");
-        require_array(wi, n, "wi");
-        require_array(wo, n, "wo");
-        require_array(pdf_out, n, "pdf_out");
-        for (size_t i = 0; i < n; ++i) {
-            require_unit_direction(wi, "wi", i);
-            check_view(wo, h, i);
-        }
+        require_pair_batch(n, wi, wo, pdf_out, "pdf_out");
+        for (size_t i = 0; i < n; ++i) require_pair(wi, wo, h, i);
         for_each_item(n, [&](size_t i) {
-            pdf_out[i] = bsdf_at(*sampler, wo, h, i).pdf({wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]});
+            pdf_out[i] = bsdf_at(*sampler, wo, h, i).pdf(vec3_at(wi, i));
         });
         return HAIRIS_OK;
     });
@@ -128,19 +111,10 @@ HAIRIS_API int hairis_sampler_eval(const hairis_sampler *sampler, size_t n, cons
         require(sampler, "sampler");
         if (!sampler->shading.model())
             invalid("sampler: it was created without a fiber, so it has no f; create it with a fiber");
-        require_batch_size(n, 3, "n");
-        require_array(wi, n, "wi");
-        require_array(wo, n, "wo");
-        require_array(rgb_out, n, "rgb_out");
-        for (size_t i = 0; i < n; ++i) {
-            require_unit_direction(wi, "wi", i);
-            check_view(wo, h, i);
-        }
+        require_pair_batch(n, wi, wo, rgb_out, "rgb_out");
+        for (size_t i = 0; i < n; ++i) require_pair(wi, wo, h, i);
         for_each_item(n, [&](size_t i) {
-            const Rgb f = bsdf_at(*sampler, wo, h, i).f({wi[3 * i], wi[3 * i + 1], wi[3 * i + 2]});
-            rgb_out[3 * i] = f.r;
-            rgb_out[3 * i + 1] = f.g;
-            rgb_out[3 * i + 2] = f.b;
+            store_rgb(rgb_out, i, bsdf_at(*sampler, wo, h, i).f(vec3_at(wi, i)));
         });
         return HAIRIS_OK;
     });

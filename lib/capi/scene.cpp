@@ -254,6 +254,20 @@ WorldLight environment_world(const OptionReader &reader, const WorldOptions &o,
     return world;
 }
 
+// Reads a spot's or an area's options: a light placed by its object's matrix, refused when the
+// matrix's Z axis is zero since the light shines along it.
+template <typename Options>
+auto read_placed_light(OptionReader &reader, Options &o, const std::string &what,
+                       const char *consequence) {
+    describe(reader, o);
+    ok_or_invalid(reader.finish());
+    auto light = o.light;
+    light.light_to_world = Mat4::from_row_major(o.matrix);
+    if (!(length(light.light_to_world.column(2)) > 0.0f))
+        invalid(what + ": matrix has a zero Z axis (column 2): " + consequence);
+    return light;
+}
+
 // Reads world options; `pixels` says whether the image comes as an array (then `image` is
 // refused).
 OptionReader read_world_options(const char *options, WorldOptions &o, bool pixels) {
@@ -705,22 +719,10 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
             scene->desc.point_lights.push_back(point);
         } else if (type == 3) {
             SpotOptions o;
-            describe(reader, o);
-            ok_or_invalid(reader.finish());
-            SpotLight spot;
-            spot.light_to_world = Mat4::from_row_major(o.matrix);
-            if (!(length(spot.light_to_world.column(2)) > 0.0f))
-                invalid(what + ": matrix has a zero Z axis (column 2): the spot has no direction");
-            if (o.cycles == CyclesVersion::V3_4 && !o.soft_falloff)
+            const SpotLight spot = read_placed_light(reader, o, what, "the spot has no direction");
+            if (spot.cycles == CyclesVersion::V3_4 && !spot.soft_falloff)
                 invalid(what + ": soft_falloff=0 (a sphere) needs cycles=4.5; Cycles 3.4 has "
                                "only the disk");
-            spot.color = o.color;
-            spot.power = o.power;
-            spot.radius = o.radius;
-            spot.spot_size = o.spot_size;
-            spot.spot_blend = o.spot_blend;
-            spot.cycles = o.cycles;
-            spot.soft_falloff = o.soft_falloff;
             // Refused now rather than at render time (e.g. a singular matrix for 4.5).
             LightsDesc check;
             check.spots = {spot};
@@ -729,19 +731,8 @@ HAIRIS_API int hairis_scene_add_light(hairis_scene *scene, const char *options) 
             scene->desc.spot_lights.push_back(spot);
         } else {
             AreaOptions o;
-            describe(reader, o);
-            ok_or_invalid(reader.finish());
-            AreaLight light;
-            light.light_to_world = Mat4::from_row_major(o.matrix);
-            if (!(length(light.light_to_world.column(2)) > 0.0f))
-                invalid(what + ": matrix has a zero Z axis (column 2): the light has no emitting direction");
-            light.shape = AreaShape(o.shape);
-            light.size_x = o.size;
-            light.size_y = o.size_y;
-            light.color = o.color;
-            light.power = o.power;
-            light.cycles = o.cycles;
-            scene->desc.area_lights.push_back(light);
+            scene->desc.area_lights.push_back(
+                read_placed_light(reader, o, what, "the light has no emitting direction"));
         }
         return HAIRIS_OK;
     });
