@@ -204,22 +204,17 @@ Expected<LightSet> LightSet::build(const std::vector<SunLight> &suns,
                                    const std::vector<AreaLight> &areas, const WorldLight &world,
                                    std::vector<EmissiveTriangle> emissive,
                                    std::vector<std::string> *warnings) {
-    LightsDesc lights;
-    lights.suns = suns;
-    lights.points = points;
-    lights.areas = areas;
-    lights.world = world;
-    return build(lights, std::move(emissive), warnings);
+    return build(LightsDesc{suns, points, {}, areas, world}, std::move(emissive), warnings);
 }
 
 Expected<LightSet> LightSet::build(const LightsDesc &lights,
                                    std::vector<EmissiveTriangle> emissive,
                                    std::vector<std::string> *warnings) {
     LightSet set;
-    if (auto e = set.add_suns(lights.suns)) return *e;
-    if (auto e = set.add_points(lights.points)) return *e;
-    if (auto e = set.add_spots(lights.spots)) return *e;
-    if (auto e = set.add_areas(lights.areas, warnings)) return *e;
+    if (auto e = set.add_lamps(lights.suns, "sun light")) return *e;
+    if (auto e = set.add_lamps(lights.points, "point light")) return *e;
+    if (auto e = set.add_lamps(lights.spots, "spot light")) return *e;
+    if (auto e = set.add_lamps(lights.areas, "area light", warnings)) return *e;
     if (auto e = set.set_world(lights.world)) return *e;
     set.set_triangles(emissive);
     const bool has_lamps = !set.lamps_.empty(), has_triangles = !set.triangles_.empty();
@@ -229,153 +224,153 @@ Expected<LightSet> LightSet::build(const LightsDesc &lights,
     return set;
 }
 
-// Sun lamps, checked; black ones left out.
-Status LightSet::add_suns(const std::vector<SunLight> &suns) {
-    for (std::size_t i = 0; i < suns.size(); ++i) {
-        const SunLight &s = suns[i];
-        const std::string name = "sun light " + std::to_string(i);
-        if (auto e = check_position(name + ": to_sun", s.to_sun)) return *e;
-        if (!(length(s.to_sun) > 0.0f))
-            return Error{name + ": to_sun must not be the zero vector"};
-        if (auto e = check_color(name + ":", s.color)) return *e;
-        if (auto e = check::non_negative((name + ": strength").c_str(), s.strength)) return *e;
-        if (!(s.angle >= 0.0f && s.angle < kPiF))
-            return Error{name + ": angle must be in [0, pi) radians (got " +
-                         std::to_string(s.angle) + ")"};
-        if (auto e = check_version(name, s.cycles, true)) return *e;
-        if (s.strength == 0.0f || s.color.is_black()) continue;
-        Lamp lamp;
-        lamp.type = LampType::Sun;
-        lamp.cycles = s.cycles;
-        lamp.value = cycles_light::strength(s.color, s.strength);
-        lamp.direction = safe_normalize(s.to_sun);
-        lamp.importance = luminance(cycles_light::strength(s.color, s.strength));
-        lamp.radius = std::tan(0.5f * s.angle);
-        lamp.cos_half = std::cos(0.5f * s.angle);
-        lamp.invarea = cycles_light::sun_invarea(s.angle);
-        if (s.cycles == CyclesVersion::V4_5) {
-            lamp.radius = 0.5f * s.angle;
-            const float h = std::sin(0.25f * s.angle);
-            lamp.one_minus_cos_half = 2.0f * h * h;
-            if (s.angle > 0.0f) lamp.value = cycles_light::sun_radiance_cycles45(s.color, s.strength, s.angle);
-        }
-        lamps_.push_back(lamp);
+// A point's or a spot's emission: a disk facing the shading point, or a sphere without soft
+// falloff, of the light's radius (a point for radius 0).
+template <typename Light>
+void LightSet::set_point_emission(Lamp &lamp, const Light &p) {
+    lamp.radius = p.radius;
+    lamp.sphere = !p.soft_falloff && p.radius > 0.0f;
+    lamp.invarea = cycles_light::point_invarea(p.radius);
+    lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
+                                 : cycles_light::point_intensity(p.color, p.power);
+    lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
+}
+
+// Adds the lamp of each light (none for one that emits nothing), naming light i "<kind> i" in
+// its errors.
+template <typename Light, typename... Extra>
+Status LightSet::add_lamps(const std::vector<Light> &lights, const char *kind, Extra... extra) {
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        std::optional<Lamp> lamp;
+        const std::string name = std::string(kind) + " " + std::to_string(i);
+        if (auto e = lamp_of(lights[i], name, lamp, extra...)) return *e;
+        if (lamp) lamps_.push_back(*lamp);
     }
     return std::nullopt;
 }
 
-// Point lamps, checked; black ones left out.
-Status LightSet::add_points(const std::vector<PointLight> &points) {
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const PointLight &p = points[i];
-        const std::string name = "point light " + std::to_string(i);
-        if (auto e = check_position(name + ": position", p.position)) return *e;
-        if (auto e = check_color(name + ":", p.color)) return *e;
-        if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
-        if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
-        if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
-        if (p.power == 0.0f || p.color.is_black()) continue;
-        Lamp lamp;
-        lamp.type = LampType::Point;
-        lamp.cycles = p.cycles;
-        lamp.position = p.position;
-        lamp.radius = p.radius;
-        lamp.sphere = !p.soft_falloff && p.radius > 0.0f;
-        lamp.invarea = cycles_light::point_invarea(p.radius);
-        lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
-                                     : cycles_light::point_intensity(p.color, p.power);
-        lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
-        lamps_.push_back(lamp);
+// A sun's lamp, checked; none for a black one.
+Status LightSet::lamp_of(const SunLight &s, const std::string &name, std::optional<Lamp> &out) {
+    if (auto e = check_position(name + ": to_sun", s.to_sun)) return *e;
+    if (!(length(s.to_sun) > 0.0f))
+        return Error{name + ": to_sun must not be the zero vector"};
+    if (auto e = check_color(name + ":", s.color)) return *e;
+    if (auto e = check::non_negative((name + ": strength").c_str(), s.strength)) return *e;
+    if (!(s.angle >= 0.0f && s.angle < kPiF))
+        return Error{name + ": angle must be in [0, pi) radians (got " +
+                     std::to_string(s.angle) + ")"};
+    if (auto e = check_version(name, s.cycles, true)) return *e;
+    if (s.strength == 0.0f || s.color.is_black()) return std::nullopt;
+    Lamp lamp;
+    lamp.type = LampType::Sun;
+    lamp.cycles = s.cycles;
+    lamp.value = cycles_light::strength(s.color, s.strength);
+    lamp.direction = safe_normalize(s.to_sun);
+    lamp.importance = luminance(cycles_light::strength(s.color, s.strength));
+    lamp.radius = std::tan(0.5f * s.angle);
+    lamp.cos_half = std::cos(0.5f * s.angle);
+    lamp.invarea = cycles_light::sun_invarea(s.angle);
+    if (s.cycles == CyclesVersion::V4_5) {
+        lamp.radius = 0.5f * s.angle;
+        const float h = std::sin(0.25f * s.angle);
+        lamp.one_minus_cos_half = 2.0f * h * h;
+        if (s.angle > 0.0f) lamp.value = cycles_light::sun_radiance_cycles45(s.color, s.strength, s.angle);
     }
+    out = lamp;
     return std::nullopt;
 }
 
-// Spot lamps, checked; black ones left out.
-Status LightSet::add_spots(const std::vector<SpotLight> &spots) {
-    for (std::size_t i = 0; i < spots.size(); ++i) {
-        const SpotLight &p = spots[i];
-        const std::string name = "spot light " + std::to_string(i);
-        if (!p.light_to_world.finite())
-            return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
-        const Vec3 z = p.light_to_world.column(2);
-        if (!(length(z) > 0.0f))
-            return Error{name + ": light_to_world has a zero Z axis (no direction to shine in)"};
-        if (auto e = check_color(name + ":", p.color)) return *e;
-        if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
-        if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
-        if (!(p.spot_size > 0.0f && p.spot_size <= kPiF))
-            return Error{name + ": spot_size must be in (0, pi] radians (got " +
-                         std::to_string(p.spot_size) + ")"};
-        if (!(p.spot_blend >= 0.0f && p.spot_blend <= 1.0f))
-            return Error{name + ": spot_blend must be in [0, 1] (got " +
-                         std::to_string(p.spot_blend) + ")"};
-        if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
-        Lamp lamp;
-        lamp.type = LampType::Spot;
-        lamp.cycles = p.cycles;
-        if (p.cycles == CyclesVersion::V4_5 && !invert_linear(p.light_to_world, lamp.world_to_light))
-            return Error{name + ": light_to_world is singular (Cycles 4.5 shapes the cone in the "
-                                "light's own frame)"};
-        if (p.power == 0.0f || p.color.is_black()) continue;
-        lamp.position = p.light_to_world.column(3);
-        lamp.direction = safe_normalize(-z);
-        lamp.radius = p.radius;
-        lamp.sphere = !p.soft_falloff && p.radius > 0.0f;
-        lamp.invarea = cycles_light::point_invarea(p.radius);
-        lamp.value = p.radius > 0.0f ? cycles_light::point_radiance(p.color, p.power, p.radius)
-                                     : cycles_light::point_intensity(p.color, p.power);
-        lamp.importance = luminance(cycles_light::point_intensity(p.color, p.power));
-        lamp.cos_half = std::cos(0.5f * p.spot_size);
-        lamp.smooth = (1.0f - lamp.cos_half) * p.spot_blend;
-        lamps_.push_back(lamp);
-    }
+// A point light's lamp, checked; none for a black one.
+Status LightSet::lamp_of(const PointLight &p, const std::string &name, std::optional<Lamp> &out) {
+    if (auto e = check_position(name + ": position", p.position)) return *e;
+    if (auto e = check_color(name + ":", p.color)) return *e;
+    if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
+    if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
+    if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
+    if (p.power == 0.0f || p.color.is_black()) return std::nullopt;
+    Lamp lamp;
+    lamp.type = LampType::Point;
+    lamp.cycles = p.cycles;
+    lamp.position = p.position;
+    set_point_emission(lamp, p);
+    out = lamp;
     return std::nullopt;
 }
 
-// Area lamps, checked; black and empty ones left out (an empty one with a warning).
-Status LightSet::add_areas(const std::vector<AreaLight> &areas, std::vector<std::string> *warnings) {
-    for (std::size_t i = 0; i < areas.size(); ++i) {
-        const AreaLight &a = areas[i];
-        const std::string name = "area light " + std::to_string(i);
-        if (!a.light_to_world.finite())
-            return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
-        const int shape = int(a.shape);
-        if (shape < 0 || shape > 3)
-            return Error{name + ": shape must be Square (0), Rectangle (1), Disk (2) or Ellipse "
-                                "(3) (got " + std::to_string(shape) + ")"};
-        if (auto e = check::non_negative((name + ": size_x").c_str(), a.size_x)) return *e;
-        if (auto e = check::non_negative((name + ": size_y").c_str(), a.size_y)) return *e;
-        if (auto e = check_color(name + ":", a.color)) return *e;
-        if (auto e = check::non_negative((name + ": power").c_str(), a.power)) return *e;
-        if (auto e = check_version(name, a.cycles, true)) return *e;
-        const Vec3 z = a.light_to_world.column(2);
-        if (!(length(z) > 0.0f))
-            return Error{name + ": light_to_world has a zero Z axis (no emitting direction)"};
-        if (a.power == 0.0f || a.color.is_black()) continue;
-        const float area = cycles_light::area_light_area(a);
-        if (!(area > 0.0f) || !std::isfinite(area)) {
-            if (warnings)
-                warnings->push_back(name + ": zero size, left out (it would emit nothing)");
-            continue;
-        }
-        const bool two_sizes = a.shape == AreaShape::Rectangle || a.shape == AreaShape::Ellipse;
-        Lamp lamp;
-        lamp.type = LampType::Area;
-        lamp.cycles = a.cycles;
-        lamp.position = a.light_to_world.column(3);
-        lamp.axis_u = a.light_to_world.column(0) * a.size_x;
-        lamp.axis_v = a.light_to_world.column(1) * (two_sizes ? a.size_y : a.size_x);
-        lamp.direction = safe_normalize(-z);
-        lamp.round = a.shape == AreaShape::Disk || a.shape == AreaShape::Ellipse;
-        // Solid-angle sampling needs a true rectangle (no shear in the object matrix).
-        lamp.solid_angle =
-            !lamp.round && std::fabs(dot(lamp.axis_u, lamp.axis_v)) <=
-                               1e-5f * length(lamp.axis_u) * length(lamp.axis_v);
-        lamp.invarea = 1.0f / area;
-        lamp.value = cycles_light::area_radiance(a.color, a.power, area, a.cycles);
-        lamp.importance = luminance(lamp.value) * area;  // its intensity along the normal
-        lamps_.push_back(lamp);
+// A spot's lamp, checked; none for a black one.
+Status LightSet::lamp_of(const SpotLight &p, const std::string &name, std::optional<Lamp> &out) {
+    if (!p.light_to_world.finite())
+        return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
+    const Vec3 z = p.light_to_world.column(2);
+    if (!(length(z) > 0.0f))
+        return Error{name + ": light_to_world has a zero Z axis (no direction to shine in)"};
+    if (auto e = check_color(name + ":", p.color)) return *e;
+    if (auto e = check::non_negative((name + ": power").c_str(), p.power)) return *e;
+    if (auto e = check::non_negative((name + ": radius").c_str(), p.radius)) return *e;
+    if (!(p.spot_size > 0.0f && p.spot_size <= kPiF))
+        return Error{name + ": spot_size must be in (0, pi] radians (got " +
+                     std::to_string(p.spot_size) + ")"};
+    if (!(p.spot_blend >= 0.0f && p.spot_blend <= 1.0f))
+        return Error{name + ": spot_blend must be in [0, 1] (got " +
+                     std::to_string(p.spot_blend) + ")"};
+    if (auto e = check_version(name, p.cycles, p.soft_falloff)) return *e;
+    Lamp lamp;
+    lamp.type = LampType::Spot;
+    lamp.cycles = p.cycles;
+    if (p.cycles == CyclesVersion::V4_5 && !invert_linear(p.light_to_world, lamp.world_to_light))
+        return Error{name + ": light_to_world is singular (Cycles 4.5 shapes the cone in the "
+                            "light's own frame)"};
+    if (p.power == 0.0f || p.color.is_black()) return std::nullopt;
+    lamp.position = p.light_to_world.column(3);
+    lamp.direction = safe_normalize(-z);
+    set_point_emission(lamp, p);
+    lamp.cos_half = std::cos(0.5f * p.spot_size);
+    lamp.smooth = (1.0f - lamp.cos_half) * p.spot_blend;
+    out = lamp;
+    return std::nullopt;
+}
+
+// An area light's lamp, checked; none for a black or empty one (an empty one with a warning).
+Status LightSet::lamp_of(const AreaLight &a, const std::string &name, std::optional<Lamp> &out,
+                         std::vector<std::string> *warnings) {
+    if (!a.light_to_world.finite())
+        return Error{name + ": light_to_world must be finite (it holds NaN or infinity)"};
+    const int shape = int(a.shape);
+    if (shape < 0 || shape > 3)
+        return Error{name + ": shape must be Square (0), Rectangle (1), Disk (2) or Ellipse "
+                            "(3) (got " + std::to_string(shape) + ")"};
+    if (auto e = check::non_negative((name + ": size_x").c_str(), a.size_x)) return *e;
+    if (auto e = check::non_negative((name + ": size_y").c_str(), a.size_y)) return *e;
+    if (auto e = check_color(name + ":", a.color)) return *e;
+    if (auto e = check::non_negative((name + ": power").c_str(), a.power)) return *e;
+    if (auto e = check_version(name, a.cycles, true)) return *e;
+    const Vec3 z = a.light_to_world.column(2);
+    if (!(length(z) > 0.0f))
+        return Error{name + ": light_to_world has a zero Z axis (no emitting direction)"};
+    if (a.power == 0.0f || a.color.is_black()) return std::nullopt;
+    const float area = cycles_light::area_light_area(a);
+    if (!(area > 0.0f) || !std::isfinite(area)) {
+        if (warnings)
+            warnings->push_back(name + ": zero size, left out (it would emit nothing)");
+        return std::nullopt;
     }
+    const bool two_sizes = a.shape == AreaShape::Rectangle || a.shape == AreaShape::Ellipse;
+    Lamp lamp;
+    lamp.type = LampType::Area;
+    lamp.cycles = a.cycles;
+    lamp.position = a.light_to_world.column(3);
+    lamp.axis_u = a.light_to_world.column(0) * a.size_x;
+    lamp.axis_v = a.light_to_world.column(1) * (two_sizes ? a.size_y : a.size_x);
+    lamp.direction = safe_normalize(-z);
+    lamp.round = a.shape == AreaShape::Disk || a.shape == AreaShape::Ellipse;
+    // Solid-angle sampling needs a true rectangle (no shear in the object matrix).
+    lamp.solid_angle =
+        !lamp.round && std::fabs(dot(lamp.axis_u, lamp.axis_v)) <=
+                           1e-5f * length(lamp.axis_u) * length(lamp.axis_v);
+    lamp.invarea = 1.0f / area;
+    lamp.value = cycles_light::area_radiance(a.color, a.power, area, a.cycles);
+    lamp.importance = luminance(lamp.value) * area;  // its intensity along the normal
+    out = lamp;
     return std::nullopt;
 }
 

@@ -333,10 +333,15 @@ class LightSet {
     };
 
     // The steps of build(), in its order.
-    Status add_suns(const std::vector<SunLight> &suns);
-    Status add_points(const std::vector<PointLight> &points);
-    Status add_spots(const std::vector<SpotLight> &spots);
-    Status add_areas(const std::vector<AreaLight> &areas, std::vector<std::string> *warnings);
+    template <typename Light>
+    static void set_point_emission(Lamp &lamp, const Light &p);
+    template <typename Light, typename... Extra>
+    Status add_lamps(const std::vector<Light> &lights, const char *kind, Extra... extra);
+    static Status lamp_of(const SunLight &s, const std::string &name, std::optional<Lamp> &out);
+    static Status lamp_of(const PointLight &p, const std::string &name, std::optional<Lamp> &out);
+    static Status lamp_of(const SpotLight &p, const std::string &name, std::optional<Lamp> &out);
+    static Status lamp_of(const AreaLight &a, const std::string &name, std::optional<Lamp> &out,
+                          std::vector<std::string> *warnings);
     Status set_world(const WorldLight &world);
     void set_triangles(const std::vector<EmissiveTriangle> &emissive);
 

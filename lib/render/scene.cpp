@@ -17,13 +17,7 @@ namespace hairis {
 namespace {
 
 LightsDesc lights_of(const SceneDesc &desc) {
-    LightsDesc lights;
-    lights.suns = desc.suns;
-    lights.points = desc.point_lights;
-    lights.spots = desc.spot_lights;
-    lights.areas = desc.area_lights;
-    lights.world = desc.world;
-    return lights;
+    return {desc.suns, desc.point_lights, desc.spot_lights, desc.area_lights, desc.world};
 }
 
 struct alignas(16) Float4 {

@@ -35,6 +35,21 @@ std::string bytes_text(long long bytes) {
     return std::to_string(bytes) + " bytes (limit " + std::to_string(kMaxSamplingTableBytes) + ")";
 }
 
+// Refuses values that do not hold `cells` entries (`shape` says how they are laid out) or
+// that hold a negative or non-finite entry, which name_of(n) names.
+template <typename NameOf>
+Status check_values(const char *owner, const std::vector<float> &values, long long cells,
+                    const char *shape, NameOf name_of) {
+    if ((long long)values.size() != cells)
+        return Error{std::string(owner) + ": values must hold " + shape + " = " +
+                     std::to_string(cells) + " entries (got " + std::to_string(values.size()) +
+                     ")"};
+    for (size_t n = 0; n < values.size(); ++n)
+        if (!(std::isfinite(values[n]) && values[n] >= 0.0f))
+            return prefixed(owner, *check::non_negative(name_of(n).c_str(), double(values[n])));
+    return std::nullopt;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -154,20 +169,15 @@ Expected<DirectTable> DirectTable::create(const std::vector<float> &theta_r_node
         return Error{std::string(kOwner) + ": " + std::to_string(node_count) + " nodes × " +
                      std::to_string(theta_i_count) + " × " + std::to_string(phi_count) +
                      " cells would need " + bytes_text(bytes)};
-    if ((long long)values.size() != cells)
-        return Error{
-            std::string(kOwner) + ": values must hold node count × theta_i_count × phi_count = " +
-            std::to_string(cells) + " entries (got " + std::to_string(values.size()) + ")"};
-    for (size_t n = 0; n < values.size(); ++n) {
-        if (!(std::isfinite(values[n]) && values[n] >= 0.0f)) {
-            const size_t j = n % size_t(phi_count),
-                         i = (n / size_t(phi_count)) % size_t(theta_i_count),
-                         r = n / (size_t(phi_count) * size_t(theta_i_count));
-            const std::string name = "values[node " + std::to_string(r) + ", theta_i cell " +
-                                     std::to_string(i) + ", phi cell " + std::to_string(j) + "]";
-            return prefixed(kOwner, *check::non_negative(name.c_str(), double(values[n])));
-        }
-    }
+    const auto direct_cell = [&](size_t n) {
+        const size_t j = n % size_t(phi_count), i = (n / size_t(phi_count)) % size_t(theta_i_count),
+                     r = n / (size_t(phi_count) * size_t(theta_i_count));
+        return "values[node " + std::to_string(r) + ", theta_i cell " + std::to_string(i) +
+               ", phi cell " + std::to_string(j) + "]";
+    };
+    if (Status s = check_values(kOwner, values, cells, "node count × theta_i_count × phi_count",
+                                direct_cell))
+        return *s;
 
     DirectTable t;
     t.nodes_ = std::move(nodes).value();
@@ -293,21 +303,15 @@ Expected<MultipleTable> MultipleTable::create(const std::vector<float> &theta_r_
     if (bytes > kMaxSamplingTableBytes)
         return Error{std::string(kOwner) + ": " + std::to_string(cells) + " cells would need " +
                      bytes_text(bytes)};
-    if ((long long)values.size() != cells)
-        return Error{
-            std::string(kOwner) + ": values must hold node count × n_h count × theta_i_count = " +
-            std::to_string(cells) + " entries (got " + std::to_string(values.size()) + ")"};
-    for (size_t n = 0; n < values.size(); ++n) {
-        if (!(std::isfinite(values[n]) && values[n] >= 0.0f)) {
-            const size_t i = n % size_t(theta_i_count),
-                         k = (n / size_t(theta_i_count)) % size_t(strands),
-                         r = n / (size_t(theta_i_count) * size_t(strands));
-            const std::string name = "values[node " + std::to_string(r) + ", n_h " +
-                                     std::to_string(n_h_values[k]) + ", theta_i cell " +
-                                     std::to_string(i) + "]";
-            return prefixed(kOwner, *check::non_negative(name.c_str(), double(values[n])));
-        }
-    }
+    const auto multiple_cell = [&](size_t n) {
+        const size_t i = n % size_t(theta_i_count), k = (n / size_t(theta_i_count)) % size_t(strands),
+                     r = n / (size_t(theta_i_count) * size_t(strands));
+        return "values[node " + std::to_string(r) + ", n_h " + std::to_string(n_h_values[k]) +
+               ", theta_i cell " + std::to_string(i) + "]";
+    };
+    if (Status s = check_values(kOwner, values, cells, "node count × n_h count × theta_i_count",
+                                multiple_cell))
+        return *s;
 
     MultipleTable t;
     t.nodes_ = std::move(nodes).value();

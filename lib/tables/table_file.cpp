@@ -164,6 +164,21 @@ std::string pixel_name(long long x, long long y) { return "pixel (" + std::to_st
 
 Error file_error(const std::string &what) { return Error{"hairis table: " + what, ErrorKind::InvalidTable}; }
 
+// The options that string attribute `name` holds.
+Expected<OptionReader> attribute_options(const OIIO::ImageSpec &spec, const char *name) {
+    Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute(name), name);
+    if (!reader) return file_error(reader.error().message);
+    return reader;
+}
+
+// The options of string attribute `name`, which the file's parts require (`missing` says so).
+Expected<OptionReader> required_options(const OIIO::ImageSpec &spec, const char *name,
+                                        const std::string &missing) {
+    const OIIO::ParamValue *attribute = spec.find_attribute(name);
+    if (!attribute || attribute->type() != TypeDesc::STRING) return file_error(missing);
+    return attribute_options(spec, name);
+}
+
 // A padding pixel: outside every part, so all four channels must be 0.
 Status check_padding(const float *p, size_t x, size_t y) {
     if (p[0] != 0.0f || p[1] != 0.0f || p[2] != 0.0f || p[3] != 0.0f)
@@ -366,12 +381,11 @@ Status check_huang_parts(const OIIO::ImageSpec &spec, bool multiple) {
 
 // hairis:huang: the Huang part's axes, within the size limits.
 Status read_huang_axes(const OIIO::ImageSpec &spec, HuangTableSet &h, HuangLayout &layout) {
-    const OIIO::ParamValue *attribute = spec.find_attribute("hairis:huang");
-    if (!attribute || attribute->type() != TypeDesc::STRING)
-        return file_error("hairis:parts is \"huang\" but there is no string attribute hairis:huang "
-                          "(\"row=0;theta_o=...;phi_o=...;theta_i=...;phi=...\")");
-    Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:huang"), "hairis:huang");
-    if (!reader) return file_error(reader.error().message);
+    Expected<OptionReader> reader = required_options(
+        spec, "hairis:huang",
+        "hairis:parts is \"huang\" but there is no string attribute hairis:huang "
+        "(\"row=0;theta_o=...;phi_o=...;theta_i=...;phi=...\")");
+    if (!reader) return reader.error();
     int row = -1;
     reader.value().field("row", row, 0, 0);
     reader.value().field("theta_o", layout.theta_o, 1, kMaxThetaRNodes);
@@ -399,8 +413,8 @@ Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layou
                                    "(\"row=...\")"
                                  : "hairis:parts names no f part, but the file has hairis:huang_f");
     if (!with_f) return std::nullopt;
-    Expected<OptionReader> fr = OptionReader::parse(spec.get_string_attribute("hairis:huang_f"), "hairis:huang_f");
-    if (!fr) return file_error(fr.error().message);
+    Expected<OptionReader> fr = attribute_options(spec, "hairis:huang_f");
+    if (!fr) return fr.error();
     int f_row = -1;
     fr.value().field("row", f_row, 0, kMaxTableCells);
     if (Status e = fr.value().finish()) return file_error(e->message);
@@ -413,12 +427,11 @@ Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layou
 
 // hairis:multiple with its θ_r nodes and n_h values, starting after the f part.
 Status read_huang_multiple(const OIIO::ImageSpec &spec, bool with_f, TableSet &t, HuangLayout &layout) {
-    const OIIO::ParamValue *m = spec.find_attribute("hairis:multiple");
-    if (!m || m->type() != TypeDesc::STRING)
-        return file_error("hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
-                          "(\"row=...;theta_r=...;theta_i=...\")");
-    Expected<OptionReader> mr = OptionReader::parse(spec.get_string_attribute("hairis:multiple"), "hairis:multiple");
-    if (!mr) return file_error(mr.error().message);
+    Expected<OptionReader> mr = required_options(
+        spec, "hairis:multiple",
+        "hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
+        "(\"row=...;theta_r=...;theta_i=...\")");
+    if (!mr) return mr.error();
     int multiple_row = -1;
     mr.value().field("row", multiple_row, 0, kMaxTableCells);
     mr.value().field("theta_r", layout.theta_r, 1, kMaxThetaRNodes);
@@ -625,8 +638,8 @@ Status read_near_header(const OIIO::ImageSpec &spec, long long far_rows, NearFie
     if (near_attribute->type() != TypeDesc::STRING)
         return file_error("hairis:near must be a string \"row=...;theta_o=...;theta_i=...\" (got a " +
                           std::string(near_attribute->type().c_str()) + ")");
-    Expected<OptionReader> reader = OptionReader::parse(spec.get_string_attribute("hairis:near"), "hairis:near");
-    if (!reader) return file_error(reader.error().message);
+    Expected<OptionReader> reader = attribute_options(spec, "hairis:near");
+    if (!reader) return reader.error();
     int row = -1;
     reader.value().field("row", row, 0, kMaxTableCells);
     reader.value().field("theta_o", near.theta_o_nodes, 2, kMaxThetaRNodes);
