@@ -8,10 +8,6 @@
 // reaches the check it names. The regression_* files that are raw byte crafts of the EXR
 // header, refused by the header pre-check, are kept as committed and not written here.
 // Deterministic: the same bytes on every run. Usage: write_table_seeds DIR.
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/hash.h>
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -21,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +27,7 @@
 #include "sampling/near_field_table.h"
 #include "tables/bake.h"
 #include "tables/table_file.h"
+#include "table_image.h"
 
 namespace {
 
@@ -51,40 +49,19 @@ Bytes encode(const TableSet &t) { return ok(encode_table_exr(t), "encoding"); }
 
 // ---- Pixel-level changes through OpenImageIO ---------------------------------------------------
 
-struct Image {
-    OIIO::ImageSpec spec;
-    std::vector<float> px;
-    float &at(int x, int y, int c) { return px[(size_t(y) * size_t(spec.width) + size_t(x)) * 4 + size_t(c)]; }
-};
+using testing::Image;
+using testing::rehash;
 
 Image read(const Bytes &bytes) {
-    OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-    auto in = OIIO::ImageInput::create("openexr");
-    Image image;
-    OIIO::ImageSpec config;
-    void *proxy_pointer = &reader;
-    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
-    if (!in || !in->open("t.exr", image.spec, config)) fail("cannot read back a table file");
-    image.px.resize(size_t(image.spec.width) * size_t(image.spec.height) * size_t(image.spec.nchannels));
-    if (!in->read_image(0, 0, 0, image.spec.nchannels, OIIO::TypeDesc::FLOAT, image.px.data()))
-        fail("cannot read back a table file's pixels");
-    in->close();
-    return image;
+    std::optional<Image> image = testing::decode_image(bytes);
+    if (!image) fail("cannot read back a table file");
+    return std::move(*image);
 }
 
 Bytes write(const Image &image) {
-    Bytes bytes;
-    OIIO::Filesystem::IOVecOutput writer(bytes);
-    auto out = OIIO::ImageOutput::create("openexr");
-    if (!out || !out->set_ioproxy(&writer) || !out->open("t.exr", image.spec) ||
-        !out->write_image(OIIO::TypeDesc::FLOAT, image.px.data()) || !out->close())
-        fail("cannot write a tampered file");
-    return bytes;
-}
-
-void rehash(Image &image) {
-    OIIO::SHA1 sha(image.px.data(), image.px.size() * sizeof(float));
-    image.spec.attribute("hairis:pixel_sha1", sha.digest());
+    std::optional<Bytes> bytes = testing::encode_image(image);
+    if (!bytes) fail("cannot write a tampered file");
+    return std::move(*bytes);
 }
 
 // `bytes` re-encoded after `edit` changed the header or the pixels; the hash is made to match

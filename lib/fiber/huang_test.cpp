@@ -8,6 +8,7 @@
 
 #include "core/frame.h"
 #include "core/quadrature.h"
+#include "hemisphere.h"
 
 namespace hairis {
 namespace {
@@ -135,19 +136,10 @@ TEST(Huang, FarFieldIsNearFieldAveragedOverOffset) {
 // ---------------------------------------------------------------------------------------
 // White furnace.
 
-// ∫ f dω_i over the sphere by a product Gauss rule in (sin θ_i, φ_i).
+// ∫ f dω_i over the sphere.
 template <typename F>
 double albedo(const F &f) {
-    const QuadratureRule s = QuadratureRule::composite(-1.0, 1.0, 6, 6);
-    const QuadratureRule phi = QuadratureRule::composite(-kPi, kPi, 8, 6);
-    double sum = 0.0;
-    for (std::size_t i = 0; i < s.x.size(); ++i)
-        for (std::size_t j = 0; j < phi.x.size(); ++j) {
-            const double c = std::sqrt(1.0 - s.x[i] * s.x[i]);
-            const Vec3 wi{float(s.x[i]), float(c * std::cos(phi.x[j])), float(c * std::sin(phi.x[j]))};
-            sum += s.w[i] * phi.w[j] * f(wi);
-        }
-    return sum;
+    return testing::integrate_fiber_sphere(f);
 }
 
 struct FurnaceCase {

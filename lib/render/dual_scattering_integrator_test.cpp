@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "cameras.h"
 #include "same_bits.h"
 #include "core/quadrature.h"
 #include "fiber/chiang.h"
@@ -93,17 +94,7 @@ TriangleMesh quad_at(float half, float z, std::uint32_t material) {
     return m;
 }
 
-// An orthographic camera at height 5 looking down −Z onto a half_x × half_y window.
-CameraDesc looking_down(float half_x, float half_y, int w, int h) {
-    CameraDesc c;
-    c.camera_to_world = Mat4::translation({0, 0, 5});
-    c.projection = Projection::Orthographic;
-    c.frame = {Vec3{half_x, half_y, -1}, Vec3{half_x, -half_y, -1}, Vec3{-half_x, -half_y, -1},
-               Vec3{-half_x, half_y, -1}};
-    c.width = w;
-    c.height = h;
-    return c;
-}
+using testing::ortho_down;
 
 Scene build(SceneDesc d) {
     auto s = Scene::build(std::move(d));
@@ -143,7 +134,7 @@ TEST(TraceThroughHair, ReportsEveryStrandCrossedOnceInOrder) {
     d.materials = {DiffuseMaterial{}, dual_hair(blonde())};
     d.curves = {straight_hairs(centres, radii)};
     d.curves[0].material = 1;
-    d.camera = looking_down(1, 1, 4, 4);
+    d.camera = ortho_down(1, 1, 4, 4);
     const Scene scene = build(std::move(d));
     std::vector<StrandCrossing> strands;
     const auto mesh = scene.trace_through_hair({0.3f, 0, 1}, {0, 0, -1}, 0.0f, INFINITY, {}, {}, strands);
@@ -171,7 +162,7 @@ TEST(TraceThroughHair, AJointOfTwoSegmentsIsOneCrossing) {
     SceneDesc d;
     d.materials = {dual_hair(blonde())};
     d.curves = {straight_hairs({{0, 0, 0}}, {0.08f})};
-    d.camera = looking_down(1, 1, 4, 4);
+    d.camera = ortho_down(1, 1, 4, 4);
     const Scene scene = build(std::move(d));
     std::vector<StrandCrossing> strands;
     for (float x : {-0.5f, 0.5f, 0.0f, -0.5f + 1e-3f}) {
@@ -189,7 +180,7 @@ TEST(TraceThroughHair, MeshesStopTheRayAndHairBehindThemIsNotReported) {
     d.curves = {straight_hairs({{0, 0, -1}, {0, 0, -2}, {0, 0, -3}}, {0.05f, 0.05f, 0.05f})};
     d.curves[0].material = 1;
     d.meshes = {quad_at(2.0f, -2.5f, 0)};
-    d.camera = looking_down(1, 1, 4, 4);
+    d.camera = ortho_down(1, 1, 4, 4);
     const Scene scene = build(std::move(d));
     std::vector<StrandCrossing> strands;
     const auto mesh = scene.trace_through_hair({0.2f, 0, 1}, {0, 0, -1}, 0.0f, INFINITY, {}, {}, strands);
@@ -225,7 +216,7 @@ TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveTheFixedCountForm) {
     SceneDesc d;
     d.materials = {dual_hair(b)};
     d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
-    d.camera = looking_down(1, 1, 2, 2);
+    d.camera = ortho_down(1, 1, 2, 2);
     const Scene scene = build(std::move(d));
     for (double theta : {-0.9, -0.2, 0.0, 0.35, 1.1}) {
         const Vec3 dir{float(std::sin(theta)), float(std::cos(theta)), 0.0f};
@@ -264,7 +255,7 @@ TEST(DualScatteringIntegrator, EachStrandCountsAtItsOwnInclination) {
     SceneDesc d;
     d.materials = {dual_hair(b)};
     d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
-    d.camera = looking_down(1, 1, 2, 2);
+    d.camera = ortho_down(1, 1, 2, 2);
     const Scene scene = build(std::move(d));
     const Vec3 dir = safe_normalize(Vec3{0.3f, -0.5f, 0.8f});
     const std::vector<Vec3> tangents{{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0.2f, 0.9f, 0.4f}, {0, 0, -1}};
@@ -356,7 +347,7 @@ Scene sun_through_strands(int k, float strength) {
     sun.strength = strength;
     d.suns = {sun};
     d.world = {Rgb(0.0f), 1.0f};
-    d.camera = looking_down(0.4f, 0.012f, 8, 2);
+    d.camera = ortho_down(0.4f, 0.012f, 8, 2);
     return build(std::move(d));
 }
 
@@ -537,7 +528,7 @@ Scene sunlit_floor(const std::vector<Vec3> &centres, float r, float floor_z, flo
     sun.to_sun = kSunAbove;
     sun.strength = strength;
     d.suns = {sun};
-    d.camera = looking_down(window, window, 1, 1);
+    d.camera = ortho_down(window, window, 1, 1);
     return build(std::move(d));
 }
 
@@ -673,7 +664,7 @@ TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter
     sun.to_sun = {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))};
     sun.strength = strength;
     d.suns = {sun};
-    d.camera = looking_down(0.4f, 0.03f, 1, 1);
+    d.camera = ortho_down(0.4f, 0.03f, 1, 1);
     const Scene scene = build(std::move(d));
     // Fiber frame at the hit: x = +X; ω_o = +Z; ω_i = to_sun.
     const FiberFrame frame = FiberFrame::from_tangent_and_view({1, 0, 0}, {0, 0, 1});
@@ -698,7 +689,7 @@ Scene sun_with_three_strands_behind(float strength) {
     sun.to_sun = {0.0f, std::sin(a), std::cos(a)};
     sun.strength = strength;
     d.suns = {sun};
-    d.camera = looking_down(0.4f, 0.03f, 1, 1);
+    d.camera = ortho_down(0.4f, 0.03f, 1, 1);
     return build(std::move(d));
 }
 
@@ -774,7 +765,7 @@ SceneDesc single_hair() {
     SceneDesc d;
     d.materials = {dual_hair(blonde())};
     d.curves = {straight_hairs({{0, 0, 0}}, {0.02f})};
-    d.camera = looking_down(0.01f, 0.01f, 1, 1);
+    d.camera = ortho_down(0.01f, 0.01f, 1, 1);
     return d;
 }
 
@@ -814,7 +805,7 @@ TEST(DualScatteringRender, ALayerCutsEachSamplesBackscatterAlongItsOwnLight) {
     d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r))};
     const float radiance = 1.3f;
     d.world = {Rgb(1.0f), radiance};
-    d.camera = looking_down(0.001f, 0.001f, 1, 1);  // the top of the hair, (0, 0, r)
+    d.camera = ortho_down(0.001f, 0.001f, 1, 1);  // the top of the hair, (0, 0, r)
     const Scene scene = build(std::move(d));
     const DualScattering &dual = *blonde().dual;
     // The strands a ray from (0, 0, r) along (·, dy, dz) crosses: those ahead of it whose axis
@@ -951,7 +942,7 @@ Scene tuft_cut_by_floor() {
     d.curves = {tuft(1500, 6, 0.008f)};
     d.curves[0].material = 1;
     d.meshes = {quad_at(0.2f, 0.45f, 0)};
-    d.camera = looking_down(1, 1, 4, 4);
+    d.camera = ortho_down(1, 1, 4, 4);
     return build(std::move(d));
 }
 
@@ -1045,7 +1036,7 @@ TEST(DualScatteringRender, ExactBouncesArePathTracedAndTheClosureMovesWithThem) 
     // A blonde tuft over a floor under a sun and a world: with every bounce exact the dual
     // render is the path tracer's image bit for bit; with fewer, each exact bounce moves the
     // image, since the vertex that closes the path by dual scattering moves deeper.
-    const Scene scene = tuft_over_floor(looking_down(0.4f, 0.4f, 12, 12));
+    const Scene scene = tuft_over_floor(ortho_down(0.4f, 0.4f, 12, 12));
     RenderSettings path;
     path.samples = 4;
     path.max_bounces = 6;
@@ -1138,7 +1129,7 @@ TEST(DualScatteringRender, WithNoBouncesLeftTheClosingVertexIsThePathTracersLast
     // the multiple-scattering term may be added and the image's expectation is the path
     // tracer's (their estimators differ: the continuation's density is a mixture). With every
     // order (DualBounceLimit::None) it is brighter.
-    const Scene scene = tuft_over_floor(looking_down(0.3f, 0.3f, 1, 1));
+    const Scene scene = tuft_over_floor(ortho_down(0.3f, 0.3f, 1, 1));
     RenderSettings path;
     path.max_bounces = 2;
     path.threads = 1;

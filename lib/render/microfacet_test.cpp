@@ -19,11 +19,6 @@ using testing::Sample3;
 // Every χ² test of this file, for the Šidák correction.
 constexpr int kChi2Tests = 7;
 
-Vec3 from_angles(double theta, double phi) {
-    return {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-            float(std::cos(theta))};
-}
-
 // ∫₀¹ 2π g(h) c dc for an isotropic g of the normal h = (sin θ, 0, c) sharply peaked at
 // c = 1: in t = −ln(1 − c), with sin θ from 1 − c in double so that h keeps its tilt in float.
 template <typename G>
@@ -52,7 +47,7 @@ TEST(Microfacet, GgxVisibleAreaIsTheProjectedView) {
     // Heitz 2014: ∫ G1(ω_o) max(0, ω_o·h) D(h) dω_h = cos θ_o, tying Λ to D.
     for (float alpha : {0.15f, 0.5f, 0.9f})
         for (double theta : {0.2, 0.9, 1.35}) {
-            const Vec3 wo = from_angles(theta, 0.4);
+            const Vec3 wo = testing::polar_direction(theta, 0.4);
             const float a2 = alpha * alpha;
             const double visible = testing::integrate_hemisphere([&](Vec3 h) {
                 return microfacet::ggx_g1(a2, wo.z) * std::max(0.0f, dot(wo, h)) *
@@ -123,7 +118,7 @@ Chi2Result ggx_chi2(Vec3 wo, float alpha) {
 
 TEST(Microfacet, GgxVisibleNormalSamplerMatchesItsDensity) {
     for (const auto &[theta, alpha] : {std::pair{0.3, 0.5f}, {1.1, 0.3f}, {1.45, 0.7f}, {0.0, 0.25f}}) {
-        const Vec3 wo = from_angles(theta, 0.7);
+        const Vec3 wo = testing::polar_direction(theta, 0.7);
         const Chi2Result r = ggx_chi2(wo, alpha);
         EXPECT_TRUE(r.passed) << "theta " << theta << " alpha " << alpha << ": " << r.message;
         // The missing mass is the share below the horizon: the density integrates to the rest.
@@ -133,7 +128,7 @@ TEST(Microfacet, GgxVisibleNormalSamplerMatchesItsDensity) {
 
 TEST(Microfacet, Gtr1SamplerMatchesItsDensity) {
     for (const auto &[theta, alpha] : {std::pair{0.4, 0.3f}, {1.2, 0.6f}, {0.9, 1.0f}}) {
-        const Vec3 wo = from_angles(theta, -1.1);
+        const Vec3 wo = testing::polar_direction(theta, -1.1);
         const Chi2Result r = testing::chi2_direction_test(
             [&](Sample3 u) -> std::optional<Vec3> {
                 const Vec3 h = microfacet::sample_gtr1(alpha, u.u0, u.u1);

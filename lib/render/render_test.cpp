@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cameras.h"
 #include "same_bits.h"
 
 #include "fiber/chiang_strands.h"
@@ -19,6 +20,7 @@
 #include "core/quadrature.h"
 #include "fiber/fresnel.h"
 #include "hemisphere.h"
+#include "huang_fixtures.h"
 
 #include <cstdio>
 
@@ -49,16 +51,7 @@ constexpr double kPiD = kPi;
 
 // ---- Scene helpers ------------------------------------------------------------------------
 
-CameraDesc ortho_down(float half_x, float half_y, int w, int h, Vec3 position = {0, 0, 5}) {
-    CameraDesc c;
-    c.camera_to_world = Mat4::translation(position);  // looks down −Z
-    c.projection = Projection::Orthographic;
-    c.frame = {Vec3{half_x, half_y, -1}, Vec3{half_x, -half_y, -1}, Vec3{-half_x, -half_y, -1},
-               Vec3{-half_x, half_y, -1}};
-    c.width = w;
-    c.height = h;
-    return c;
-}
+using testing::ortho_down;
 
 CameraDesc perspective(Vec3 position, float tan_half, int w, int h) {
     CameraDesc c;
@@ -1050,15 +1043,7 @@ TEST(Render, HuangFurnaceFollowsEvalOrCyclesSampler) {
     // ∫ f dω_i of the far field seen along −z across a fiber along x, in Huang's frame
     // (circular: y = normalize(tangent × ω_o)), by a product Gauss rule in (sin θ_i, φ_i).
     const HuangExpectation far = fiber->expectation({{0.0f, 0.0f, -1.0f}, 0.0f, 1.0f});
-    const QuadratureRule sin_theta = QuadratureRule::composite(-1.0, 1.0, 6, 6);
-    const QuadratureRule phi = QuadratureRule::composite(-kPi, kPi, 8, 6);
-    double albedo = 0;
-    for (std::size_t i = 0; i < sin_theta.x.size(); ++i)
-        for (std::size_t j = 0; j < phi.x.size(); ++j) {
-            const double c = std::sqrt(1.0 - sin_theta.x[i] * sin_theta.x[i]);
-            const Vec3 wi{float(sin_theta.x[i]), float(c * std::cos(phi.x[j])), float(c * std::sin(phi.x[j]))};
-            albedo += sin_theta.w[i] * phi.w[j] * double(far.f(wi).g);
-        }
+    const double albedo = testing::integrate_fiber_sphere([&](Vec3 wi) { return far.f(wi).g; });
     EXPECT_GT(albedo, 1.3);  // the edges' overweight (docs/huang.md §6)
     const FurnaceEstimate eval_mode = huang_furnace(fiber, HuangSampling::Strategy, 6);
     EXPECT_NEAR(eval_mode.mean, albedo, 4.0 * eval_mode.standard_error + 0.005 * albedo)
@@ -1088,11 +1073,7 @@ TEST(Render, HuangCyclesSamplingShadesLightSamplesWithTheBakedF) {
     HuangParams p;
     p.sigma_a = principled_hair::sigma_from_reflectance({0.55f, 0.4f, 0.25f}, 0.3f);
     auto fiber = std::make_shared<const HuangFiber>(HuangFiber::create(p).value());
-    HuangBakeOptions o;
-    o.theta_o_count = 8;
-    o.phi_o_count = 3;
-    o.theta_i_count = 16;
-    o.phi_count = 24;
+    const HuangBakeOptions o = testing::small_huang_bake();
     auto table = std::make_shared<const HuangSamplingTable>(
         HuangSamplingTable::from(bake_huang_table(*fiber, o).value()).value());
     auto tabulated = std::make_shared<const HuangTabulatedFiber>(HuangTabulatedFiber::create(fiber, table).value());

@@ -21,11 +21,6 @@ using testing::Sample3;
 
 constexpr int kChi2Tests = 5;
 
-Vec3 from_angles(double theta, double phi) {
-    return {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-            float(std::cos(theta))};
-}
-
 SurfaceLobe lobe(SurfaceLobeKind kind, Rgb weight, float select) {
     SurfaceLobe l;
     l.kind = kind;
@@ -126,11 +121,11 @@ TEST(SurfaceBsdf, MixtureSamplerMatchesItsDensity) {
         Vec3 wo, ng;
     };
     const std::vector<Case> cases = {
-        {"3.4 principled", lobes_34(), from_angles(0.6, 0.3), Vec3{0, 0, 1}},
-        {"3.4 principled, tilted ng, grazing", lobes_34(), from_angles(1.2, 2.0), tilted_ng},
-        {"4.x layers, tilted ng", lobes_4(), from_angles(0.9, -0.5), tilted_ng},
-        {"lambert", {lobe(SurfaceLobeKind::Lambert, Rgb(0.7f), 1.0f)}, from_angles(0.4, 0.0), Vec3{0, 0, 1}},
-        {"3.4 principled, Cycles' clearcoat sampler", cycles_clearcoat_lobes(), from_angles(0.7, 0.5), Vec3{0, 0, 1}},
+        {"3.4 principled", lobes_34(), testing::polar_direction(0.6, 0.3), Vec3{0, 0, 1}},
+        {"3.4 principled, tilted ng, grazing", lobes_34(), testing::polar_direction(1.2, 2.0), tilted_ng},
+        {"4.x layers, tilted ng", lobes_4(), testing::polar_direction(0.9, -0.5), tilted_ng},
+        {"lambert", {lobe(SurfaceLobeKind::Lambert, Rgb(0.7f), 1.0f)}, testing::polar_direction(0.4, 0.0), Vec3{0, 0, 1}},
+        {"3.4 principled, Cycles' clearcoat sampler", cycles_clearcoat_lobes(), testing::polar_direction(0.7, 0.5), Vec3{0, 0, 1}},
     };
     for (const Case &c : cases) {
         const SurfaceBsdf b = make_bsdf(c.lobes, c.wo, c.ng);
@@ -141,7 +136,7 @@ TEST(SurfaceBsdf, MixtureSamplerMatchesItsDensity) {
 }
 
 TEST(SurfaceBsdf, SampleWeightIsEvalOverPdf) {
-    const SurfaceBsdf b = make_bsdf(lobes_4(), from_angles(0.7, 1.0), safe_normalize(Vec3{0.2f, 0.0f, 1.0f}));
+    const SurfaceBsdf b = make_bsdf(lobes_4(), testing::polar_direction(0.7, 1.0), safe_normalize(Vec3{0.2f, 0.0f, 1.0f}));
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     int drawn = 0;
@@ -164,7 +159,7 @@ TEST(SurfaceBsdf, SampleWeightsAverageToTheReflectedEnergy) {
     // reach (above ng), by an independent quadrature of eval.
     const Vec3 ng = safe_normalize(Vec3{0.3f, -0.2f, 1.0f});
     for (const auto &lobes : {lobes_34(), lobes_4()}) {
-        const SurfaceBsdf b = make_bsdf(lobes, from_angles(0.8, 0.4), ng);
+        const SurfaceBsdf b = make_bsdf(lobes, testing::polar_direction(0.8, 0.4), ng);
         double quadrature[3] = {0, 0, 0};
         for (int k = 0; k < 3; ++k)
             quadrature[k] = testing::integrate_hemisphere([&](Vec3 wi) {
@@ -197,7 +192,7 @@ TEST(SurfaceBsdf, CyclesClearcoatWeightsByTheDensityItReports) {
     // Cycles 3.4's clearcoat is drawn from GGX visible normals but weighted with its GTR1
     // formula: the sample's pdf is the true mixture Q, its weight f / P with P the reported
     // mixture, so the mean weight is ∫ f Q / P (not ∫ f), by quadrature here.
-    const SurfaceBsdf b = make_bsdf(cycles_clearcoat_lobes(), from_angles(0.8, 0.4), Vec3{0, 0, 1});
+    const SurfaceBsdf b = make_bsdf(cycles_clearcoat_lobes(), testing::polar_direction(0.8, 0.4), Vec3{0, 0, 1});
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     const int n = 400000;
@@ -226,16 +221,16 @@ TEST(SurfaceBsdf, CyclesClearcoatWeightsByTheDensityItReports) {
     EXPECT_NEAR(mean, cycles, 5.0 * sd);
     EXPECT_GT(std::fabs(cycles - exact), 10.0 * sd) << "the test must tell the two apart";
     // The exact lobes report what they draw: P = Q.
-    const SurfaceBsdf plain = make_bsdf(lobes_34(), from_angles(0.8, 0.4), Vec3{0, 0, 1});
+    const SurfaceBsdf plain = make_bsdf(lobes_34(), testing::polar_direction(0.8, 0.4), Vec3{0, 0, 1});
     for (double t : {0.1, 0.7, 1.3}) {
         float q, p;
-        plain.eval(from_angles(t, 3.0), q, &p);
+        plain.eval(testing::polar_direction(t, 3.0), q, &p);
         EXPECT_EQ(q, p);
     }
 }
 
 TEST(SurfaceBsdf, DefensiveSelectionRaisesSmallLobes) {
-    SurfaceBsdf b = make_bsdf(lobes_34(), from_angles(0.5, 0.0), Vec3{0, 0, 1});
+    SurfaceBsdf b = make_bsdf(lobes_34(), testing::polar_direction(0.5, 0.0), Vec3{0, 0, 1});
     const float total = 0.4f + 0.05f + 0.1f + 0.05f;
     b.defend_selection(0.125f);
     EXPECT_FLOAT_EQ(b.lobe(0).select, 0.4f);
@@ -246,7 +241,7 @@ TEST(SurfaceBsdf, DefensiveSelectionRaisesSmallLobes) {
 
 TEST(SurfaceBsdf, LambertReflectsItsWeight) {
     const SurfaceBsdf b = make_bsdf({lobe(SurfaceLobeKind::Lambert, Rgb(0.8f, 0.5f, 0.2f), 1.0f)},
-                                    from_angles(0.5, 0.0), Vec3{0, 0, 1});
+                                    testing::polar_direction(0.5, 0.0), Vec3{0, 0, 1});
     const double albedo = testing::integrate_hemisphere([&](Vec3 wi) {
         float pdf;
         return double(b.eval(wi, pdf).g);
@@ -267,16 +262,16 @@ TEST(SurfaceBsdf, PrincipledDiffuseAlbedoAtNormalIncidence) {
     EXPECT_NEAR(lobe_albedo(l, Vec3{0, 0, 1}), 41.0 / 42.0, 1e-5);
     // Retro-reflection adds energy with roughness (Burley's model is not energy conserving).
     l.roughness = 1.0f;
-    EXPECT_GT(lobe_albedo(l, from_angles(1.2, 0.0)), 1.0);
+    EXPECT_GT(lobe_albedo(l, testing::polar_direction(1.2, 0.0)), 1.0);
 }
 
 TEST(SurfaceBsdf, OrenNayarVersions) {
     // σ = 0 is Lambert in both; 4.3+'s model with its multiple scattering preserves energy
     // (white furnace), 3.4's loses some.
     SurfaceLobe old_on = lobe(SurfaceLobeKind::OrenNayar34, Rgb(1.0f), 1.0f);
-    EXPECT_NEAR(lobe_albedo(old_on, from_angles(0.7, 0.0)), 1.0, 1e-5);
+    EXPECT_NEAR(lobe_albedo(old_on, testing::polar_direction(0.7, 0.0)), 1.0, 1e-5);
     old_on.roughness = 1.0f;
-    EXPECT_LT(lobe_albedo(old_on, from_angles(0.7, 0.0)), 0.98);
+    EXPECT_LT(lobe_albedo(old_on, testing::polar_direction(0.7, 0.0)), 0.98);
 
     // The multiple-scattering colour for a white albedo and this ω_o, from OpenPBR's formula
     // written out here: E(c) = Aπ + B G(c), E_avg = Aπ + (2π − 5.6) B / 3,
@@ -291,7 +286,7 @@ TEST(SurfaceBsdf, OrenNayarVersions) {
             SurfaceLobe on = lobe(SurfaceLobeKind::OrenNayar, Rgb(1.0f), 1.0f);
             on.roughness = float(sigma);
             on.multiscatter = Rgb(float(ems * (1.0 - (a * pi + b * g))));
-            EXPECT_NEAR(lobe_albedo(on, from_angles(theta, 0.0)), 1.0, 5e-3) << sigma << " " << theta;
+            EXPECT_NEAR(lobe_albedo(on, testing::polar_direction(theta, 0.0)), 1.0, 5e-3) << sigma << " " << theta;
         }
 }
 
@@ -344,7 +339,7 @@ TEST(SurfaceBsdf, MicrofacetLobesFollowCyclesFormulas) {
     for (const SurfaceLobe &l : all) {
         if (l.kind != SurfaceLobeKind::Microfacet) continue;
         for (const auto &[to, ti, dphi] : {std::tuple{0.3, 0.5, 2.8}, {1.1, 0.9, 3.2}, {0.8, 1.3, 1.0}}) {
-            const Vec3 wo = from_angles(to, 0.0), wi = from_angles(ti, dphi);
+            const Vec3 wo = testing::polar_direction(to, 0.0), wi = testing::polar_direction(ti, dphi);
             float pdf;
             const Rgb v = eval_lobe(l, wo, wi, pdf);
             for (int k = 0; k < 3; ++k) {
@@ -357,7 +352,7 @@ TEST(SurfaceBsdf, MicrofacetLobesFollowCyclesFormulas) {
 
 TEST(SurfaceBsdf, ReflectionLobesAreZeroBelowTheNormalAndCycles4MicrofacetsBelowNg) {
     const Vec3 ng = safe_normalize(Vec3{0.5f, 0.0f, 1.0f});
-    const Vec3 wo = from_angles(0.5, 0.0);
+    const Vec3 wo = testing::polar_direction(0.5, 0.0);
     // Above n (z > 0) but below ng (x·0.5 + z < 0).
     const Vec3 wi = safe_normalize(Vec3{-1.0f, 0.0f, 0.3f});
     ASSERT_GT(wi.z, 0.0f);
@@ -373,7 +368,7 @@ TEST(SurfaceBsdf, ReflectionLobesAreZeroBelowTheNormalAndCycles4MicrofacetsBelow
     }
     for (const SurfaceLobe &l : lobes_34()) {
         float pdf;
-        EXPECT_EQ(eval_lobe(l, wo, from_angles(1.8, 0.3), pdf).max_component(), 0.0f);
+        EXPECT_EQ(eval_lobe(l, wo, testing::polar_direction(1.8, 0.3), pdf).max_component(), 0.0f);
     }
 }
 

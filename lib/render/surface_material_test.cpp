@@ -13,11 +13,6 @@
 namespace hairis {
 namespace {
 
-Vec3 from_angles(double theta, double phi) {
-    return {float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-            float(std::cos(theta))};
-}
-
 SurfaceMaterial material(std::vector<SurfaceNode> nodes) {
     Expected<SurfaceMaterial> m = SurfaceMaterial::create(std::move(nodes));
     EXPECT_TRUE(m) << (m ? "" : m.error().message);
@@ -50,7 +45,7 @@ void expect_rgb(Rgb a, Rgb b, float tol) {
 TEST(SurfaceMaterial, Principled34DefaultsMakeDiffuseAndSpecular) {
     PrincipledBsdfNode p;  // Blender 3.4's defaults: Specular 0.5, Roughness 0.5
     p.base_color.value = Rgb(0.6f, 0.4f, 0.2f);
-    const SurfaceBsdf b = at(material({p}), from_angles(0.5, 0.0));
+    const SurfaceBsdf b = at(material({p}), testing::polar_direction(0.5, 0.0));
     ASSERT_EQ(b.lobe_count(), 2);
     const SurfaceLobe *diffuse = find(b, SurfaceLobeKind::PrincipledDiffuse);
     ASSERT_TRUE(diffuse);
@@ -76,7 +71,7 @@ TEST(SurfaceMaterial, Principled34MetallicTintSheenAndClearcoat) {
     p.sheen_tint = 1.0f;
     p.coat = 0.8f;
     p.coat_roughness = 0.2f;
-    const SurfaceBsdf b = at(material({p}), from_angles(0.3, 1.0));
+    const SurfaceBsdf b = at(material({p}), testing::polar_direction(0.3, 1.0));
     const SurfaceLobe *diffuse = find(b, SurfaceLobeKind::PrincipledDiffuse);
     ASSERT_TRUE(diffuse);
     expect_rgb(diffuse->weight, Rgb(0.9f, 0.5f, 0.1f) * 0.75f, 1e-6f);
@@ -106,7 +101,7 @@ TEST(SurfaceMaterial, Principled34MetallicTintSheenAndClearcoat) {
     EXPECT_NEAR(coat->select, (0.04f * (1.0f - s) + s) * 0.2f, 1e-6f);
     EXPECT_NEAR(diffuse->select, (0.9f + 0.5f + 0.1f) / 3.0f * 0.75f, 1e-6f);
     const SurfaceMaterial m = material({p});
-    const SurfaceBsdf first = m.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
+    const SurfaceBsdf first = m.prepare({testing::polar_direction(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
     float total = 0.0f;
     for (int i = 0; i < b.lobe_count(); ++i) total += b.lobe(i).select;
     for (int i = 0; i < first.lobe_count(); ++i)
@@ -117,8 +112,8 @@ TEST(SurfaceMaterial, Principled34MetallicTintSheenAndClearcoat) {
     later.sheen = 0.0f;
     later.sheen_tint = 0.5f;
     const SurfaceMaterial m4 = material({later});
-    const SurfaceBsdf a4 = m4.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, false});
-    const SurfaceBsdf b4 = m4.prepare({from_angles(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
+    const SurfaceBsdf a4 = m4.prepare({testing::polar_direction(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, false});
+    const SurfaceBsdf b4 = m4.prepare({testing::polar_direction(0.3, 1.0), Vec3{0, 0, 1}, Vec3{0, 0, 1}, 0, 0, true});
     for (int i = 0; i < a4.lobe_count(); ++i) EXPECT_EQ(a4.lobe(i).select, b4.lobe(i).select);
 }
 
@@ -159,14 +154,14 @@ TEST(SurfaceMaterial, Principled4IorLevelScalesF0) {
     p.cycles = CyclesVersion::V4_5;
     p.ior = 1.5f;
     p.specular = 0.25f;  // IOR Level: F0 = 0.04 · 2 · 0.25
-    const SurfaceBsdf b = at(material({p}), from_angles(0.4, 0.0));
+    const SurfaceBsdf b = at(material({p}), testing::polar_direction(0.4, 0.0));
     const SurfaceLobe *spec = find(b, SurfaceLobeKind::Microfacet);
     ASSERT_TRUE(spec);
     expect_rgb(spec->f0, Rgb(0.02f), 1e-6f);
     const float s = std::sqrt(0.02f);
     EXPECT_NEAR(spec->ior, (1.0f + s) / (1.0f - s), 1e-5f);
     p.specular = 0.0f;  // F0 = 0: η = 1, no specular lobe
-    EXPECT_FALSE(find(at(material({p}), from_angles(0.4, 0.0)), SurfaceLobeKind::Microfacet));
+    EXPECT_FALSE(find(at(material({p}), testing::polar_direction(0.4, 0.0)), SurfaceLobeKind::Microfacet));
 }
 
 TEST(SurfaceMaterial, MultiscatterGgxCompensatesItsLostEnergy) {
@@ -179,7 +174,7 @@ TEST(SurfaceMaterial, MultiscatterGgxCompensatesItsLostEnergy) {
             g.color.value = Rgb(1.0f);
             g.roughness = roughness;
             g.multiscatter = true;
-            EXPECT_NEAR(albedo(at(material({g}), from_angles(theta, 0.0))), 1.0, 0.015)
+            EXPECT_NEAR(albedo(at(material({g}), testing::polar_direction(theta, 0.0))), 1.0, 0.015)
                 << roughness << " " << theta;
             PrincipledBsdfNode metal;
             metal.cycles = CyclesVersion::V4_5;
@@ -187,10 +182,10 @@ TEST(SurfaceMaterial, MultiscatterGgxCompensatesItsLostEnergy) {
             metal.metallic = 1.0f;
             metal.roughness = roughness;
             metal.base_color.value = Rgb(1.0f);
-            EXPECT_NEAR(albedo(at(material({metal}), from_angles(theta, 0.0))), 1.0, 0.015);
+            EXPECT_NEAR(albedo(at(material({metal}), testing::polar_direction(theta, 0.0))), 1.0, 0.015);
             // Without it the lobe reflects the single-scattering albedo E.
             g.multiscatter = false;
-            EXPECT_NEAR(albedo(at(material({g}), from_angles(theta, 0.0))),
+            EXPECT_NEAR(albedo(at(material({g}), testing::polar_direction(theta, 0.0))),
                         ggx_reflection_albedo(double(roughness) * roughness, std::cos(theta)), 3e-3);
         }
 }
@@ -204,7 +199,7 @@ TEST(SurfaceMaterial, Principled4WhiteDielectricNearlyConservesEnergy) {
         p.multiscatter = true;
         p.ior = 1.5f;
         p.base_color.value = Rgb(1.0f);
-        const double a = albedo(at(material({p}), from_angles(theta, 0.0)));
+        const double a = albedo(at(material({p}), testing::polar_direction(theta, 0.0)));
         EXPECT_GT(a, 0.95) << theta;
         EXPECT_LT(a, 1.02) << theta;
     }
@@ -241,19 +236,19 @@ TEST(SurfaceMaterial, MixAndAddWeightTheirInputs) {
     mix.factor = 0.25f;
     mix.first = 0;
     mix.second = 1;
-    const SurfaceBsdf m = at(material({red, blue, mix}), from_angles(0.3, 0.0));
+    const SurfaceBsdf m = at(material({red, blue, mix}), testing::polar_direction(0.3, 0.0));
     ASSERT_EQ(m.lobe_count(), 2);
     expect_rgb(m.lobe(0).weight, Rgb(0.75f, 0.0f, 0.0f), 1e-7f);
     expect_rgb(m.lobe(1).weight, Rgb(0.0f, 0.0f, 0.25f), 1e-7f);
     AddShaderNode add;
     add.first = 0;
     add.second = 1;
-    const SurfaceBsdf a = at(material({red, blue, add}), from_angles(0.3, 0.0));
+    const SurfaceBsdf a = at(material({red, blue, add}), testing::polar_direction(0.3, 0.0));
     expect_rgb(a.lobe(0).weight, Rgb(1.0f, 0.0f, 0.0f), 0.0f);
     expect_rgb(a.lobe(1).weight, Rgb(0.0f, 0.0f, 1.0f), 0.0f);
     // The factor is clamped like Cycles' Mix Shader.
     mix.factor = 1.7f;
-    EXPECT_EQ(at(material({red, blue, mix}), from_angles(0.3, 0.0)).lobe_count(), 1);
+    EXPECT_EQ(at(material({red, blue, mix}), testing::polar_direction(0.3, 0.0)).lobe_count(), 1);
 }
 
 TEST(SurfaceMaterial, EmissionFollowsTheTree) {
@@ -271,7 +266,7 @@ TEST(SurfaceMaterial, EmissionFollowsTheTree) {
     add.second = 0;
     const SurfaceMaterial m = material({e, p, mix, add});
     expect_rgb(m.emission(), Rgb(1.0f, 0.5f, 0.25f) * 4.0f * 1.75f + Rgb(0.0f, 2.0f, 0.0f) * 0.25f, 1e-5f);
-    EXPECT_EQ(at(m, from_angles(0.2, 0.0)).lobe_count(), 2);  // emission makes no lobe
+    EXPECT_EQ(at(m, testing::polar_direction(0.2, 0.0)).lobe_count(), 2);  // emission makes no lobe
 }
 
 TEST(SurfaceMaterial, TextureFeedsTheBaseColour) {
@@ -287,8 +282,8 @@ TEST(SurfaceMaterial, TextureFeedsTheBaseColour) {
         if (version == CyclesVersion::V4_5) p.ior = 1.0f;  // η = 1: no specular layer
         p.base_color.texture = texture;
         const SurfaceMaterial m = material({p});
-        const SurfaceBsdf left = at(m, from_angles(0.4, 0.0), 0.25f, 0.5f);
-        const SurfaceBsdf right = at(m, from_angles(0.4, 0.0), 0.75f, 0.5f);
+        const SurfaceBsdf left = at(m, testing::polar_direction(0.4, 0.0), 0.25f, 0.5f);
+        const SurfaceBsdf right = at(m, testing::polar_direction(0.4, 0.0), 0.75f, 0.5f);
         ASSERT_EQ(left.lobe_count(), 1);
         expect_rgb(left.lobe(0).weight, Rgb(0.1f, 0.2f, 0.3f), 1e-6f);
         expect_rgb(right.lobe(0).weight, Rgb(0.9f, 0.8f, 0.7f), 1e-6f);

@@ -97,12 +97,7 @@ TEST(HairMixture, SamplesItsDensity) {
         }
         testing::Chi2Options options;
         options.test_count = 2;
-        const auto r = testing::chi2_direction_test(
-            [&](testing::Sample3 s) -> std::optional<Vec3> {
-                auto d = at.sample(s.u0, s.u1, s.u2);
-                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
-            },
-            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        const auto r = testing::chi2_sampler_test(at, options);
         EXPECT_TRUE(r.passed) << (weights ? "strand weights: " : "material weights: ") << r.message;
         EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
     }

@@ -69,11 +69,7 @@ std::shared_ptr<const HuangFiber> make_fiber(const FiberCase &c) {
 }
 
 HuangBakeOptions small_table() {
-    HuangBakeOptions o;
-    o.theta_o_count = 8;
-    o.phi_o_count = 3;
-    o.theta_i_count = 16;
-    o.phi_count = 24;
+    HuangBakeOptions o = testing::small_huang_bake();
     o.evaluator = "estimate";
     o.f = false;  // the sampler reads the sampling values alone
     return o;
@@ -135,12 +131,7 @@ TEST_P(HuangTableChi2, SamplesThePdfItReports) {
     testing::add_huang_table_breaks(options, table, q, point);
     const std::string what = "fiber " + std::to_string(v.fiber) + " at theta_o " + std::to_string(v.theta_o) +
                              ", phi_o " + std::to_string(v.phi_o);
-    const auto r = testing::chi2_direction_test(
-        [&](Sample3 u) -> std::optional<Vec3> {
-            const auto s = at.sample(u.u0, u.u1, u.u2);
-            return s ? std::optional<Vec3>(s->wi) : std::nullopt;
-        },
-        [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+    const auto r = testing::chi2_sampler_test(at, options);
     std::printf("[chi2] %s: %s\n", what.c_str(), r.message.c_str());
     EXPECT_TRUE(r.passed) << what << ": " << r.message;
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what;

@@ -32,11 +32,7 @@ std::shared_ptr<const HuangFiber> make_fiber(float aspect, float roughness) {
 }
 
 std::shared_ptr<const HuangSamplingTable> bake(const HuangFiber &fiber, bool with_f = true) {
-    HuangBakeOptions o;
-    o.theta_o_count = 8;
-    o.phi_o_count = 3;
-    o.theta_i_count = 16;
-    o.phi_count = 24;
+    HuangBakeOptions o = testing::small_huang_bake();
     o.first_order = o.f_first_order = 3;
     o.second_order = o.f_second_order = 2;
     o.f = with_f;

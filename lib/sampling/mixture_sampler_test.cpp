@@ -37,12 +37,7 @@ TEST(MixtureSampler, IsTheWeightedSumOfItsComponentsAndSamplesIt) {
         }
         testing::Chi2Options options;
         options.test_count = int(seed_family);
-        const auto r = testing::chi2_direction_test(
-            [&](testing::Sample3 s) -> std::optional<Vec3> {
-                auto d = at.sample(s.u0, s.u1, s.u2);
-                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
-            },
-            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        const auto r = testing::chi2_sampler_test(at, options);
         EXPECT_TRUE(r.passed) << "w " << w << ": " << r.message;
         EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
     }

@@ -72,12 +72,7 @@ TEST(NearFieldTable, ExactForARoughCoatedFiberWithALargeTilt) {
         options.theta_breaks.push_back(-kHalfPi + kPi * k / table->theta_i_cells());
     for (double theta_o : {-60.0, 20.0}) {
         const testing::SamplerAt at(sampler, view_at(theta_o), 0.7f);
-        const auto r = testing::chi2_direction_test(
-            [&](Sample3 u) -> std::optional<Vec3> {
-                auto s = at.sample(u.u0, u.u1, u.u2);
-                return s ? std::optional<Vec3>(s->wi) : std::nullopt;
-            },
-            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        const auto r = testing::chi2_sampler_test(at, options);
         EXPECT_TRUE(r.passed) << "theta_o " << theta_o << ": " << r.message;
     }
 }

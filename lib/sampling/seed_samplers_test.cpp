@@ -57,12 +57,7 @@ TEST_P(GaussianStrategy, PdfIsTheSampledDensity) {
     const SamplerAt at(*gaussian(w, 2), view_at(theta_r_deg));
     Chi2Options options;
     options.test_count = kChi2Family;
-    const auto r = testing::chi2_direction_test(
-        [&](Sample3 u) -> std::optional<Vec3> {
-            auto s = at.sample(u.u0, u.u1, u.u2);
-            return s ? std::optional<Vec3>(s->wi) : std::nullopt;
-        },
-        [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+    const auto r = testing::chi2_sampler_test(at, options);
     EXPECT_TRUE(r.passed) << "theta_r " << theta_r_deg << " w " << w << ": " << r.message;
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
     EXPECT_EQ(r.failed_samples, 0);

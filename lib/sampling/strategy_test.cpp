@@ -76,12 +76,7 @@ void expect_exact(const Sampler &sampler, double theta_r_deg, float h, const std
     // ... and at the near-field table's (linear inside each cell).
     for (int k = 0; k <= NearFieldTableOptions{}.theta_i_cells; ++k)
         options.theta_breaks.push_back(-kHalfPi + kPi * k / NearFieldTableOptions{}.theta_i_cells);
-    const auto r = testing::chi2_direction_test(
-        [&](Sample3 u) -> std::optional<Vec3> {
-            auto s = at.sample(u.u0, u.u1, u.u2);
-            return s ? std::optional<Vec3>(s->wi) : std::nullopt;
-        },
-        [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+    const auto r = testing::chi2_sampler_test(at, options);
     EXPECT_TRUE(r.passed) << what << " at theta_r " << theta_r_deg << ": " << r.message;
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what << " at theta_r " << theta_r_deg;
     EXPECT_EQ(r.failed_samples, 0) << what;
@@ -310,11 +305,7 @@ std::shared_ptr<const HuangFiber> huang_fiber(float roughness = 0.3f) {
 const HuangFixture &huang_fixture() {
     static const HuangFixture f = [] {
         auto fiber = huang_fiber();
-        HuangBakeOptions o;
-        o.theta_o_count = 8;
-        o.phi_o_count = 3;
-        o.theta_i_count = 16;
-        o.phi_count = 24;
+        HuangBakeOptions o = testing::small_huang_bake();
         o.evaluator = "estimate";
         return HuangFixture{fiber, HuangSamplingTable::from(bake_huang_table(*fiber, o).value()).value()};
     }();
@@ -329,14 +320,7 @@ StrategyInputs huang_inputs(const HuangSamplingTable *table, float uniform_weigh
     return in;
 }
 
-// A renderer hit at θ_o (degrees) whose curve normal puts the major axis at ψ from y.
-FiberHit huang_hit(double theta_o_deg, double psi) {
-    const double t = radians(theta_o_deg);
-    FiberHit hit;
-    hit.wo = {float(std::sin(t)), 0.0f, float(-std::cos(t))};
-    hit.normal = {0.2f, float(std::cos(psi)), float(std::sin(psi))};
-    return hit;
-}
+using testing::huang_hit;
 
 TEST(HuangStrategy, TableIsExact) {
     const auto s = made(StrategyKind::Table, huang_inputs(&huang_fixture().table));
@@ -345,20 +329,7 @@ TEST(HuangStrategy, TableIsExact) {
     // θ_o on a node (33.75°), between nodes, grazing; the major axis in several directions.
     const std::pair<double, double> views[] = {{33.75, 0.0}, {-20.0, 0.7}, {86.0, 2.5}, {-60.0, -1.9}};
     for (const auto &[theta_o, psi] : views) {
-        const FiberHit hit = huang_hit(theta_o, psi);
-        ScratchBuffer scratch;
-        const HuangPoint &point = static_cast<const HuangPoint &>(s->model()->prepare(hit, scratch));
-        const SamplerPoint &at = s->at(hit, &point, scratch);
-        const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
-        Chi2Options options;
-        options.test_count = kHuangFamily;
-        testing::add_huang_table_breaks(options, table, q, point);
-        const auto r = testing::chi2_direction_test(
-            [&](Sample3 u) -> std::optional<Vec3> {
-                auto d = at.sample(u.u0, u.u1, u.u2);
-                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
-            },
-            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        const auto r = testing::chi2_huang_table_sampler(*s, table, theta_o, psi, kHuangFamily);
         std::printf("[chi2] Huang table strategy at theta_o %.2f, psi %.1f: %s\n", theta_o, psi, r.message.c_str());
         EXPECT_TRUE(r.passed) << theta_o << ": " << r.message;
         EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << theta_o;

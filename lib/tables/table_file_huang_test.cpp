@@ -86,14 +86,11 @@ TableSet distinct_with_multiple(int theta_o = 3, int phi_o = 2, int theta_i = 4,
 }
 
 using testing::encode;
+using testing::expect_refused;
 using testing::Image;
 using testing::read_image;
+using testing::rehash;
 using testing::write_image;
-
-void rehash(Image &image) {
-    OIIO::SHA1 sha(image.px.data(), image.px.size() * sizeof(float));
-    image.spec.attribute("hairis:pixel_sha1", sha.digest());
-}
 
 // Valid bytes of `t` re-encoded after `edit` changed the header or the pixels; the hash is
 // made to match the edited pixels unless `fix_hash` is false.
@@ -102,13 +99,6 @@ std::vector<unsigned char> tamper(const TableSet &t, const std::function<void(Im
     edit(image);
     if (fix_hash) rehash(image);
     return write_image(image);
-}
-
-void expect_refused(const std::vector<unsigned char> &bytes, const std::string &fragment) {
-    const Expected<TableSet> t = decode_table_exr(bytes.data(), bytes.size());
-    ASSERT_FALSE(t.ok()) << "expected a refusal mentioning \"" << fragment << "\"";
-    EXPECT_NE(t.error().message.find(fragment), std::string::npos) << t.error().message;
-    EXPECT_EQ(t.error().kind, ErrorKind::InvalidTable) << t.error().message;
 }
 
 void expect_same_huang_part(const TableSet &b, const TableSet &t) {
@@ -286,14 +276,7 @@ TEST(HuangTableFile, EncodingIsDeterministic) { EXPECT_EQ(encode(baked()), encod
 
 // ---- The TABLE strategy from a loaded file -------------------------------------------------
 
-// A renderer hit at θ_o (degrees) whose curve normal puts the major axis at ψ from y.
-FiberHit huang_hit(double theta_o_deg, double psi) {
-    const double t = radians(theta_o_deg);
-    FiberHit hit;
-    hit.wo = {float(std::sin(t)), 0.0f, float(-std::cos(t))};
-    hit.normal = {0.2f, float(std::cos(psi)), float(std::sin(psi))};
-    return hit;
-}
+using testing::huang_hit;
 
 std::shared_ptr<const Sampler> table_sampler(const SamplingTables &tables) {
     StrategyInputs in;
@@ -311,20 +294,7 @@ void expect_table_strategy_exact(const SamplingTables &tables, const char *what)
     const HuangTable &table = *tables.huang->table;
     const std::pair<double, double> views[] = {{-33.75, 0.0}, {20.0, 0.7}, {-70.0, 2.2}};
     for (const auto &[theta_o, psi] : views) {
-        const FiberHit hit = huang_hit(theta_o, psi);
-        ScratchBuffer scratch;
-        const HuangPoint &point = static_cast<const HuangPoint &>(s->model()->prepare(hit, scratch));
-        const SamplerPoint &at = s->at(hit, &point, scratch);
-        const HuangTableQuery q = table.locate(point.to_huang(hit.wo));
-        Chi2Options options;
-        options.test_count = 2 * int(std::size(views));
-        testing::add_huang_table_breaks(options, table, q, point);
-        const auto r = testing::chi2_direction_test(
-            [&](Sample3 u) -> std::optional<Vec3> {
-                auto d = at.sample(u.u0, u.u1, u.u2);
-                return d ? std::optional<Vec3>(d->wi) : std::nullopt;
-            },
-            [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+        const auto r = testing::chi2_huang_table_sampler(*s, table, theta_o, psi, 2 * int(std::size(views)));
         std::printf("[chi2] Huang table %s at theta_o %.2f, psi %.1f: %s\n", what, theta_o, psi, r.message.c_str());
         EXPECT_TRUE(r.passed) << what << " " << theta_o << ": " << r.message;
         EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << what << " " << theta_o;

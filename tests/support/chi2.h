@@ -54,6 +54,18 @@ Chi2Result chi2_direction_test(const std::function<std::optional<Vec3>(Sample3)>
                                const std::function<double(Vec3)> &pdf,
                                const Chi2Options &options = {});
 
+/// chi2_direction_test of a sampler at one point: `at.sample(u0, u1, u2)` returns an optional
+/// sample with a direction wi, and `at.pdf(wi)` is its density.
+template <typename At>
+Chi2Result chi2_sampler_test(const At &at, const Chi2Options &options = {}) {
+    return chi2_direction_test(
+        [&](Sample3 u) -> std::optional<Vec3> {
+            const auto s = at.sample(u.u0, u.u1, u.u2);
+            return s ? std::optional<Vec3>(s->wi) : std::nullopt;
+        },
+        [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+}
+
 /// The same test on a 1D density over an interval [lo, hi] with equal-width cells.
 Chi2Result chi2_interval_test(const std::function<std::optional<double>(double)> &sample,
                               const std::function<double(double)> &pdf, double lo, double hi,

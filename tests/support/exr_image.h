@@ -1,14 +1,15 @@
-// Table files as images, for the table-file tests: encode tables to EXR bytes, read the bytes'
-// header and float RGBA pixels with OpenImageIO, change them, and write them back.
+// Table files as images, for the table-file tests: encode tables to EXR bytes, read them as
+// images (table_image.h), write them back, and expect the reader to refuse them.
 #pragma once
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "table_image.h"
 #include "tables/table_file.h"
 
 namespace hairis::testing {
@@ -20,36 +21,26 @@ inline std::vector<unsigned char> encode(const TableSet &t) {
     return bytes.ok() ? bytes.value() : std::vector<unsigned char>{};
 }
 
-// The header and the float RGBA pixels of EXR bytes, as OpenImageIO reads them.
-struct Image {
-    OIIO::ImageSpec spec;
-    std::vector<float> px;
-    float &at(int x, int y, int c) { return px[(size_t(y) * size_t(spec.width) + size_t(x)) * 4 + size_t(c)]; }
-};
-
+// The image of EXR bytes that must read (a test failure otherwise).
 inline Image read_image(const std::vector<unsigned char> &bytes) {
-    OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-    auto in = OIIO::ImageInput::create("openexr");
-    Image image;
-    OIIO::ImageSpec config;
-    void *proxy_pointer = &reader;
-    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
-    EXPECT_TRUE(in && in->open("t.exr", image.spec, config));
-    image.px.resize(size_t(image.spec.width) * image.spec.height * image.spec.nchannels);
-    EXPECT_TRUE(in->read_image(0, 0, 0, image.spec.nchannels, OIIO::TypeDesc::FLOAT, image.px.data()));
-    in->close();
-    return image;
+    std::optional<Image> image = decode_image(bytes);
+    EXPECT_TRUE(image) << "OpenImageIO cannot read the table file";
+    return image ? std::move(*image) : Image{};
 }
 
+// The EXR bytes of an image that must write (a test failure otherwise).
 inline std::vector<unsigned char> write_image(const Image &image) {
-    std::vector<unsigned char> out_bytes;
-    OIIO::Filesystem::IOVecOutput writer(out_bytes);
-    auto out = OIIO::ImageOutput::create("openexr");
-    EXPECT_TRUE(out->set_ioproxy(&writer));
-    EXPECT_TRUE(out->open("t.exr", image.spec));
-    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, image.px.data()));
-    EXPECT_TRUE(out->close());
-    return out_bytes;
+    std::optional<std::vector<unsigned char>> bytes = encode_image(image);
+    EXPECT_TRUE(bytes) << "OpenImageIO cannot write the table file";
+    return bytes ? std::move(*bytes) : std::vector<unsigned char>{};
+}
+
+// Expects the reader to refuse `bytes` as an invalid table with a message naming `fragment`.
+inline void expect_refused(const std::vector<unsigned char> &bytes, const std::string &fragment) {
+    const Expected<TableSet> t = decode_table_exr(bytes.data(), bytes.size());
+    ASSERT_FALSE(t.ok()) << "expected a refusal mentioning \"" << fragment << "\"";
+    EXPECT_NE(t.error().message.find(fragment), std::string::npos) << t.error().message;
+    EXPECT_EQ(t.error().kind, ErrorKind::InvalidTable) << t.error().message;
 }
 
 }  // namespace hairis::testing
