@@ -58,16 +58,23 @@ TEST(Rng, UniformAlongEachAxis) {
     }
 }
 
-TEST(Rng, NeighbouringDimensionsAreUncorrelated) {
-    const int n = 100000;
+// The sample correlation of dimensions a and b over samples 0..n−1 of one pixel (seed 42,
+// pixel 17) of generator Rng.
+template <typename Rng>
+double correlation(int n, std::uint32_t a, std::uint32_t b) {
     double sxy = 0, sx = 0, sy = 0, sxx = 0, syy = 0;
     for (int s = 0; s < n; ++s) {
-        const SampleRng rng(42, 17, std::uint64_t(s));
-        const double x = rng.get(0), y = rng.get(1);
+        const Rng rng(42, 17, std::uint64_t(s));
+        const double x = rng.get(a), y = rng.get(b);
         sx += x; sy += y; sxy += x * y; sxx += x * x; syy += y * y;
     }
     const double cov = sxy / n - (sx / n) * (sy / n);
-    const double corr = cov / std::sqrt((sxx / n - sqr(sx / n)) * (syy / n - sqr(sy / n)));
+    return cov / std::sqrt((sxx / n - sqr(sx / n)) * (syy / n - sqr(sy / n)));
+}
+
+TEST(Rng, NeighbouringDimensionsAreUncorrelated) {
+    const int n = 100000;
+    const double corr = correlation<SampleRng>(n, 0, 1);
     // The standard error of a correlation estimate is 1/sqrt(n) ≈ 0.0032: allow 5 of them.
     EXPECT_LT(std::fabs(corr), 5.0 / std::sqrt(double(n)));
 }
@@ -167,14 +174,7 @@ TEST(SobolRng, PairsArePaddedIndependently) {
     // Dimension 0 and dimension 2 belong to different pairs: their shuffles differ, so over a
     // pixel's samples they are uncorrelated (unlike a plain Sobol sequence's dimensions).
     const int n = 4096;
-    double sxy = 0, sx = 0, sy = 0, sxx = 0, syy = 0;
-    for (int s = 0; s < n; ++s) {
-        const SobolSampleRng rng(42, 17, std::uint64_t(s));
-        const double x = rng.get(0), y = rng.get(2);
-        sx += x; sy += y; sxy += x * y; sxx += x * x; syy += y * y;
-    }
-    const double cov = sxy / n - (sx / n) * (sy / n);
-    const double corr = cov / std::sqrt((sxx / n - sqr(sx / n)) * (syy / n - sqr(sy / n)));
+    const double corr = correlation<SobolSampleRng>(n, 0, 2);
     EXPECT_LT(std::fabs(corr), 5.0 / std::sqrt(double(n)));
     EXPECT_NE(SobolSampleRng(1, 2, 3).get(0), SobolSampleRng(2, 2, 3).get(0));
     EXPECT_NE(SobolSampleRng(1, 2, 3).get(0), SobolSampleRng(1, 3, 3).get(0));

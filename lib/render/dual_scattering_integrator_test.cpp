@@ -208,16 +208,22 @@ Rgb fixed_count_transmittance(const DualScattering &dual, double theta, int k) {
     return {channel(0), channel(1), channel(2)};
 }
 
+// One blonde strand under an orthographic camera: the scene that gathers forward scattering
+// along strands the tests describe themselves.
+Scene one_blonde_strand() {
+    SceneDesc d;
+    d.materials = {dual_hair(blonde())};
+    d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
+    d.camera = ortho_down(1, 1, 2, 2);
+    return build(std::move(d));
+}
+
 TEST(DualScatteringIntegrator, StrandsAtOneInclinationGiveTheFixedCountForm) {
     // k strands crossed at the shading fiber's own inclination: T_f = d_f (ā_f + sin²θ ā_b)^k
     // and σ_f² = k β̄_f² (forward_spread_variance), and the multiple term is scattered_f_cos of
     // them; with a(θ) = ā_f (θ = 0) it is the paper's multiple_f_cos.
     const Blonde &b = blonde();
-    SceneDesc d;
-    d.materials = {dual_hair(b)};
-    d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
-    d.camera = ortho_down(1, 1, 2, 2);
-    const Scene scene = build(std::move(d));
+    const Scene scene = one_blonde_strand();
     for (double theta : {-0.9, -0.2, 0.0, 0.35, 1.1}) {
         const Vec3 dir{float(std::sin(theta)), float(std::cos(theta)), 0.0f};
         for (int k : {1, 2, 3, 7, 16}) {
@@ -252,11 +258,7 @@ TEST(DualScatteringIntegrator, EachStrandCountsAtItsOwnInclination) {
     // a = ā_f + sin²θ ā_b at the inclination θ of the light to it, σ_f² the sum of its β̄_f²,
     // and reversing a tangent flips the sign of that inclination.
     const Blonde &b = blonde();
-    SceneDesc d;
-    d.materials = {dual_hair(b)};
-    d.curves = {straight_hairs({{0, 0, 0}}, {0.05f})};
-    d.camera = ortho_down(1, 1, 2, 2);
-    const Scene scene = build(std::move(d));
+    const Scene scene = one_blonde_strand();
     const Vec3 dir = safe_normalize(Vec3{0.3f, -0.5f, 0.8f});
     const std::vector<Vec3> tangents{{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0.2f, 0.9f, 0.4f}, {0, 0, -1}};
     std::vector<StrandCrossing> strands;

@@ -196,6 +196,26 @@ TEST(LightSet, SunIrradianceIsItsStrength) {
     EXPECT_FLOAT_EQ(s->value.r / s->pdf, 3.0f);
 }
 
+// Draws 500 light samples at the origin (seeds (seed, k, i)) and calls check(i, sample, hit)
+// for each one drawn, with what a BSDF ray along it finds (MIS with the sample's own pdf);
+// returns how many were drawn. Area-like samples only: a delta light fails.
+template <typename Check>
+int for_each_hit(const LightSet &set, std::uint64_t seed, std::size_t k, const Check &check) {
+    int drawn = 0;
+    for (int i = 0; i < 500 && !::testing::Test::HasFatalFailure(); ++i) {
+        const SampleRng rng(seed, k, std::uint64_t(i));
+        const auto s = set.sample({0, 0, 0}, rng.get(0), rng.get(1), rng.get(2));
+        if (!s) continue;
+        EXPECT_FALSE(s->delta);
+        const Rgb hit = std::isinf(s->distance)
+                            ? set.escaped({0, 0, 0}, s->wi, s->pdf, true)
+                            : set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f, INFINITY, s->pdf, true);
+        check(i, *s, hit);
+        ++drawn;
+    }
+    return drawn;
+}
+
 TEST(LightSet, HitsAgreeWithSamples) {
     // For a sampled direction, the radiance and density a BSDF ray finds there are the
     // sample's own: with bsdf_pdf = the light pdf the power heuristic gives exactly 1/2.
@@ -216,26 +236,14 @@ TEST(LightSet, HitsAgreeWithSamples) {
         build({}, {}, {rect}), build({}, {}, {ellipse})};
     for (std::size_t k = 0; k < sets.size(); ++k) {
         const LightSet &set = sets[k];
-        int checked = 0;
-        for (int i = 0; i < 500; ++i) {
-            const SampleRng rng(5, k, std::uint64_t(i));
-            const auto s = set.sample({0, 0, 0}, rng.get(0), rng.get(1), rng.get(2));
-            if (!s) continue;
-            ASSERT_FALSE(s->delta);
-            const Rgb hit = std::isinf(s->distance)
-                                ? set.escaped({0, 0, 0}, s->wi, s->pdf, true)
-                                : set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f, INFINITY, s->pdf,
-                                                      true);
-            ASSERT_NEAR(hit.r, 0.5f * s->value.r, 1e-3f * s->value.r)
-                << "light set " << k << ", sample " << i;
+        const int checked = for_each_hit(set, 5, k, [&](int i, const LightSample &s, Rgb hit) {
+            ASSERT_NEAR(hit.r, 0.5f * s.value.r, 1e-3f * s.value.r) << "light set " << k << ", sample " << i;
             // A ray stopped before the light (tmax < distance) does not see it.
-            if (!std::isinf(s->distance)) {
-                const Rgb before = set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f,
-                                                       0.5f * s->distance, s->pdf, true);
+            if (!std::isinf(s.distance)) {
+                const Rgb before = set.lamps_along_ray({0, 0, 0}, s.wi, 0.0f, 0.5f * s.distance, s.pdf, true);
                 EXPECT_EQ(before.r, 0.0f);
             }
-            ++checked;
-        }
+        });
         EXPECT_EQ(checked, 500) << "light set " << k;
     }
 }
@@ -600,19 +608,10 @@ TEST(LightSet, NewLampsHitsAgreeWithSamples) {
         build_lights(env)};
     for (std::size_t k = 0; k < sets.size(); ++k) {
         const LightSet &set = sets[k];
-        int checked = 0;
-        for (int i = 0; i < 500; ++i) {
-            const SampleRng rng(7, k, std::uint64_t(i));
-            const auto s = set.sample({0, 0, 0}, rng.get(0), rng.get(1), rng.get(2));
-            if (!s) continue;
-            ASSERT_FALSE(s->delta);
-            const Rgb hit = std::isinf(s->distance)
-                                ? set.escaped({0, 0, 0}, s->wi, s->pdf, true)
-                                : set.lamps_along_ray({0, 0, 0}, s->wi, 0.0f, INFINITY, s->pdf, true);
-            ASSERT_NEAR(hit.g, 0.5f * s->value.g, 1e-3f * s->value.g) << "set " << k << ", sample " << i;
-            ASSERT_NEAR(set.pdf({0, 0, 0}, s->wi), s->pdf, 1e-3f * s->pdf) << "set " << k;
-            ++checked;
-        }
+        const int checked = for_each_hit(set, 7, k, [&](int i, const LightSample &s, Rgb hit) {
+            ASSERT_NEAR(hit.g, 0.5f * s.value.g, 1e-3f * s.value.g) << "set " << k << ", sample " << i;
+            ASSERT_NEAR(set.pdf({0, 0, 0}, s.wi), s.pdf, 1e-3f * s.pdf) << "set " << k;
+        });
         EXPECT_GT(checked, 450) << "light set " << k;
     }
 }

@@ -57,6 +57,15 @@ Scene build_ok(SceneDesc desc) {
     return std::move(s).value();
 }
 
+// A scene of `curves` (by default straight_hair) in `material` under small_camera.
+SceneDesc one_hair(HairMaterial material, HairCurves curves = straight_hair()) {
+    SceneDesc d;
+    d.materials = {std::move(material)};
+    d.curves = {std::move(curves)};
+    d.camera = small_camera();
+    return d;
+}
+
 std::string build_error(SceneDesc desc) {
     auto s = Scene::build(std::move(desc));
     return s.ok() ? std::string("(built without error)") : s.error().message;
@@ -241,11 +250,7 @@ TEST(Scene, CurveAttributesAreLinearAlongEachSegment) {
         }
     }
     // Without normals the attribute reads zero.
-    SceneDesc plain;
-    plain.materials = {hair_material()};
-    plain.curves = {straight_hair()};
-    plain.camera = small_camera();
-    const Scene bare = build_ok(std::move(plain));
+    const Scene bare = build_ok(one_hair(hair_material()));
     const auto hit = bare.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
     ASSERT_TRUE(hit.has_value());
     const SurfacePoint sp = bare.surface_point({0.3f, 0, 5}, {0, 0, -1}, *hit);
@@ -565,11 +570,7 @@ TEST(Scene, PointInputsInterpolateAlongTheCurveAndCurveInputsAreTheCurves) {
         EXPECT_LE(m, b) << x;
     }
     // Triangles and curves without inputs have none.
-    SceneDesc plain;
-    plain.materials = {strands_material()};
-    plain.curves = {straight_hair()};
-    plain.camera = small_camera();
-    const Scene without = build_ok(std::move(plain));
+    const Scene without = build_ok(one_hair(strands_material()));
     const auto hit = without.intersect({0.3f, 0, 5}, {0, 0, -1}, 0.0f, INFINITY);
     ASSERT_TRUE(hit.has_value());
     HairInputValues none;
@@ -702,10 +703,7 @@ TEST(Scene, SetShadingRefusesMaterialsTheGeometryCannotUseAndKeepsItsOwn) {
 // Curves (by default straight_hair, a straight hair along +X) as a scene of the given shape.
 Scene curve_scene(CurveShape shape, HairCurves curves = straight_hair(),
                   CurveBackfaces backfaces = CurveBackfaces::Ignore) {
-    SceneDesc d;
-    d.materials = {hair_material()};
-    d.curves = {std::move(curves)};
-    d.camera = small_camera();
+    SceneDesc d = one_hair(hair_material(), std::move(curves));
     d.curve_shape = shape;
     d.curve_backfaces = backfaces;
     return build_ok(std::move(d));

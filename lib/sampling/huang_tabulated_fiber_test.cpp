@@ -196,13 +196,22 @@ const StrandFixture &strand_fixture() {
     return f;
 }
 
-// The strand's fiber made from the node with `input` set to `value` directly (not through
-// HairInputValues).
-HuangFiber strand_fiber(PrincipledHairNode node, HairInput input, float value) {
-    if (input == HairInput::Melanin) node.melanin = value;
-    if (input == HairInput::Roughness) node.roughness = value;
-    return HuangFiber::create(to_huang_params(node).value()).value();
-}
+// A strand whose node input `input` is `value`: the inputs that its hits carry, and its own
+// fiber, made from the node with the input set directly (not through HairInputValues).
+struct Strand {
+    Strand(PrincipledHairNode node, HairInput input, float v) : value(v) {
+        if (input == HairInput::Melanin) node.melanin = value;
+        if (input == HairInput::Roughness) node.roughness = value;
+        own = std::make_unique<const HuangFiber>(HuangFiber::create(to_huang_params(node).value()).value());
+        inputs.set(input, &value);
+    }
+    Strand(const Strand &) = delete;
+    Strand &operator=(const Strand &) = delete;
+
+    float value;
+    HairInputValues inputs;
+    std::unique_ptr<const HuangFiber> own;
+};
 
 // Running mean and variance of a sequence of draws.
 struct Moments {
@@ -225,17 +234,15 @@ Moments moments(const FiberPoint &point, Vec3 wi, int draws) {
 
 TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoise) {
     const StrandFixture &fx = strand_fixture();
-    const HuangFiber own = strand_fiber(fx.node, HairInput::Melanin, 0.3f);
-    HairInputValues inputs;
-    const float melanin = 0.3f;
-    inputs.set(HairInput::Melanin, &melanin);
+    const Strand strand(fx.node, HairInput::Melanin, 0.3f);
+    const HuangFiber &own = *strand.own;
     const int draws = 2000;
     const Vec3 directions[] = {safe_normalize(Vec3{-0.3f, 0.6f, 0.7f}), safe_normalize(Vec3{0.4f, -0.2f, 0.9f}),
                                safe_normalize(Vec3{-0.5f, 0.1f, -0.8f})};
     for (const Vec3 wi : directions) {
         FiberHit hit = hit_at(25.0, 0.7);
         hit.seed = 3;
-        hit.inputs = &inputs;
+        hit.inputs = &strand.inputs;
         ScratchBuffer scratch;
         const FiberPoint &point = fx.model->prepare(hit, scratch);
         // Draw by draw: the node's table at the hit, plus the strand's Cycles eval minus the
@@ -266,13 +273,11 @@ TEST(HuangTabulatedFiber, OwnEvalShadesAStrandOfOtherMelaninWithItsCyclesEval) {
     const StrandFixture &fx = strand_fixture();
     const HuangTabulatedFiber own_eval =
         HuangTabulatedFiber::create(fx.fiber, fx.table, fx.strands, StrandShading::OwnEval).value();
-    const HuangFiber own = strand_fiber(fx.node, HairInput::Melanin, 0.3f);
-    HairInputValues inputs;
-    const float melanin = 0.3f;
-    inputs.set(HairInput::Melanin, &melanin);
+    const Strand strand(fx.node, HairInput::Melanin, 0.3f);
+    const HuangFiber &own = *strand.own;
     FiberHit hit = hit_at(25.0, 0.7);
     hit.seed = 3;
-    hit.inputs = &inputs;
+    hit.inputs = &strand.inputs;
     ScratchBuffer scratch;
     const FiberPoint &point = own_eval.prepare(hit, scratch);
     const HuangPoint own_point = own.at(hit);
@@ -291,13 +296,11 @@ TEST(HuangTabulatedFiber, OwnEvalShadesAStrandOfOtherMelaninWithItsCyclesEval) {
 
 TEST(HuangTabulatedFiber, AStrandOfOtherRoughnessIsShadedWithItsOwnEval) {
     const StrandFixture &fx = strand_fixture();
-    const HuangFiber own = strand_fiber(fx.node, HairInput::Roughness, 0.6f);
-    HairInputValues inputs;
-    const float roughness = 0.6f;
-    inputs.set(HairInput::Roughness, &roughness);
+    const Strand strand(fx.node, HairInput::Roughness, 0.6f);
+    const HuangFiber &own = *strand.own;
     FiberHit hit = hit_at(-40.0, 0.2);
     hit.seed = 9;
-    hit.inputs = &inputs;
+    hit.inputs = &strand.inputs;
     ScratchBuffer scratch;
     const FiberPoint &point = fx.model->prepare(hit, scratch);
     const HuangPoint own_point = own.at(hit);

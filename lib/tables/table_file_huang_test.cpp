@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include "chi2.h"
 #include "huang_table_breaks.h"
@@ -85,12 +86,7 @@ TableSet distinct_with_multiple(int theta_o = 3, int phi_o = 2, int theta_i = 4,
     return t;
 }
 
-using testing::encode;
-using testing::expect_refused;
-using testing::Image;
-using testing::read_image;
-using testing::rehash;
-using testing::write_image;
+using namespace testing;  // the table-file image helpers (exr_image.h)
 
 // Valid bytes of `t` re-encoded after `edit` changed the header or the pixels; the hash is
 // made to match the edited pixels unless `fix_hash` is false.
@@ -124,6 +120,20 @@ void expect_same_huang_part(const TableSet &b, const TableSet &t) {
     EXPECT_TRUE(same_bits(b.multiple, t.multiple));
     ASSERT_EQ(b.huang->f.size(), t.huang->f.size());
     EXPECT_TRUE(same_bits(b.huang->f, t.huang->f));
+}
+
+// The sampling tables of `t` read back from its bytes, which must give back its Huang part bit
+// for bit (nothing, with a test failure, when they do not load).
+std::optional<SamplingTables> round_trip(const TableSet &t) {
+    const std::vector<unsigned char> bytes = encode(t);
+    const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
+    EXPECT_TRUE(back.ok()) << back.error().message;
+    if (!back) return std::nullopt;
+    expect_same_huang_part(back.value(), t);
+    Expected<SamplingTables> sampling = SamplingTables::from(back.value());
+    EXPECT_TRUE(sampling.ok()) << sampling.error().message;
+    if (!sampling) return std::nullopt;
+    return std::move(sampling).value();
 }
 
 // `t` with an f part of distinct values (a zero among them).
@@ -172,14 +182,10 @@ TEST(HuangTableFile, TheImageHoldsThePartWhereTheFormatSays) {
 // sampling tables built from it have the multiple table (what dual scattering samples).
 TEST(HuangTableFile, TheMultiplePartRoundTripsWhereTheFormatSays) {
     for (const TableSet &t : {distinct_with_multiple(), distinct_with_multiple(1, 1, 2, 1)}) {
-        const std::vector<unsigned char> bytes = encode(t);
-        const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
-        ASSERT_TRUE(back.ok()) << back.error().message;
-        expect_same_huang_part(back.value(), t);
-        const Expected<SamplingTables> sampling = SamplingTables::from(back.value());
-        ASSERT_TRUE(sampling.ok()) << sampling.error().message;
-        ASSERT_TRUE(sampling.value().multiple && sampling.value().huang);
-        EXPECT_EQ(sampling.value().multiple->n_h_values(), t.n_h_values);
+        const std::optional<SamplingTables> sampling = round_trip(t);
+        ASSERT_TRUE(sampling);
+        ASSERT_TRUE(sampling->multiple && sampling->huang);
+        EXPECT_EQ(sampling->multiple->n_h_values(), t.n_h_values);
     }
     const TableSet t = distinct_with_multiple();
     Image image = read_image(encode(t));
@@ -213,13 +219,9 @@ TEST(HuangTableFile, TheFPartRoundTripsWhereTheFormatSays) {
     for (const TableSet &t : {with_distinct_f(distinct_tables()), with_distinct_f(distinct_with_multiple()),
                               with_distinct_f(distinct_tables(1, 1, 2, 1)), baked()}) {
         ASSERT_TRUE(t.huang->has_f());
-        const std::vector<unsigned char> bytes = encode(t);
-        const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
-        ASSERT_TRUE(back.ok()) << back.error().message;
-        expect_same_huang_part(back.value(), t);
-        const Expected<SamplingTables> sampling = SamplingTables::from(back.value());
-        ASSERT_TRUE(sampling.ok()) << sampling.error().message;
-        EXPECT_TRUE(sampling.value().huang->f);
+        const std::optional<SamplingTables> sampling = round_trip(t);
+        ASSERT_TRUE(sampling);
+        EXPECT_TRUE(sampling->huang->f);
     }
     const TableSet t = with_distinct_f(distinct_with_multiple());
     Image image = read_image(encode(t));

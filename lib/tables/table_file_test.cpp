@@ -82,12 +82,7 @@ TableSet small_tables(int theta_r_count = 3, int nodes = 2, int cells = 12) {
 // The image rows of small_tables()'s far part (3 θ_r × 6 θ_i), where its near part starts.
 constexpr int kFarRows = 18;
 
-using testing::encode;
-using testing::expect_refused;
-using testing::Image;
-using testing::read_image;
-using testing::rehash;
-using testing::write_image;
+using namespace testing;  // the table-file image helpers (exr_image.h)
 
 // Re-encodes valid table bytes after letting `edit` change the header or the pixels, the way
 // a foreign or damaged writer would.
