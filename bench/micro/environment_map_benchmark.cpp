@@ -80,39 +80,33 @@ struct Numbers {
     }
 };
 
-void sample(benchmark::State &state) {
+// Times query(map, numbers, k) over 4096 fixed random numbers, on the map that range(0) picks.
+template <typename Query>
+void time_queries(benchmark::State &state, const Query &query) {
     const EnvironmentMap &m = map(state.range(0) != 0);
     const Numbers n;
     size_t k = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(m.sample(n.u[2 * k], n.u[2 * k + 1]));
+        benchmark::DoNotOptimize(query(m, n, k));
         k = (k + 1) & 4095;
     }
     state.SetItemsProcessed(state.iterations());
+}
+
+void sample(benchmark::State &state) {
+    time_queries(state, [](const EnvironmentMap &m, const Numbers &n, size_t k) {
+        return m.sample(n.u[2 * k], n.u[2 * k + 1]);
+    });
 }
 BENCHMARK(sample)->Arg(0)->Arg(1);
 
 void pdf(benchmark::State &state) {
-    const EnvironmentMap &m = map(state.range(0) != 0);
-    const Numbers n;
-    size_t k = 0;
-    for (auto _ : state) {
-        benchmark::DoNotOptimize(m.pdf(n.dirs[k]));
-        k = (k + 1) & 4095;
-    }
-    state.SetItemsProcessed(state.iterations());
+    time_queries(state, [](const EnvironmentMap &m, const Numbers &n, size_t k) { return m.pdf(n.dirs[k]); });
 }
 BENCHMARK(pdf)->Arg(0)->Arg(1);
 
 void eval(benchmark::State &state) {
-    const EnvironmentMap &m = map(state.range(0) != 0);
-    const Numbers n;
-    size_t k = 0;
-    for (auto _ : state) {
-        benchmark::DoNotOptimize(m.eval(n.dirs[k]));
-        k = (k + 1) & 4095;
-    }
-    state.SetItemsProcessed(state.iterations());
+    time_queries(state, [](const EnvironmentMap &m, const Numbers &n, size_t k) { return m.eval(n.dirs[k]); });
 }
 BENCHMARK(eval)->Arg(0)->Arg(1);
 

@@ -80,61 +80,49 @@ void path_vertex(benchmark::State &state, int which) {
 BENCHMARK_CAPTURE(path_vertex, analytic, 1);
 BENCHMARK_CAPTURE(path_vertex, table_near_direct, 6);
 
-void chiang_near_field(benchmark::State &state) {
+// Times query(q, k) over 4096 fixed random queries.
+template <typename Query>
+void time_queries(benchmark::State &state, const Query &query) {
     const Queries q(4096);
     size_t k = 0;
     for (auto _ : state) {
-        Rgb f = setup().fiber->f_cos_near(direction_of(0.3f, 1.0f + q.u[k]), q.views[k], q.h[k]);
-        benchmark::DoNotOptimize(f);
+        benchmark::DoNotOptimize(query(q, k));
         k = (k + 1) & 4095;
     }
+}
+
+void chiang_near_field(benchmark::State &state) {
+    time_queries(state, [](const Queries &q, size_t k) {
+        return setup().fiber->f_cos_near(direction_of(0.3f, 1.0f + q.u[k]), q.views[k], q.h[k]);
+    });
 }
 BENCHMARK(chiang_near_field);
 
 // The two halves of chiang_near_field: preparing the fiber at a hit, and f there.
 void chiang_prepare(benchmark::State &state) {
-    const Queries q(4096);
-    size_t k = 0;
-    for (auto _ : state) {
-        const ChiangPoint point = setup().fiber->at({q.views[k], q.h[k]});
-        benchmark::DoNotOptimize(point);
-        k = (k + 1) & 4095;
-    }
+    time_queries(state, [](const Queries &q, size_t k) { return setup().fiber->at({q.views[k], q.h[k]}); });
 }
 BENCHMARK(chiang_prepare);
 
 void chiang_f_prepared(benchmark::State &state) {
-    const Queries q(4096);
-    const ChiangPoint point = setup().fiber->at({q.views[7], q.h[7]});
-    size_t k = 0;
-    for (auto _ : state) {
-        Rgb f = point.f(direction_of(0.3f, 1.0f + q.u[k]));
-        benchmark::DoNotOptimize(f);
-        k = (k + 1) & 4095;
-    }
+    const Queries views(4096);
+    const ChiangPoint point = setup().fiber->at({views.views[7], views.h[7]});
+    time_queries(state, [&](const Queries &q, size_t k) { return point.f(direction_of(0.3f, 1.0f + q.u[k])); });
 }
 BENCHMARK(chiang_f_prepared);
 
 void chiang_far_field(benchmark::State &state) {
-    const Queries q(4096);
-    size_t k = 0;
-    for (auto _ : state) {
-        Rgb f = setup().fiber->f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
-        benchmark::DoNotOptimize(f);
-        k = (k + 1) & 4095;
-    }
+    time_queries(state, [](const Queries &q, size_t k) {
+        return setup().fiber->f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
+    });
 }
 BENCHMARK(chiang_far_field);
 
 void marschner_far_field(benchmark::State &state) {
     static const MarschnerFiber m = MarschnerFiber::create(MarschnerParams::blonde()).value();
-    const Queries q(4096);
-    size_t k = 0;
-    for (auto _ : state) {
-        Rgb f = m.f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
-        benchmark::DoNotOptimize(f);
-        k = (k + 1) & 4095;
-    }
+    time_queries(state, [](const Queries &q, size_t k) {
+        return m.f_cos(direction_of(0.3f, 1.0f + q.u[k]), q.views[k]);
+    });
 }
 BENCHMARK(marschner_far_field);
 

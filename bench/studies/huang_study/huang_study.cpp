@@ -50,25 +50,14 @@
 #include "sampling/huang_table_sampler.h"
 #include "sampling/strategy.h"
 #include "tables/huang_bake.h"
+#include "report.h"
 
 using namespace hairis;
 
 namespace {
 
 bool quick = false;
-std::ostringstream report;
-
-void print(const char *format, ...) __attribute__((format(printf, 1, 2)));
-void print(const char *format, ...) {
-    char buffer[8192];
-    va_list args;
-    va_start(args, format);
-    std::vsnprintf(buffer, sizeof buffer, format, args);
-    va_end(args);
-    std::fputs(buffer, stdout);
-    std::fflush(stdout);
-    report << buffer;
-}
+bench::Report report;
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -343,7 +332,7 @@ struct ViewAngles {
 const ViewAngles kSweepViews[] = {{-60, 11}, {-26, 37}, {0, 69}, {20, 160}, {46, -20}, {69, -115}, {-78, 52}, {33, 83}};
 
 void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
-    print("## 1. Bake evaluator and resolution (Blender's default Huang node)\n\n"
+    report.print("## 1. Bake evaluator and resolution (Blender's default Huang node)\n\n"
           "Aspect 0.85, roughness 0.3, IOR 1.55, offset 2°, σ_a from the default colour at β = 0.3. Relative variance of the "
           "table strategy (uniform weight %.3g) at 8 views (θ_o, φ_o) = (−60, 11), (−26, 37), (0, 69), (20, 160), (46, −20), "
           "(69, −115), (−78, 52), (33, 83)°. Bake CPU = the CPU seconds of the 1-thread bake (the work, whatever shares "
@@ -404,10 +393,10 @@ void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
                            with(r[0], r[1], r[2], r[3], "expectation", 4, 3)});
     if (quick) configs.resize(3);
 
-    print("First the evaluator at the default resolution (%d × %d × %d × %d), then the resolution θ_o nodes × φ_o nodes × "
+    report.print("First the evaluator at the default resolution (%d × %d × %d × %d), then the resolution θ_o nodes × φ_o nodes × "
           "θ_i cells × φ cells with the default evaluator.\n\n",
           d.theta_o_count, d.phi_o_count, d.theta_i_count, d.phi_count);
-    print("| evaluator; θ_o × φ_o nodes × θ_i × φ cells | bake CPU (s) | bake 1 thread (s) | bake 2 threads (s) | memory (MB) | "
+    report.print("| evaluator; θ_o × φ_o nodes × θ_i × φ cells | bake CPU (s) | bake 1 thread (s) | bake 2 threads (s) | memory (MB) | "
           "median relative variance | max |\n|---|---|---|---|---|---|---|\n");
     for (Config &c : configs) {
         c.o.threads = 1;
@@ -417,11 +406,11 @@ void section_sweep(const std::shared_ptr<const HuangFiber> &fiber) {
         const HairShading shading = shading_of(fiber, StrategyKind::Table, &two.table);
         std::vector<double> v;
         for (const ViewF &view : views_for(*two.table.table)) v.push_back(grid_variance(view, shading).relative);
-        print("| %s | %.2f | %.2f | %.2f | %.2f | %s | %s |\n", c.label.c_str(), one.bake_cpu_seconds, one.bake_seconds, two.bake_seconds,
+        report.print("| %s | %.2f | %.2f | %.2f | %.2f | %s | %s |\n", c.label.c_str(), one.bake_cpu_seconds, one.bake_seconds, two.bake_seconds,
               double(two.table.table->memory_bytes()) / 1e6, number(median(v)).c_str(),
               number(*std::max_element(v.begin(), v.end())).c_str());
     }
-    print("\n");
+    report.print("\n");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -435,13 +424,13 @@ const double kThetaO[] = {-70, -35, 0, 30, 65};
 const double kPhiO[] = {10, 40, 75};
 
 void section_strategies() {
-    print("## 2. Strategies over θ_o, φ_o, aspect ratio and roughness\n\n"
+    report.print("## 2. Strategies over θ_o, φ_o, aspect ratio and roughness\n\n"
           "Per fiber the median over θ_o ∈ {−70, −35, 0, 30, 65}° × φ_o ∈ {10, 40, 75}° (circular fibers: θ_o only) of the "
           "relative variance per sample of the luminance estimate of ∫ f cos dω_i. TABLE = the policy's table strategy "
           "(default bake, uniform weight %.3g; bake = its CPU seconds; grid: 2 points per table cell and axis); Cycles = Cycles' own sampler with its own weight (%lld samples per view), "
           "whose mean is Cycles' sampled energy: the last column is its median mean / ∫ f (eval's energy).\n\n",
           double(kHuangUniformWeight), quick ? 20000LL : 200000LL);
-    print("| aspect | roughness | bake (s) | UNIFORM | Cycles | TABLE | TABLE / Cycles | Cycles mean / ∫ f |\n"
+    report.print("| aspect | roughness | bake (s) | UNIFORM | Cycles | TABLE | TABLE / Cycles | Cycles mean / ∫ f |\n"
           "|---|---|---|---|---|---|---|---|\n");
     std::vector<double> ratios;
     std::vector<std::string> detail;
@@ -472,16 +461,16 @@ void section_strategies() {
                               number(vt.back()).c_str(), mean_ratio.back(), v.integral);
                 detail.push_back(line);
             }
-        print("| %.2f | %.2f | %.1f | %s | %s | %s | %s | %.3f |\n", c.aspect, c.roughness, t.bake_cpu_seconds,
+        report.print("| %.2f | %.2f | %.1f | %s | %s | %s | %s | %.3f |\n", c.aspect, c.roughness, t.bake_cpu_seconds,
               number(median(vu)).c_str(), number(median(vc)).c_str(), number(median(vt)).c_str(),
               number(median(ratio)).c_str(), median(mean_ratio));
     }
-    print("\nMedian over all views of TABLE's variance / Cycles': %s (target ≤ 0.5); largest: %s.\n\n",
+    report.print("\nMedian over all views of TABLE's variance / Cycles': %s (target ≤ 0.5); largest: %s.\n\n",
           number(median(ratios)).c_str(), number(*std::max_element(ratios.begin(), ratios.end())).c_str());
-    print("<details><summary>Every view</summary>\n\n| aspect | roughness | θ_o | φ_o | UNIFORM | Cycles | TABLE | Cycles mean / ∫ f | ∫ f |\n"
+    report.print("<details><summary>Every view</summary>\n\n| aspect | roughness | θ_o | φ_o | UNIFORM | Cycles | TABLE | Cycles mean / ∫ f | ∫ f |\n"
           "|---|---|---|---|---|---|---|---|---|\n");
-    for (const std::string &l : detail) print("%s", l.c_str());
-    print("\n</details>\n\n");
+    for (const std::string &l : detail) report.print("%s", l.c_str());
+    report.print("\n</details>\n\n");
 
     // Monte Carlo check of the quadrature at four views of the default fiber.
     const auto fiber = make_fiber(params_of(0.85f, 0.3f));
@@ -489,32 +478,32 @@ void section_strategies() {
     o.threads = 2;
     const TableStrategy t = bake(*fiber, o);
     const HairShading table = shading_of(fiber, StrategyKind::Table, &t.table);
-    print("Monte Carlo check (default fiber, TABLE, %d samples each): ", quick ? 2000 : 20000);
+    report.print("Monte Carlo check (default fiber, TABLE, %d samples each): ", quick ? 2000 : 20000);
     for (const ViewAngles &a : {ViewAngles{-35, 40}, ViewAngles{0, 10}, ViewAngles{30, 75}, ViewAngles{65, 40}}) {
         const FiberHit hit = hit_at(a.theta_o, a.phi_o);
         const double q2 = grid_variance(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 2)), table).relative;
         const double q4 = grid_variance(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 4)), table).relative;
         const double mc = mc_variance(*fiber, table, hit, quick ? 2000 : 20000);
-        print("(%.0f°, %.0f°) quadrature %s (2 points per cell and axis) and %s (4), Monte Carlo %s; ", a.theta_o, a.phi_o,
+        report.print("(%.0f°, %.0f°) quadrature %s (2 points per cell and axis) and %s (4), Monte Carlo %s; ", a.theta_o, a.phi_o,
               number(q2).c_str(), number(q4).c_str(), number(mc).c_str());
     }
-    print("\n\n");
+    report.print("\n\n");
 }
 
 // ---------------------------------------------------------------------------------------------
 
 void section_uniform_weight() {
-    print("## 3. The uniform part of TABLE's mixture\n\n"
+    report.print("## 3. The uniform part of TABLE's mixture\n\n"
           "A baked cell can be zero where f is not (a lobe narrower than the cell, missed by the cell's evaluation points, or "
           "an evaluator that returns 0 there): the table alone then never samples there and the estimate is biased. TABLE "
           "therefore mixes the table with the uniform sphere, weight u. Median relative variance over the 8 sweep views "
           "and the largest share of ∫ f the table alone (u = 0) leaves uncovered.\n\n");
     const float weights[] = {0.0f, 0.003f, 0.01f, 0.03f, 0.1f};
-    print("| fiber |");
-    for (float w : weights) print(" u = %.3g |", double(w));
-    print(" uncovered at u = 0 |\n|---|");
-    for (size_t k = 0; k <= std::size(weights); ++k) print("---|");
-    print("\n");
+    report.print("| fiber |");
+    for (float w : weights) report.print(" u = %.3g |", double(w));
+    report.print(" uncovered at u = 0 |\n|---|");
+    for (size_t k = 0; k <= std::size(weights); ++k) report.print("---|");
+    report.print("\n");
     for (const FiberCase &c : {FiberCase{0.85f, 0.3f}, FiberCase{0.5f, 0.05f}, FiberCase{1.0f, 0.8f}}) {
         const auto fiber = make_fiber(params_of(c.aspect, c.roughness));
         HuangBakeOptions o;
@@ -525,7 +514,7 @@ void section_uniform_weight() {
             const FiberHit hit = hit_at(a.theta_o, a.phi_o);
             views.push_back(view_f(*fiber, hit, aligned(*fiber, *t.table.table, hit, 2)));
         }
-        print("| aspect %.2f, roughness %.2f |", c.aspect, c.roughness);
+        report.print("| aspect %.2f, roughness %.2f |", c.aspect, c.roughness);
         double uncovered = 0;
         for (float w : weights) {
             const HairShading s = shading_of(fiber, StrategyKind::Table, &t.table, w);
@@ -535,17 +524,17 @@ void section_uniform_weight() {
                 v.push_back(r.relative);
                 if (w == 0.0f) uncovered = std::max(uncovered, r.uncovered);
             }
-            print(" %s |", number(median(v)).c_str());
+            report.print(" %s |", number(median(v)).c_str());
         }
-        print(" %s |\n", number(uncovered).c_str());
+        report.print(" %s |\n", number(uncovered).c_str());
     }
-    print("\n");
+    report.print("\n");
 }
 
 // ---------------------------------------------------------------------------------------------
 
 void section_near_field() {
-    print("## 4. Near field\n\n"
+    report.print("## 4. Near field\n\n"
           "Camera rays on hair wider than the pixel: pixel coverage 0.1 (the pixel sees a fifth of the fiber's width "
           "around h), f = the near-field expectation at h, sampled with the far-field table (TABLE ignores h). Relative "
           "variance at the default fiber, per view the median over h ∈ {−0.9, −0.5, 0, 0.5, 0.9}·R; the far field at the "
@@ -557,7 +546,7 @@ void section_near_field() {
     const HairShading table = shading_of(fiber, StrategyKind::Table, &t.table);
     const HairShading uniform = shading_of(fiber, StrategyKind::Uniform, nullptr);
     const int sub = quick ? 2 : 4;
-    print("| θ_o | φ_o | TABLE far | TABLE near (median over h) | TABLE near (max) | UNIFORM near | Cycles near |\n"
+    report.print("| θ_o | φ_o | TABLE far | TABLE near (median over h) | TABLE near (max) | UNIFORM near | Cycles near |\n"
           "|---|---|---|---|---|---|---|\n");
     std::vector<double> far_all, near_all, cycles_all;
     for (const ViewAngles &a : {ViewAngles{-35, 40}, ViewAngles{0, 10}, ViewAngles{30, 75}, ViewAngles{65, 40}, ViewAngles{-70, 10}}) {
@@ -576,18 +565,18 @@ void section_near_field() {
         far_all.push_back(far);
         near_all.push_back(median(vt));
         cycles_all.push_back(median(vc));
-        print("| %.0f | %.0f | %s | %s | %s | %s | %s |\n", a.theta_o, a.phi_o, number(far).c_str(), number(median(vt)).c_str(),
+        report.print("| %.0f | %.0f | %s | %s | %s | %s | %s |\n", a.theta_o, a.phi_o, number(far).c_str(), number(median(vt)).c_str(),
               number(*std::max_element(vt.begin(), vt.end())).c_str(), number(median(vu)).c_str(),
               number(median(vc)).c_str());
     }
-    print("\nMedians: TABLE far %s, TABLE near %s, Cycles near %s.\n\n", number(median(far_all)).c_str(),
+    report.print("\nMedians: TABLE far %s, TABLE near %s, Cycles near %s.\n\n", number(median(far_all)).c_str(),
           number(median(near_all)).c_str(), number(median(cycles_all)).c_str());
 }
 
 // ---------------------------------------------------------------------------------------------
 
 void section_renderer_f() {
-    print("## 6. TABLE with the renderer's f\n\n"
+    report.print("## 6. TABLE with the renderer's f\n\n"
           "The sections above weight TABLE's samples with the expectation of Cycles' eval; a render weights "
           "them with one Cycles eval (HuangPoint::f: Simpson nodes in h with one microfacet chain each), a "
           "Monte Carlo estimate whose own variance adds to the sampler's. Relative variance per sample "
@@ -614,13 +603,13 @@ void section_renderer_f() {
             const double four_evals = mc_variance_renderer_f(*fiber, table, hit, n, 4);
             const double baked_f = mc_variance_renderer_f(*fiber, baked, hit, n);
             const double cycles = cycles_moments(*fiber, hit, n).relative_variance;
-            print("| %.2f | %.2f | (%.0f°, %.0f°) | %s | %s | %s | %s | %s | %s | %s |\n", c.aspect, c.roughness, a.theta_o,
+            report.print("| %.2f | %.2f | (%.0f°, %.0f°) | %s | %s | %s | %s | %s | %s | %s |\n", c.aspect, c.roughness, a.theta_o,
                   a.phi_o, number(expectation).c_str(), number(one_eval).c_str(), number(four_evals).c_str(),
                   number(baked_f).c_str(), number(cycles).c_str(), number(one_eval / cycles).c_str(),
                   number(baked_f / cycles).c_str());
         }
     }
-    print("\n");
+    report.print("\n");
 }
 
 // The largest weights: max / mean and the share of the second moment from the top 0.1%.
@@ -641,7 +630,7 @@ Tail tail_of(std::vector<double> w) {
 }
 
 void section_tails() {
-    print("## 7. The largest weights\n\n"
+    report.print("## 7. The largest weights\n\n"
           "Per view, over %d samples: the largest weight over the mean, and the share of the second moment "
           "carried by the largest 0.1%% of the weights: TABLE with one Cycles eval (a render's BSDF sample) "
           "and Cycles' sampler with its own weight. Default fiber (aspect 0.85, roughness 0.3).\n\n"
@@ -674,15 +663,15 @@ void section_tails() {
             wc.push_back(c ? double(luminance(c->weight)) : 0.0);
         }
         const Tail tt = tail_of(wt), tc = tail_of(wc);
-        print("| (%.0f°, %.0f°) | %.1f | %.3f | %.1f | %.3f |\n", a.theta_o, a.phi_o, tt.max_over_mean, tt.top_share,
+        report.print("| (%.0f°, %.0f°) | %.1f | %.3f | %.1f | %.3f |\n", a.theta_o, a.phi_o, tt.max_over_mean, tt.top_share,
               tc.max_over_mean, tc.top_share);
     }
-    print("\n");
+    report.print("\n");
 }
 
 void section_eval_noise() {
     const int draws = quick ? 500 : 4000;
-    print("## 8. The noise of one Cycles eval, lobe by lobe\n\n"
+    report.print("## 8. The noise of one Cycles eval, lobe by lobe\n\n"
           "One Cycles eval (HuangPoint::f_estimate) at a fixed pair of directions, drawn %d times from the point's LCG, "
           "at 300 random (ω_o, ω_i) pairs, with the other lobes' multipliers at 0 (TRRT+ comes with TRT: both need "
           "the internal reflection). Per pair the relative variance Var/mean²; the table gives its median over the "
@@ -731,11 +720,11 @@ void section_eval_noise() {
             mean2_sum += mean * mean;
             largest = std::max(largest, top / mean);
         }
-        print("| %s | %zu | %s | %s | %.0f | %d |\n", v.label, relative.size(),
+        report.print("| %s | %zu | %s | %s | %.0f | %d |\n", v.label, relative.size(),
               number(relative.empty() ? 0.0 : median(relative)).c_str(),
               number(mean2_sum > 0 ? variance_sum / mean2_sum : 0.0).c_str(), largest, capped);
     }
-    print("\n");
+    report.print("\n");
 }
 
 // Stratified integral over the sphere of the expectation's four lobes (luminance) at `hit`.
@@ -760,7 +749,7 @@ std::array<double, 4> eval_energy(const HuangFiber &fiber, const FiberHit &hit, 
 
 void section_sampler_against_eval() {
     const int samples = quick ? 20000 : 400000, points = quick ? 3000 : 20000;
-    print("## 10. Cycles' sampler against its eval\n\n"
+    report.print("## 10. Cycles' sampler against its eval\n\n"
           "Cycles weights a BSDF sample of Huang hair with its chained sampler's weight and a light sample with its "
           "eval (docs/huang.md §8, §9). Per lobe, the energy each carries at one view (luminance, φ_o = 0): the "
           "sampler's as the mean weight of %d samples (HuangPoint::sample_cycles), the eval's as its expectation "
@@ -798,12 +787,12 @@ void section_sampler_against_eval() {
             const std::array<double, 4> fine = eval_energy(*fiber, hit, 16, quick ? 1000 : 4000);
             const double total_s = sampler[0] + sampler[1] + sampler[2] + sampler[3];
             const double total_e = eval[0] + eval[1] + eval[2] + eval[3];
-            print("| %s | %.0f° | %.3f, %.3f, %.3f, %.3f | %.3f, %.3f, %.3f, %.3f | %.3f | %.3f |\n", c.label, theta_o,
+            report.print("| %s | %.0f° | %.3f, %.3f, %.3f, %.3f | %.3f, %.3f, %.3f, %.3f | %.3f | %.3f |\n", c.label, theta_o,
                   sampler[0], sampler[1], sampler[2], sampler[3], eval[0], eval[1], eval[2], eval[3],
                   total_s / total_e, fine[0] + fine[1] + fine[2] + fine[3]);
         }
     }
-    print("\n");
+    report.print("\n");
 }
 
 // Nanoseconds (thread CPU time) per sample on one thread, best of three passes over random hits.
@@ -832,7 +821,7 @@ double time_per_sample(PerHit &&per_hit) {
 }
 
 void section_time() {
-    print("## 5. Time per sample\n\n"
+    report.print("## 5. Time per sample\n\n"
           "One thread (its CPU time), random views (θ_o, φ_o) over the sphere, best of three passes. TABLE and UNIFORM: prepare the hit "
           "(fiber point and sampler point), sample (the direction and its pdf), f there (one Cycles eval: HuangPoint::f) "
           "and one more pdf query; also sample + pdf alone. Cycles: prepare the fiber point and Cycles' sampler (its weight "
@@ -882,10 +871,10 @@ void section_time() {
             const FiberPoint &p = fiber->prepare(hit, scratch);
             return luminance(p.f(direction_of(float(kPi) * (u[0] - 0.5f), float(kTwoPi) * u[1])));
         }) - t_prepare;
-        print("| %.2f | %.2f | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f | %.2f |\n", c.aspect, c.roughness, t_table,
+        report.print("| %.2f | %.2f | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f | %.2f |\n", c.aspect, c.roughness, t_table,
               t_sample - t_prepare, t_uniform, t_cycles, t_f, t_table / t_cycles, (t_table + t_f) / (t_cycles + t_f));
     }
-    print("\n");
+    report.print("\n");
 }
 
 }  // namespace
@@ -1022,7 +1011,7 @@ std::pair<double, double> f_time(const HuangFiber &fiber, const HairShading &bak
 
 void section_baked_f() {
     const int views = quick ? 6 : 48, grid = quick ? 16 : 32;
-    print("## 9. The baked f against the expectation\n\n"
+    report.print("## 9. The baked f against the expectation\n\n"
           "Renders shade Huang hair with R exactly (Cycles' R is deterministic) and TT + TRT + TRRT+ interpolated from the "
           "expectation baked beside the sampling table (the default bake: f part at the rule (%d,%d), TT's entry at %d). Against the "
           "expectation at the rule (8,6), over %d random far-field views × a jittered %d × %d grid of ω_i, in luminance: "
@@ -1050,12 +1039,12 @@ void section_baked_f() {
         const BakedFError e = baked_f_error(*fiber, baked, views, grid);
         const auto [ns_baked, ns_cycles] = f_time(*fiber, baked);
         const double mb = double(t.table.table->memory_bytes() + t.table.f->memory_bytes()) / 1e6;
-        print("| %.2f | %.2f | %.1f | %.1f | %s | %.2f%% | %+.2f%% | %.0f%% | %.1f%% | %.2f%% | %+.2f%% | %.2f%% | %.0f | %.0f |\n",
+        report.print("| %.2f | %.2f | %.1f | %.1f | %s | %.2f%% | %+.2f%% | %.0f%% | %.1f%% | %.2f%% | %+.2f%% | %.2f%% | %.0f | %.0f |\n",
               c.aspect, c.roughness, t.bake_seconds, mb, number(e.r_max).c_str(), 100 * e.l1, 100 * e.integral,
               100 * e.max_relative, 100 * e.p99_relative, 100 * e.rule_l1, 100 * e.rule_integral, 100 * e.reading_l1,
               ns_baked, ns_cycles);
     }
-    print("\n");
+    report.print("\n");
 }
 
 int main(int argc, char **argv) {
@@ -1065,7 +1054,7 @@ int main(int argc, char **argv) {
     auto run = [&](char section) { return sections.find(section) != std::string::npos; };
     tbb::task_arena arena(2);
     arena.execute([&] {
-        print("# Huang study\n\nGenerated by bench/huang_study%s. f = HuangExpectation at the rule (6,4) (its L1 error against "
+        report.print("# Huang study\n\nGenerated by bench/huang_study%s. f = HuangExpectation at the rule (6,4) (its L1 error against "
               "the reference rule (16,12) is about 1%% at roughness 0.3); variances by grid quadrature (see the file's "
               "header) unless marked Monte Carlo. Default bake: %d θ_o × %d φ_o nodes × %d θ_i × %d φ cells, evaluator "
               "%s (%d,%d), %d point per cell.\n\n",
@@ -1084,7 +1073,7 @@ int main(int argc, char **argv) {
         if (run('8')) section_eval_noise();
         if (run('9')) section_baked_f();
         if (run('a')) section_sampler_against_eval();
-        print("Total study time %.0f s.\n", seconds_since(t0));
+        report.print("Total study time %.0f s.\n", seconds_since(t0));
     });
     if (!folder.empty()) {
         std::ofstream md(folder + "/huang_study.md");

@@ -38,6 +38,7 @@
 #include "fiber/chiang_strands.h"
 #include "sampling/analytic_sampler.h"
 #include "sampling/near_field_table.h"
+#include "report.h"
 #include "study_common.h"
 
 using namespace hairis;
@@ -49,19 +50,7 @@ const float kOffsets[] = {-0.95f, -0.6f, -0.2f, 0.2f, 0.6f, 0.95f};
 const float kRoughness[] = {0.15f, 0.2f, 0.3f, 0.45f, 0.6f};
 const float kMelanin[] = {0.2f, 0.5f, 0.9f};
 
-std::ostringstream g_md;
-
-void print(const char *format, ...) __attribute__((format(printf, 1, 2)));
-void print(const char *format, ...) {
-    char buffer[4096];
-    va_list args;
-    va_start(args, format);
-    std::vsnprintf(buffer, sizeof buffer, format, args);
-    va_end(args);
-    std::fputs(buffer, stdout);
-    std::fflush(stdout);
-    g_md << buffer;
-}
+bench::Report report;
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
@@ -187,13 +176,11 @@ double prepare_ns(const ChiangStrands &strands, const HairInputValues *inputs) {
 }  // namespace
 
 int main(int argc, char **argv) {
-    const long long per_h = argc > 1 ? std::atoll(argv[1]) : 20000;
+    const std::optional<long long> samples = bench::sample_count(argc, argv, 20000, 1000, "strand_study");
+    if (!samples) return 1;
+    const long long per_h = *samples;
     const std::string folder = argc > 2 ? argv[2] : "";
-    if (per_h < 1000) {
-        std::fprintf(stderr, "strand_study: samples must be at least 1000 (got %s)\n", argv[1]);
-        return 1;
-    }
-    print("# Strand study\n\nRelative variance per sample of the luminance estimate of ∫ f cos dω_i for strands whose "
+    report.print("# Strand study\n\nRelative variance per sample of the luminance estimate of ∫ f cos dω_i for strands whose "
           "inputs differ from the material's (melanin 0.5, redness 0.5, roughness and radial roughness 0.3, offset "
           "2°: what the tables are baked for); %lld samples per θ_r and h, conditional on h ∈ {±0.95, ±0.6, ±0.2}, "
           "median over θ_r ∈ {−80, −60, −30, 0, 30, 60, 80}°. f is the strand's own in every column.\n\n",
@@ -201,29 +188,29 @@ int main(int argc, char **argv) {
     for (ChiangTilt tilt : {ChiangTilt::Incident, ChiangTilt::Outgoing}) {
         const Material m = make_material(tilt);
         const std::vector<Strategy> list = strategies(m);
-        print("## %s\n\n| strand roughness | melanin |", tilt == ChiangTilt::Incident ? "Cycles 3.4 (tilt on θ_i)"
+        report.print("## %s\n\n| strand roughness | melanin |", tilt == ChiangTilt::Incident ? "Cycles 3.4 (tilt on θ_i)"
                                                                                      : "Cycles 4.2+ (tilt on θ_o)");
-        for (const Strategy &s : list) print(" %s |", s.name);
-        print("\n|---|---|");
-        for (size_t k = 0; k < list.size(); ++k) print("---|");
-        print("\n");
+        for (const Strategy &s : list) report.print(" %s |", s.name);
+        report.print("\n|---|---|");
+        for (size_t k = 0; k < list.size(); ++k) report.print("---|");
+        report.print("\n");
         for (float roughness : kRoughness)
             for (float melanin : kMelanin) {
                 HairInputValues inputs;
                 inputs.set(HairInput::Roughness, &roughness);
                 inputs.set(HairInput::RadialRoughness, &roughness);
                 inputs.set(HairInput::Melanin, &melanin);
-                print("| %.2f | %.1f |", double(roughness), double(melanin));
+                report.print("| %.2f | %.1f |", double(roughness), double(melanin));
                 for (const Strategy &s : list) {
                     std::vector<double> v;
                     for (double t : kThetaR)
                         v.push_back(relative_variance(m, inputs, direction_of(float(radians(t)), -float(kHalfPi)),
                                                       per_h, s.prepare));
-                    print(" %.3g |", median(v));
+                    report.print(" %.3g |", median(v));
                 }
-                print("\n");
+                report.print("\n");
             }
-        print("\n");
+        report.print("\n");
     }
 
     const Material m = make_material(ChiangTilt::Incident);
@@ -233,13 +220,13 @@ int main(int argc, char **argv) {
     both.set(HairInput::Melanin, &melanin);
     both.set(HairInput::Roughness, &roughness);
     both.set(HairInput::RadialRoughness, &roughness);
-    print("## Preparing the fiber at a hit (one thread)\n\n| fiber | ns per hit |\n|---|---|\n");
-    print("| the material's own | %.0f |\n", prepare_ns(*m.strands, nullptr));
-    print("| a strand's melanin | %.0f |\n", prepare_ns(*m.strands, &melanin_only));
-    print("| a strand's melanin and roughness | %.0f |\n", prepare_ns(*m.strands, &both));
+    report.print("## Preparing the fiber at a hit (one thread)\n\n| fiber | ns per hit |\n|---|---|\n");
+    report.print("| the material's own | %.0f |\n", prepare_ns(*m.strands, nullptr));
+    report.print("| a strand's melanin | %.0f |\n", prepare_ns(*m.strands, &melanin_only));
+    report.print("| a strand's melanin and roughness | %.0f |\n", prepare_ns(*m.strands, &both));
 
     if (!folder.empty()) {
-        std::ofstream(folder + "/strand_study.md") << g_md.str();
+        std::ofstream(folder + "/strand_study.md") << report.str();
         std::printf("wrote %s/strand_study.md\n", folder.c_str());
     }
     return 0;

@@ -29,6 +29,7 @@
 #include "fiber/dual_scattering.h"
 #include "core/frame.h"
 #include "sampling/analytic_sampler.h"
+#include "report.h"
 #include "study_common.h"
 
 using namespace hairis;
@@ -129,7 +130,8 @@ double time_per_sample(const bench::Strategy &sampler) {
 }
 
 struct Output {
-    std::ostringstream md, json;
+    bench::Report md;
+    std::ostringstream json;
     bool first_json = true;
     void section(const std::string &key, const std::string &value) {
         json << (first_json ? "" : ",\n") << "  \"" << key << "\": " << value;
@@ -137,30 +139,16 @@ struct Output {
     }
 };
 
-void print(Output &out, const char *format, ...) __attribute__((format(printf, 2, 3)));
-void print(Output &out, const char *format, ...) {
-    char buffer[4096];
-    va_list args;
-    va_start(args, format);
-    std::vsnprintf(buffer, sizeof buffer, format, args);
-    va_end(args);
-    std::fputs(buffer, stdout);
-    std::fflush(stdout);
-    out.md << buffer;
-}
-
 }  // namespace
 
 int main(int argc, char **argv) {
-    const long long n = argc > 1 ? std::atoll(argv[1]) : 100000;
+    const std::optional<long long> samples = bench::sample_count(argc, argv, 100000, 1000, "strategy_study");
+    if (!samples) return 1;
+    const long long n = *samples;
     const std::string folder = argc > 2 ? argv[2] : "";
-    if (n < 1000) {
-        std::fprintf(stderr, "strategy_study: samples must be at least 1000 (got %s)\n", argv[1]);
-        return 1;
-    }
     Output out;
     out.json << "{\n";
-    print(out, "# Strategy study\n\n%lld samples per θ_r; relative variance per sample of the luminance estimate of ∫ f cos dω_i "
+    out.md.print("# Strategy study\n\n%lld samples per θ_r; relative variance per sample of the luminance estimate of ∫ f cos dω_i "
                "(lower is better), conditional on the offset h and averaged over h ∈ {±0.95, ±0.6, ±0.2}; θ_r ∈ {−80, −60, −30, 0, 30, 60, 80}°. Default tables (31×64×64, "
                "n_h 1..16), near-field table 121 θ_o nodes × 90 θ_i cells; the mixture variants use w = 0.25 at n_h = 2.\n\n", n);
 
@@ -171,11 +159,11 @@ int main(int argc, char **argv) {
     std::vector<double> ns_per_sample;
     for (const auto &s : bench::all_samplers(cycles_default)) ns_per_sample.push_back(time_per_sample(*s.sampler));
 
-    print(out, "## 1. Near field: median relative variance over θ_r\n\n| strategy |");
-    for (const Fiber &f : kFibers) print(out, " %s |", f.name.c_str());
-    print(out, " median of medians |\n|---|");
-    for (int k = 0; k <= int(std::size(kFibers)); ++k) print(out, "---|");
-    print(out, "\n");
+    out.md.print("## 1. Near field: median relative variance over θ_r\n\n| strategy |");
+    for (const Fiber &f : kFibers) out.md.print(" %s |", f.name.c_str());
+    out.md.print(" median of medians |\n|---|");
+    for (int k = 0; k <= int(std::size(kFibers)); ++k) out.md.print("---|");
+    out.md.print("\n");
     std::vector<std::vector<double>> medians(names.size());
     std::ostringstream per_theta;
     per_theta << "{";
@@ -203,19 +191,19 @@ int main(int argc, char **argv) {
     }
     per_theta << "}";
     for (size_t s = 0; s < names.size(); ++s) {
-        print(out, "| %s |", names[s].c_str());
-        for (double m : medians[s]) print(out, " %.3g |", m);
-        print(out, " %.3g |\n", median(medians[s]));
+        out.md.print("| %s |", names[s].c_str());
+        for (double m : medians[s]) out.md.print(" %.3g |", m);
+        out.md.print(" %.3g |\n", median(medians[s]));
     }
     out.section("theta_r_deg", json_list(std::vector<double>(std::begin(kThetaR), std::end(kThetaR))));
     out.section("near_field_variance", per_theta.str());
 
-    print(out, "\n## Time and efficiency (Cycles-default fiber, one thread, random θ_r and h)\n\n"
+    out.md.print("\n## Time and efficiency (Cycles-default fiber, one thread, random θ_r and h)\n\n"
                "| strategy | ns per prepare+sample+pdf | million per second | near-field variance (median) | efficiency 1/(variance × µs) | vs analytic |\n|---|---|---|---|---|---|\n");
     std::vector<double> efficiency;
     for (size_t s = 0; s < names.size(); ++s) efficiency.push_back(1.0 / (median(medians[s]) * ns_per_sample[s] * 1e-3));
     for (size_t s = 0; s < names.size(); ++s)
-        print(out, "| %s | %.0f | %.2f | %.3g | %.3g | %.2f× |\n", names[s].c_str(), ns_per_sample[s], 1e3 / ns_per_sample[s],
+        out.md.print("| %s | %.0f | %.2f | %.3g | %.3g | %.2f× |\n", names[s].c_str(), ns_per_sample[s], 1e3 / ns_per_sample[s],
               median(medians[s]), efficiency[s], efficiency[s] / efficiency[1]);
     {
         std::ostringstream names_json;
@@ -235,9 +223,9 @@ int main(int argc, char **argv) {
     // ---- 2. Far field -----------------------------------------------------------------------
     {
         const auto samplers = bench::all_samplers(cycles_default);
-        print(out, "\n## 2. Far field (h-averaged f, what the 2D tables tabulate), Cycles-default fiber\n\n| strategy |");
-        for (double t : kThetaR) print(out, " %g° |", t);
-        print(out, " median |\n|---|---|---|---|---|---|---|---|---|\n");
+        out.md.print("\n## 2. Far field (h-averaged f, what the 2D tables tabulate), Cycles-default fiber\n\n| strategy |");
+        for (double t : kThetaR) out.md.print(" %g° |", t);
+        out.md.print(" median |\n|---|---|---|---|---|---|---|---|---|\n");
         std::vector<double> far_medians;
         for (const auto &s : samplers) {
             std::vector<double> v;
@@ -247,9 +235,9 @@ int main(int argc, char **argv) {
                     return double(luminance(cycles_default.fiber->f_cos(wi, wo)));
                 }));
             }
-            print(out, "| %s |", s.name.c_str());
-            for (double x : v) print(out, " %.3g |", x);
-            print(out, " %.3g |\n", median(v));
+            out.md.print("| %s |", s.name.c_str());
+            for (double x : v) out.md.print(" %.3g |", x);
+            out.md.print(" %.3g |\n", median(v));
             far_medians.push_back(median(v));
         }
         out.section("far_field_median", json_list(far_medians));
@@ -270,13 +258,13 @@ int main(int argc, char **argv) {
             return median(v);
         };
         const int n_h_values[] = {1, 2, 4, 8, 16};
-        print(out, "\n## 3. Multiple scattering (∫ F_multiple cos dω_i through n_h strands), median over θ_r\n\n"
+        out.md.print("\n## 3. Multiple scattering (∫ F_multiple cos dω_i through n_h strands), median over θ_r\n\n"
                    "| strategy | n_h = 1 | 2 | 4 | 8 | 16 |\n|---|---|---|---|---|---|\n");
         const char *labels[] = {"uniform", "analytic (single-scattering lobes)", "gaussian (seed, w = 1)", "table (multiple, w = 1)"};
         std::ostringstream json;
         json << "{";
         for (int which = 0; which < 4; ++which) {
-            print(out, "| %s |", labels[which]);
+            out.md.print("| %s |", labels[which]);
             std::vector<double> row;
             for (int n_h : n_h_values) {
                 StrategyInputs in;
@@ -289,9 +277,9 @@ int main(int argc, char **argv) {
                 row.push_back(median_over_theta_r(sampler, [&](float theta_i, float theta_r) {
                     return dual.multiple_f_cos(theta_i, theta_r, n_h);
                 }));
-                print(out, " %.3g |", row.back());
+                out.md.print(" %.3g |", row.back());
             }
-            print(out, "\n");
+            out.md.print("\n");
             json << (which ? ", " : "") << "\"" << labels[which] << "\": " << json_list(row);
         }
         json << "}";
@@ -299,7 +287,7 @@ int main(int argc, char **argv) {
 
         // The layer (dual_hair_volume=layer) cuts Ā_b at the strands behind the vertex: the same
         // baked table (the unbounded term's) then samples a term it was not baked for.
-        print(out, "\nThe multiple table (baked for the unbounded term) sampling the layer's term, Ā_b cut at "
+        out.md.print("\nThe multiple table (baked for the unbounded term) sampling the layer's term, Ā_b cut at "
                    "`depth` strands behind:\n\n| depth | n_h = 1 | 2 | 4 | 8 | 16 |\n|---|---|---|---|---|---|\n");
         StrategyInputs in;
         in.tables = &cycles_default.sampling;
@@ -309,7 +297,7 @@ int main(int argc, char **argv) {
         const int depths[] = {1, 2, 4, -1};
         for (int d = 0; d < 4; ++d) {
             const int depth = depths[d];
-            print(out, "| %s |", depth < 0 ? "unbounded" : std::to_string(depth).c_str());
+            out.md.print("| %s |", depth < 0 ? "unbounded" : std::to_string(depth).c_str());
             std::vector<double> row;
             for (int n_h : n_h_values) {
                 in.n_h = n_h;
@@ -318,9 +306,9 @@ int main(int argc, char **argv) {
                     return dual.scattered_f_cos(theta_i, theta_r, dual.forward_transmittance(theta_i, n_h),
                                                 dual.forward_spread_variance(theta_i, n_h), depth);
                 }));
-                print(out, " %.3g |", row.back());
+                out.md.print(" %.3g |", row.back());
             }
-            print(out, "\n");
+            out.md.print("\n");
             layer_json << (d ? ", " : "") << "\"" << depth << "\": " << json_list(row);
         }
         layer_json << "}";
@@ -329,7 +317,7 @@ int main(int argc, char **argv) {
 
     // ---- 4. Resolution sweeps -------------------------------------------------------------------
     {
-        print(out, "\n## 4a. Near-field table resolution (Cycles-default fiber, w = 0): median variance and memory\n\n"
+        out.md.print("\n## 4a. Near-field table resolution (Cycles-default fiber, w = 0): median variance and memory\n\n"
                    "| θ_o nodes | θ_i cells | median variance | memory (KiB) | build (ms, all cores) |\n|---|---|---|---|---|\n");
         std::ostringstream json;
         json << "[";
@@ -354,7 +342,7 @@ int main(int argc, char **argv) {
                         return double(luminance(cycles_default.fiber->f_cos_near(wi, wo, h)));
                     }));
                 }
-                print(out, "| %d | %d | %.3g | %.0f | %.0f |\n", nodes, cells, median(v), table->memory_bytes() / 1024.0, ms);
+                out.md.print("| %d | %d | %.3g | %.0f | %.0f |\n", nodes, cells, median(v), table->memory_bytes() / 1024.0, ms);
                 json << (first ? "" : ", ") << "{\"nodes\": " << nodes << ", \"cells\": " << cells << ", \"variance\": " << median(v)
                      << ", \"kib\": " << table->memory_bytes() / 1024.0 << "}";
                 first = false;
@@ -364,7 +352,7 @@ int main(int argc, char **argv) {
         out.section("near_field_resolution", json.str());
     }
     {
-        print(out, "\n## 4b. Far-field table resolution (Cycles-default fiber, w = 0, far-field integrand)\n\n"
+        out.md.print("\n## 4b. Far-field table resolution (Cycles-default fiber, w = 0, far-field integrand)\n\n"
                    "| θ_r × θ_i × φ | median variance | table floats (MiB) | bake (s, all cores) |\n|---|---|---|---|\n");
         std::ostringstream json;
         json << "[";
@@ -391,7 +379,7 @@ int main(int argc, char **argv) {
                 }));
             }
             const double mib = double(set.direct.size() + set.multiple.size()) * 4.0 / (1024.0 * 1024.0);
-            print(out, "| %d × %d × %d | %.3g | %.1f | %.2f |\n", size[0], size[1], size[2], median(v), mib, seconds);
+            out.md.print("| %d × %d × %d | %.3g | %.1f | %.2f |\n", size[0], size[1], size[2], median(v), mib, seconds);
             json << (first ? "" : ", ") << "{\"size\": [" << size[0] << ", " << size[1] << ", " << size[2]
                  << "], \"variance\": " << median(v) << ", \"mib\": " << mib << ", \"bake_s\": " << seconds << "}";
             first = false;
@@ -402,7 +390,7 @@ int main(int argc, char **argv) {
 
     // ---- 5. Smooth fibers ----------------------------------------------------------------------
     {
-        print(out, "\n## 5. Near field against roughness (Cycles-default fiber otherwise, w = 0)\n\n"
+        out.md.print("\n## 5. Near field against roughness (Cycles-default fiber otherwise, w = 0)\n\n"
                    "Lobes narrower than the near-field table's cells (2°) and node spacing (1.5°) draw θ_i from the fiber's "
                    "cone sampler instead of their table row, chosen per node and lobe when the table is built "
                    "(near_field_table.h). θ_r ∈ {−88, −80, −60, −30, 0, 30, 60, 80, 88}°, 1.3° off the nodes.\n\n"
@@ -437,7 +425,7 @@ int main(int argc, char **argv) {
                 mean[k] = 0;
                 for (double x : v) mean[k] += x / double(v.size());
             }
-            print(out, "| %.2f | %.3g / %.3g | %.3g / %.3g | %.3g / %.3g | %.0f |\n", roughness, med[0], mean[0], med[1], mean[1],
+            out.md.print("| %.2f | %.3g / %.3g | %.3g / %.3g | %.3g / %.3g | %.0f |\n", roughness, med[0], mean[0], med[1], mean[1],
                   med[2], mean[2], ms);
             json << (roughness > 0.0f ? ", " : "") << "{\"roughness\": " << roughness << ", \"analytic\": [" << med[0] << ", " << mean[0]
                  << "], \"rows\": [" << med[1] << ", " << mean[1] << "], \"table\": [" << med[2] << ", " << mean[2]
@@ -447,7 +435,7 @@ int main(int argc, char **argv) {
         out.section("roughness_sweep", json.str());
     }
 
-    print(out, "\nMachine: %u hardware threads.\n", std::thread::hardware_concurrency());
+    out.md.print("\nMachine: %u hardware threads.\n", std::thread::hardware_concurrency());
     out.json << "\n}\n";
     if (!folder.empty()) {
         std::ofstream md(folder + "/strategy_study.md"), json(folder + "/strategy_study.json");
