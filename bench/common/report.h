@@ -34,12 +34,19 @@ class Report {
     std::string text_;
 };
 
-/// A study's sample count: argv[1] if given, else `fallback`; nothing, after saying why on
-/// stderr, when it is below `minimum`.
-inline std::optional<long long> sample_count(int argc, char **argv, long long fallback,
-                                             long long minimum, const char *study) {
-    const long long n = argc > 1 ? std::atoll(argv[1]) : fallback;
-    if (n >= minimum) return n;
+/// A study's command line: a sample count (argv[1], default `fallback`) and the folder to write
+/// its report into (argv[2], empty for none).
+struct StudyArguments {
+    long long samples = 0;
+    std::string folder;
+};
+
+/// The study's arguments; nothing, after saying why on stderr, when the sample count is below
+/// `minimum`.
+inline std::optional<StudyArguments> study_arguments(int argc, char **argv, long long fallback,
+                                                     long long minimum, const char *study) {
+    StudyArguments a{argc > 1 ? std::atoll(argv[1]) : fallback, argc > 2 ? argv[2] : ""};
+    if (a.samples >= minimum) return a;
     std::fprintf(stderr, "%s: samples must be at least %lld (got %s)\n", study, minimum,
                  argc > 1 ? argv[1] : "nothing");
     return std::nullopt;

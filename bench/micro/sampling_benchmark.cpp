@@ -29,9 +29,10 @@ struct Queries {
     }
 };
 
-// Per direction, as a path vertex pays it: prepare the BSDF at the hit, draw ω_i (f comes
-// with it) and evaluate the density there (what MIS against a light needs).
-void sample_and_pdf(benchmark::State &state, int which) {
+// Times `vertex` on the BSDF of strategy `which` prepared at each of 4096 fixed queries, the
+// preparation included.
+template <typename Vertex>
+void time_vertices(benchmark::State &state, int which, const Vertex &vertex) {
     const auto samplers = all_samplers(setup());
     const Strategy &s = *samplers[size_t(which)].sampler;
     state.SetLabel(samplers[size_t(which)].name);
@@ -40,13 +41,20 @@ void sample_and_pdf(benchmark::State &state, int which) {
     size_t k = 0;
     for (auto _ : state) {
         scratch.reset();
-        const HairBsdf bsdf = s.at(q.views[k], q.h[k], scratch);
-        const auto smp = bsdf.sample(q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
-        float value = smp ? smp->f.g + bsdf.pdf(smp->wi) : 0.0f;
+        const float value = vertex(s.at(q.views[k], q.h[k], scratch), q, k);
         benchmark::DoNotOptimize(value);
         k = (k + 1) & 4095;
     }
     state.SetItemsProcessed(state.iterations());
+}
+
+// Per direction, as a path vertex pays it: prepare the BSDF at the hit, draw ω_i (f comes
+// with it) and evaluate the density there (what MIS against a light needs).
+void sample_and_pdf(benchmark::State &state, int which) {
+    time_vertices(state, which, [](const HairBsdf &bsdf, const Queries &q, size_t k) {
+        const auto smp = bsdf.sample(q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
+        return smp ? smp->f.g + bsdf.pdf(smp->wi) : 0.0f;
+    });
 }
 BENCHMARK_CAPTURE(sample_and_pdf, uniform, 0);
 BENCHMARK_CAPTURE(sample_and_pdf, analytic, 1);
@@ -59,23 +67,12 @@ BENCHMARK_CAPTURE(sample_and_pdf, table_near_mixture, 7);
 // What a path vertex pays for hair: prepare the BSDF, f and pdf at a light sample's direction
 // (next-event estimation with MIS), then a BSDF sample with its f.
 void path_vertex(benchmark::State &state, int which) {
-    const auto samplers = all_samplers(setup());
-    const Strategy &s = *samplers[size_t(which)].sampler;
-    state.SetLabel(samplers[size_t(which)].name);
-    const Queries q(4096);
-    ScratchBuffer scratch;
-    size_t k = 0;
-    for (auto _ : state) {
-        scratch.reset();
-        const HairBsdf bsdf = s.at(q.views[k], q.h[k], scratch);
+    time_vertices(state, which, [](const HairBsdf &bsdf, const Queries &q, size_t k) {
         float light_pdf = 0.0f;
         const Rgb light_f = bsdf.f_and_pdf(q.views[(k + 1) & 4095], light_pdf);
         const auto smp = bsdf.sample(q.u[3 * k], q.u[3 * k + 1], q.u[3 * k + 2]);
-        float value = light_f.g + light_pdf + (smp ? smp->f.g + smp->pdf : 0.0f);
-        benchmark::DoNotOptimize(value);
-        k = (k + 1) & 4095;
-    }
-    state.SetItemsProcessed(state.iterations());
+        return light_f.g + light_pdf + (smp ? smp->f.g + smp->pdf : 0.0f);
+    });
 }
 BENCHMARK_CAPTURE(path_vertex, analytic, 1);
 BENCHMARK_CAPTURE(path_vertex, table_near_direct, 6);

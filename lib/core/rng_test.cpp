@@ -35,25 +35,30 @@ TEST(Rng, UnitFloatIsInHalfOpenRange) {
     }
 }
 
+// The χ² test of draw(0), draw(1), ..., draw(n − 1) against the uniform density on [0, 1) in
+// 64 cells, one of `test_count` tests of its family.
+template <typename Draw>
+testing::Chi2Result chi2_uniform(int n, int test_count, const Draw &draw) {
+    testing::Chi2Options options;
+    options.sample_count = n;
+    options.test_count = test_count;
+    std::uint64_t k = 0;
+    return testing::chi2_interval_test([&](double) -> std::optional<double> { return draw(k++); },
+                                       [](double) { return 1.0; }, 0.0, 1.0, 64, options);
+}
+
 TEST(Rng, UniformAlongEachAxis) {
     // One χ² test per axis that varies: dimension, sample, pixel and seed.
     const int n = 200000;
     for (int axis = 0; axis < 4; ++axis) {
-        int i = 0;
-        testing::Chi2Options options;
-        options.sample_count = n;
-        options.test_count = 4;
-        const auto result = testing::chi2_interval_test(
-            [&](double) -> std::optional<double> {
-                const std::uint64_t k = std::uint64_t(i++);
-                switch (axis) {
-                    case 0: return random_float(1, 2, 3, std::uint32_t(k));
-                    case 1: return random_float(1, 2, k, 3);
-                    case 2: return random_float(1, k, 2, 3);
-                    default: return random_float(k, 1, 2, 3);
-                }
-            },
-            [](double) { return 1.0; }, 0.0, 1.0, 64, options);
+        const auto result = chi2_uniform(n, 4, [&](std::uint64_t k) {
+            switch (axis) {
+                case 0: return random_float(1, 2, 3, std::uint32_t(k));
+                case 1: return random_float(1, 2, k, 3);
+                case 2: return random_float(1, k, 2, 3);
+                default: return random_float(k, 1, 2, 3);
+            }
+        });
         EXPECT_TRUE(result.passed) << "axis " << axis << ": " << result.message;
     }
 }
@@ -157,15 +162,9 @@ TEST(SobolRng, UniformAcrossPixelsAndSeeds) {
     // points random, which is what keeps the estimates unbiased.
     const int n = 200000;
     for (std::uint32_t dimension : {0u, 1u, 7u}) {
-        int i = 0;
-        testing::Chi2Options options;
-        options.sample_count = n;
-        options.test_count = 3;
-        const auto result = testing::chi2_interval_test(
-            [&](double) -> std::optional<double> {
-                return SobolSampleRng(9, std::uint64_t(i++), 5).get(dimension);
-            },
-            [](double) { return 1.0; }, 0.0, 1.0, 64, options);
+        const auto result = chi2_uniform(n, 3, [&](std::uint64_t k) {
+            return SobolSampleRng(9, k, 5).get(dimension);
+        });
         EXPECT_TRUE(result.passed) << "dimension " << dimension << ": " << result.message;
     }
 }

@@ -46,8 +46,7 @@ ARGS, PACKAGE = helpers.setup()
 if helpers.VERSION < (4, 0, 0):
     helpers.skip("Blender %s has no OpenImageDenoise in its compositor here"
                  % bpy.app.version_string)
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet")
+helpers.require_library(PACKAGE)
 
 RESOLUTION, REF_SPP, SPPS, SEEDS = helpers.study_settings((96, 72), 2048, (4, 16, 64), 3)
 OUT = os.environ.get("HAIRIS_STUDY_OUT", HERE)

@@ -45,12 +45,7 @@ def scene_for(radius_scale, tip, close_tip, children):
     st.use_close_tip = close_tip
     helpers.match_cycles(scene, 4, 8)
     scene.cycles.diffuse_bounces = 4
-    scene.hairis.max_bounces = 8
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
-    scene.hairis.threads = 2
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = 2
+    helpers.use_table(scene, 8, threads=2)
     bpy.context.view_layer.update()
     return scene, sphere
 

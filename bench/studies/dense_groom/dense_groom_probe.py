@@ -88,12 +88,7 @@ def make_scene():
     bounces = int(env("PROBE_BOUNCES", "8"))
     helpers.match_cycles(scene, int(env("PROBE_SPP", "16")), bounces)
     scene.hairis.samples = scene.cycles.samples
-    scene.hairis.max_bounces = bounces
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
-    scene.hairis.threads = 2
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = 2
+    helpers.use_table(scene, bounces, threads=2)
     bpy.context.view_layer.update()
     return scene
 

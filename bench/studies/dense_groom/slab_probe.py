@@ -53,9 +53,7 @@ def make_scene():
     bounces = int(env("SLAB_BOUNCES", "8"))
     helpers.match_cycles(scene, int(env("SLAB_SPP", "16")), bounces)
     scene.hairis.samples = scene.cycles.samples
-    scene.hairis.max_bounces = bounces
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
+    helpers.use_table(scene, bounces)
     bpy.context.view_layer.update()
     return scene
 

@@ -56,10 +56,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))  # the repository
 sys.path.insert(0, os.path.join(ROOT, "tests", "blender"))
 import helpers  # noqa: E402
 
-ARGS, PACKAGE = helpers.setup()
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
+ARGS = helpers.setup_compare()
 
 # The hair: "sphere" (the study's ball, the default) or "head" (the demo head of
 # scripts/render_demo.py in the case's colour and lighting: longer, thicker hair on a larger
@@ -166,13 +163,9 @@ def make_case_scene(colour, lighting):
         sphere = helpers.make_particle_hair(scene, count=1500, children=8,
                                             location=(0.0, 0.0, 0.0), scale=1.0,
                                             hair_material=hair, skin_material=skin)
-        settings = sphere.modifiers["Hair"].particle_system.settings
-        settings.hair_length = 0.5
-        settings.radius_scale = 0.006
-        settings.root_radius = 1.0
-        settings.tip_radius = 0.5
-        settings.child_radius = 0.08
-        settings.render_step = 3
+        helpers.configure(sphere.modifiers["Hair"].particle_system.settings, hair_length=0.5,
+                          radius_scale=0.006, root_radius=1.0, tip_radius=0.5,
+                          child_radius=0.08, render_step=3)
     helpers.match_cycles(scene, 4, BOUNCES)
     scene.cycles.diffuse_bounces = 4  # Hairis' max_diffuse_bounces default
     scene.render.threads_mode = "FIXED"
@@ -207,21 +200,11 @@ def hair_mask(scene, sphere):
     sphere.show_instancer_for_render = False
     scene.render.film_transparent = True
     helpers.set_samples(scene, 16)
-    scene.render.engine = "CYCLES"
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.ops.render.render()
-    path = os.path.join(ARGS.workdir, "mask.exr")
-    bpy.data.images["Render Result"].save_render(path, scene=scene)
-    image = bpy.data.images.load(path)
-    width, height = image.size
-    pixels = np.empty(width * height * 4, np.float32)
-    image.pixels.foreach_get(pixels)
-    bpy.data.images.remove(image)
-    os.remove(path)
+    rgba, _ = helpers.render_pixels(scene, "CYCLES", scene.cycles.seed, ARGS.workdir, "mask",
+                                    alpha=True)
     sphere.show_instancer_for_render = True
     scene.render.film_transparent = False
-    return pixels.reshape(height, width, 4)[..., 3] > 0.5
+    return rgba[..., 3] > 0.5
 
 
 def errors(image, reference, mask, ref_mse_channel):

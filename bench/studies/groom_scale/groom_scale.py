@@ -58,12 +58,7 @@ def base_scene():
         "Coat": 0.0, "IOR": 1.55, "Offset": math.radians(2.0)})
     skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
     helpers.match_cycles(scene, 16, 8)
-    scene.hairis.max_bounces = 8
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
-    scene.hairis.threads = 2
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = 2
+    helpers.use_table(scene, 8, threads=2)
     return scene, hair, skin
 
 

@@ -46,15 +46,9 @@ import helpers  # noqa: E402
 import render_study_report  # noqa: E402
 from render_study_report import METHODS, STRATEGIES  # noqa: E402
 
-ARGS, PACKAGE = helpers.setup()
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
+ARGS = helpers.setup_compare()
 
-RESOLUTION = tuple(int(v) for v in os.environ.get("HAIRIS_STUDY_RESOLUTION", "64x48").split("x"))
-REF_SPP = int(os.environ.get("HAIRIS_STUDY_REF_SPP", "512"))
-SPPS = [int(v) for v in os.environ.get("HAIRIS_STUDY_SPPS", "4,16,64,256").split(",")]
-SEEDS = int(os.environ.get("HAIRIS_STUDY_SEEDS", "1"))
+RESOLUTION, REF_SPP, SPPS, SEEDS = helpers.study_settings((64, 48), 512, (4, 16, 64, 256), 1)
 OUT = os.environ.get("HAIRIS_STUDY_OUT", HERE)
 BOUNCES = 4
 REF_SEED = 1000

@@ -47,19 +47,15 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))  # the repository
 sys.path.insert(0, os.path.join(ROOT, "tests", "blender"))
 sys.path.insert(0, HERE)
 import helpers  # noqa: E402
-from render_study_report import interpolate_loglog, loglog_slope, table, fmt_percent  # noqa: E402
+from render_study_report import (  # noqa: E402
+    fmt_percent, interpolate_loglog, loglog_slope, made_by, table)
 
 ARGS, PACKAGE = helpers.setup()
 if helpers.VERSION < (4, 0, 0):
     helpers.skip("Blender %s has no Huang model" % bpy.app.version_string)
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
+helpers.require_library(PACKAGE)
 
-RESOLUTION = tuple(int(v) for v in os.environ.get("HAIRIS_STUDY_RESOLUTION", "64x48").split("x"))
-REF_SPP = int(os.environ.get("HAIRIS_STUDY_REF_SPP", "2048"))
-SPPS = [int(v) for v in os.environ.get("HAIRIS_STUDY_SPPS", "4,16,64,256").split(",")]
-SEEDS = int(os.environ.get("HAIRIS_STUDY_SEEDS", "3"))
+RESOLUTION, REF_SPP, SPPS, SEEDS = helpers.study_settings((64, 48), 2048, (4, 16, 64, 256), 3)
 OUT = os.environ.get("HAIRIS_STUDY_OUT", HERE)
 SCENE = os.environ.get("HAIRIS_STUDY_SCENE", "compare")
 SCENES = {
@@ -154,11 +150,7 @@ def markdown(results):
     lines = [
         "# Render study on Huang hair: Hairis against Cycles",
         "",
-        "Made by render_study_huang.py in Blender %s at commit %s on %d cores (%s); "
-        "load average %.2f at the start and %.2f at the end (a shared machine: times carry "
-        "noise); %.0f s in all." % (m["blender_version"], m["git_commit"] or "?", m["nproc"],
-                                    m["cpu_model"], m["load_average_start"][0],
-                                    m["load_average_end"][0], m["total_seconds"]),
+        made_by("render_study_huang.py in Blender %s" % m["blender_version"], m),
         "",
         "Scene %s: %s, at %dx%d pixels, %d bounces, Cycles matched as in the "
         "README's \"Comparing with Cycles\"; seeds %s per sample count." % (

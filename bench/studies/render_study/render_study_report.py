@@ -105,6 +105,16 @@ def summarize(results):
     return summary
 
 
+def made_by(maker, m):
+    """The report's first sentence: ``maker`` (the script and its Blender), then the commit,
+    the machine ``m`` and its load, which the figures depend on."""
+    return ("Made by %s at commit %s on %d cores (%s); load average %.2f at the start and %.2f "
+            "at the end (the machine is shared, so times carry noise); the whole run took "
+            "%.0f s." % (maker, m["git_commit"] or "?", m["nproc"], m["cpu_model"],
+                         m["load_average_start"][0], m["load_average_end"][0],
+                         m["total_seconds"]))
+
+
 def linear_time_fit(per_spp):
     """Seconds = overhead + per_sample · spp, least squares; returns both."""
     spp = np.array([p["spp"] for p in per_spp], float)
@@ -124,12 +134,8 @@ def markdown(results):
     lines = [
         "# Render study: Hairis strategies against Cycles",
         "",
-        "Made by `render_study` (render_study.py in Blender %s, plots by "
-        "plot_render_study.py) at commit %s on %d cores (%s); load average %.2f at the "
-        "start and %.2f at the end (the machine is shared, so times carry noise); the whole "
-        "run took %.0f s." % (m["blender_version"], m["git_commit"] or "?", m["nproc"],
-                              m["cpu_model"], m["load_average_start"][0],
-                              m["load_average_end"][0], m["total_seconds"]),
+        made_by("`render_study` (render_study.py in Blender %s, plots by "
+                "plot_render_study.py)" % m["blender_version"], m),
         "",
         "Scene: tests/blender/test_cycles_compare.py's (particle hair with a Melanin Principled "
         "Hair BSDF on a diffuse sphere, Curves with a Color-parametrized one, sun, point and "

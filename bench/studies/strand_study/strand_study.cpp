@@ -176,10 +176,11 @@ double prepare_ns(const ChiangStrands &strands, const HairInputValues *inputs) {
 }  // namespace
 
 int main(int argc, char **argv) {
-    const std::optional<long long> samples = bench::sample_count(argc, argv, 20000, 1000, "strand_study");
-    if (!samples) return 1;
-    const long long per_h = *samples;
-    const std::string folder = argc > 2 ? argv[2] : "";
+    const std::optional<bench::StudyArguments> arguments =
+        bench::study_arguments(argc, argv, 20000, 1000, "strand_study");
+    if (!arguments) return 1;
+    const long long per_h = arguments->samples;
+    const std::string &folder = arguments->folder;
     report.print("# Strand study\n\nRelative variance per sample of the luminance estimate of ∫ f cos dω_i for strands whose "
           "inputs differ from the material's (melanin 0.5, redness 0.5, roughness and radial roughness 0.3, offset "
           "2°: what the tables are baked for); %lld samples per θ_r and h, conditional on h ∈ {±0.95, ±0.6, ±0.2}, "

@@ -142,10 +142,11 @@ struct Output {
 }  // namespace
 
 int main(int argc, char **argv) {
-    const std::optional<long long> samples = bench::sample_count(argc, argv, 100000, 1000, "strategy_study");
-    if (!samples) return 1;
-    const long long n = *samples;
-    const std::string folder = argc > 2 ? argv[2] : "";
+    const std::optional<bench::StudyArguments> arguments =
+        bench::study_arguments(argc, argv, 100000, 1000, "strategy_study");
+    if (!arguments) return 1;
+    const long long n = arguments->samples;
+    const std::string &folder = arguments->folder;
     Output out;
     out.json << "{\n";
     out.md.print("# Strategy study\n\n%lld samples per θ_r; relative variance per sample of the luminance estimate of ∫ f cos dω_i "
