@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "chi2.h"
-#include "cameras.h"
+#include "scene_fixtures.h"
 #include "same_bits.h"
 #include "core/quadrature.h"
 #include "fiber/chiang.h"
@@ -344,10 +344,7 @@ Scene sun_through_strands(int k, float strength) {
     SceneDesc d;
     d.materials = {dual_hair(blonde())};
     d.curves = {straight_hairs(centres, radii)};
-    SunLight sun;
-    sun.to_sun = {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))};
-    sun.strength = strength;
-    d.suns = {sun};
+    testing::set_sun(d, {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))}, strength);
     d.world = {Rgb(0.0f), 1.0f};
     d.camera = ortho_down(0.4f, 0.012f, 8, 2);
     return build(std::move(d));
@@ -526,10 +523,7 @@ Scene sunlit_floor(const std::vector<Vec3> &centres, float r, float floor_z, flo
     d.materials = {dual_hair(blonde()), DiffuseMaterial{Rgb(kFloorAlbedo)}};
     d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), r), 3.0f)};
     if (floor) d.meshes = {quad_at(1.0f, floor_z, 1)};
-    SunLight sun;
-    sun.to_sun = kSunAbove;
-    sun.strength = strength;
-    d.suns = {sun};
+    testing::set_sun(d, kSunAbove, strength);
     d.camera = ortho_down(window, window, 1, 1);
     return build(std::move(d));
 }
@@ -662,10 +656,7 @@ TEST(DualScatteringRender, DirectlyLitHairIsSingleScatteringPlusLocalBackscatter
     SceneDesc d;
     d.materials = {dual_hair(blonde())};
     d.curves = {straight_hairs(centres, {0.02f})};
-    SunLight sun;
-    sun.to_sun = {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))};
-    sun.strength = strength;
-    d.suns = {sun};
+    testing::set_sun(d, {float(std::sin(0.4)), 0.0f, -float(std::cos(0.4))}, strength);
     d.camera = ortho_down(0.4f, 0.03f, 1, 1);
     const Scene scene = build(std::move(d));
     // Fiber frame at the hit: x = +X; ω_o = +Z; ω_i = to_sun.
@@ -687,10 +678,7 @@ Scene sun_with_three_strands_behind(float strength) {
     SceneDesc d;
     d.materials = {dual_hair(blonde())};
     d.curves = {straight_hairs(centres, std::vector<float>(centres.size(), 0.02f))};
-    SunLight sun;
-    sun.to_sun = {0.0f, std::sin(a), std::cos(a)};
-    sun.strength = strength;
-    d.suns = {sun};
+    testing::set_sun(d, {0.0f, std::sin(a), std::cos(a)}, strength);
     d.camera = ortho_down(0.4f, 0.03f, 1, 1);
     return build(std::move(d));
 }
@@ -1025,10 +1013,7 @@ Scene tuft_over_floor(CameraDesc camera) {
     d.materials = {dual_hair(blonde()), DiffuseMaterial{}};
     d.curves = {tuft(300, 6, 0.006f)};
     d.meshes = {quad_at(1.0f, 0.0f, 1)};
-    SunLight sun;
-    sun.to_sun = safe_normalize(Vec3{0.3f, -0.5f, 1.0f});
-    sun.strength = 2.0f;
-    d.suns = {sun};
+    testing::set_sun(d, safe_normalize(Vec3{0.3f, -0.5f, 1.0f}), 2.0f);
     d.world = {Rgb(0.3f), 1.0f};
     d.camera = camera;
     return build(std::move(d));

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cameras.h"
+#include "scene_fixtures.h"
 #include "same_bits.h"
 
 #include "fiber/chiang_strands.h"
@@ -212,11 +212,8 @@ TEST(Render, DiffusePlaneUnderTheSun) {
         SceneDesc d;
         d.materials = {DiffuseMaterial{Rgb(albedo), Rgb(0.0f)}};
         d.meshes = {quad(100.0f, 0.0f, 0)};
-        SunLight sun;
-        sun.to_sun = {std::sin(theta), 0.0f, std::cos(theta)};
-        sun.strength = strength;
-        sun.angle = angle;
-        d.suns = {sun};
+        const Vec3 to_sun{std::sin(theta), 0.0f, std::cos(theta)};
+        testing::set_sun(d, to_sun, strength, angle);
         d.camera = ortho_down(1, 1, 8, 8);
         const Scene scene = build(std::move(d));
         RenderSettings s;
@@ -226,7 +223,7 @@ TEST(Render, DiffusePlaneUnderTheSun) {
         // uniform points on the disc of radius tan(angle/2) at distance 1, as Cycles samples).
         double mean_cos = std::cos(theta);
         if (angle > 0.0f) {
-            const Vec3 c = sun.to_sun;
+            const Vec3 c = to_sun;
             const Vec3 a{std::cos(theta), 0.0f, -std::sin(theta)}, b{0, 1, 0};
             const double r = std::tan(0.5 * angle);
             double sum = 0, n = 0;
@@ -602,11 +599,7 @@ TEST(Render, HairStrategiesAgree) {
         d.materials = {hair(fiber, std::move(sampler))};
         d.curves = {parallel_hairs(3, 0.14f, 0.06f)};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
-        SunLight sun;
-        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
-        sun.strength = 2.0f;
-        sun.angle = 0.2f;
-        d.suns = {sun};
+        testing::set_sun(d, safe_normalize(Vec3{0.3f, 0.5f, 1.0f}), 2.0f, 0.2f);
         d.camera = ortho_down(0.05f, 0.25f, 1, 5);
         return build(std::move(d));
     };
@@ -644,10 +637,7 @@ TEST(Render, StrandInputsRenderAsTheFiberOfTheirValues) {
         c.inputs = std::move(inputs);
         d.curves = {c};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
-        SunLight sun;
-        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
-        sun.strength = 2.0f;
-        d.suns = {sun};
+        testing::set_sun(d, safe_normalize(Vec3{0.3f, 0.5f, 1.0f}), 2.0f);
         d.camera = ortho_down(0.3f, 0.3f, 6, 6);
         return build(std::move(d));
     };
@@ -688,11 +678,7 @@ TEST(Render, TableAndAnalyticAgreeOnStrandsAwayFromTheTables) {
                     {HairInput::Coat, true, {0, 0.3f, 0.6f, 0.9f, 0, 0, 0, 0, 0.2f, 0.2f, 0.2f, 0.2f}}};
         d.curves = {c};
         d.world = {Rgb(0.3f, 0.4f, 0.5f), 1.0f};
-        SunLight sun;
-        sun.to_sun = safe_normalize(Vec3{0.3f, 0.5f, 1.0f});
-        sun.strength = 2.0f;
-        sun.angle = 0.2f;
-        d.suns = {sun};
+        testing::set_sun(d, safe_normalize(Vec3{0.3f, 0.5f, 1.0f}), 2.0f, 0.2f);
         d.camera = ortho_down(0.05f, 0.25f, 1, 5);
         return build(std::move(d));
     };
@@ -720,11 +706,7 @@ TEST(Render, HairStrategiesAgreeOnDeepPaths) {
         d.materials = {hair(fiber, std::move(sampler))};
         d.curves = {parallel_hairs(9, 0.1f, 0.05f)};
         d.world = {Rgb(0.4f, 0.5f, 0.7f), 1.0f};
-        SunLight sun;
-        sun.to_sun = safe_normalize(Vec3{0.3f, -0.6f, 0.5f});
-        sun.strength = 3.0f;
-        sun.angle = 0.05f;
-        d.suns = {sun};
+        testing::set_sun(d, safe_normalize(Vec3{0.3f, -0.6f, 0.5f}), 3.0f, 0.05f);
         d.camera = ortho_down(0.05f, 0.05f, 1, 1);
         return build(std::move(d));
     };
@@ -1058,10 +1040,7 @@ TEST(Render, HuangFurnaceFollowsEvalOrCyclesSampler) {
 HairRadiance sunlit_fiber(std::shared_ptr<const ShadingModel> model, Vec3 to_sun, HuangSampling sampling,
                           std::uint64_t seed) {
     SceneDesc d = thin_fiber_scene(std::move(model));
-    SunLight sun;
-    sun.to_sun = to_sun;
-    sun.strength = 2.0f;
-    d.suns = {sun};
+    testing::set_sun(d, to_sun, 2.0f);
     return direct_hair_radiance(build(std::move(d)), 64, sampling, seed);
 }
 
@@ -1158,11 +1137,7 @@ SceneDesc hair_tuft_desc(int width, int height, int curves = 64) {
     d.curves = {tuft(curves, 8, 0.01f)};
     d.meshes = {quad(3.0f, 0.0f, 1)};
     d.world = {Rgb(0.2f, 0.25f, 0.3f), 1.0f};
-    SunLight sun;
-    sun.to_sun = safe_normalize(Vec3{0.4f, -0.3f, 1.0f});
-    sun.strength = 3.0f;
-    sun.angle = float(radians(2.0));
-    d.suns = {sun};
+    testing::set_sun(d, safe_normalize(Vec3{0.4f, -0.3f, 1.0f}), 3.0f, float(radians(2.0)));
     d.point_lights = {{Vec3{1, 1, 2}, Rgb(1.0f, 0.9f, 0.8f), 200.0f, 0.2f}};
     // Looking at the tuft from the side and above.
     CameraDesc c = perspective({0, 0, 0}, 0.45f, width, height);

@@ -26,6 +26,7 @@
 #include "sampling/strategy.h"
 #include "tables/bake.h"
 #include "tables/table_file.h"
+#include "scene_fixtures.h"
 
 namespace hairis {
 namespace {
@@ -151,12 +152,7 @@ TEST(BakedTextureIsTheSampler, TheAlteredFilesSamplerIsExact) {
     for (const double theta_o : kThetaO)
         for (const float h : kH) {
             const SamplerAt at(*sampler, view_at(theta_o), h);
-            const auto r = testing::chi2_direction_test(
-                [&](Sample3 u) -> std::optional<Vec3> {
-                    auto s = at.sample(u.u0, u.u1, u.u2);
-                    return s ? std::optional<Vec3>(s->wi) : std::nullopt;
-                },
-                [&](Vec3 wi) { return double(at.pdf(wi)); }, options);
+            const auto r = testing::chi2_sampler_test(at, options);
             EXPECT_TRUE(r.passed) << "theta_o " << theta_o << " h " << h << ": " << r.message;
             EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3) << "theta_o " << theta_o << " h " << h;
             EXPECT_EQ(r.failed_samples, 0);
@@ -234,11 +230,7 @@ Scene hair_scene(const std::shared_ptr<const Sampler> &sampler) {
     }
     d.curves = {c};
     d.world = {Rgb(0.3f, 0.35f, 0.4f), 1.0f};
-    SunLight sun;
-    sun.to_sun = safe_normalize(Vec3{0.4f, -0.3f, 1.0f});
-    sun.strength = 3.0f;
-    sun.angle = float(radians(3.0));
-    d.suns = {sun};
+    testing::set_sun(d, safe_normalize(Vec3{0.4f, -0.3f, 1.0f}), 3.0f, float(radians(3.0)));
     CameraDesc camera;
     camera.camera_to_world = Mat4::translation({0, 0, 3});  // looks down −Z
     const float tan_half = 0.2f;

@@ -1,8 +1,9 @@
-// Test helper: cameras that the render tests share.
+// Test helper: the cameras and lights that the render tests share.
 #pragma once
 
 #include "core/math.h"
 #include "render/camera.h"
+#include "render/scene.h"
 
 namespace hairis::testing {
 
@@ -18,6 +19,16 @@ inline CameraDesc ortho_down(float half_x, float half_y, int w, int h,
     c.width = w;
     c.height = h;
     return c;
+}
+
+/// Makes a sun towards `to_sun` (strength in W/m², angular diameter in radians) the scene's only
+/// sun.
+inline void set_sun(SceneDesc &d, Vec3 to_sun, float strength, float angle = 0.0f) {
+    SunLight sun;
+    sun.to_sun = to_sun;
+    sun.strength = strength;
+    sun.angle = angle;
+    d.suns = {sun};
 }
 
 }  // namespace hairis::testing
