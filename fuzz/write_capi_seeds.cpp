@@ -18,6 +18,7 @@
 
 #include "fuzz_input.h"
 #include "hairis/hairis.h"
+#include "seed_writer.h"
 
 namespace {
 
@@ -167,12 +168,10 @@ const std::vector<std::array<float, 4>> kStrand = {
 }  // namespace
 
 int main(int argc, char **argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
-        return 2;
-    }
-    std::vector<std::pair<std::string, Blob>> seeds;
-    auto add = [&](const std::string &name, Blob b) { seeds.emplace_back(name, std::move(b)); };
+    const char *folder = hairis::fuzz::seed_folder(argc, argv);
+    if (!folder) return 2;
+    hairis::fuzz::Seeds seeds;
+    auto add = [&](const std::string &name, Blob b) { seeds.emplace_back(name, std::move(b.bytes)); };
 
     {  // A Chiang fiber (the Principled Hair node): evaluate, bake tiny tables, sample them.
         Blob b;
@@ -459,15 +458,5 @@ int main(int argc, char **argv) {
         add("regression_table_sampler_roughness_tiny", b);
     }
 
-    for (const auto &[name, blob] : seeds) {
-        const std::string path = std::string(argv[1]) + "/" + name;
-        std::FILE *f = std::fopen(path.c_str(), "wb");
-        if (!f || std::fwrite(blob.bytes.data(), 1, blob.bytes.size(), f) != blob.bytes.size() ||
-            std::fclose(f) != 0) {
-            std::fprintf(stderr, "cannot write %s\n", path.c_str());
-            return 1;
-        }
-    }
-    std::printf("wrote %zu seeds to %s\n", seeds.size(), argv[1]);
-    return 0;
+    return hairis::fuzz::write_seeds(folder, seeds);
 }

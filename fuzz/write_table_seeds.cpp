@@ -28,6 +28,7 @@
 #include "tables/bake.h"
 #include "tables/table_file.h"
 #include "table_image.h"
+#include "seed_writer.h"
 
 namespace {
 
@@ -240,11 +241,9 @@ std::shared_ptr<const NearFieldData> near_part(const Chiang &c, int nodes, int c
 }  // namespace
 
 int main(int argc, char **argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
-        return 2;
-    }
-    std::vector<std::pair<std::string, Bytes>> seeds;
+    const char *folder = hairis::fuzz::seed_folder(argc, argv);
+    if (!folder) return 2;
+    hairis::fuzz::Seeds seeds;
     auto add = [&](const std::string &name, Bytes b) { seeds.emplace_back(name, std::move(b)); };
 
     const Chiang chiang = cycles_default();
@@ -451,14 +450,5 @@ int main(int argc, char **argv) {
     add("huang_parts_without_multiple.exr", with_attribute(huang_multiple_file, "hairis:parts", "huang"));
     add("huang_parts_multiple_missing.exr", with_attribute(huang_file, "hairis:parts", "huang,multiple"));
 
-    for (const auto &[name, bytes] : seeds) {
-        const std::string path = std::string(argv[1]) + "/" + name;
-        std::FILE *f = std::fopen(path.c_str(), "wb");
-        if (!f || std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fclose(f) != 0) {
-            std::fprintf(stderr, "cannot write %s\n", path.c_str());
-            return 1;
-        }
-    }
-    std::printf("wrote %zu seeds to %s\n", seeds.size(), argv[1]);
-    return 0;
+    return hairis::fuzz::write_seeds(folder, seeds);
 }

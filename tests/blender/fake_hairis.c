@@ -505,24 +505,25 @@ void hairis_fiber_destroy(hairis_fiber *fiber)
     clear_error();
 }
 
-const char *hairis_fiber_model(const hairis_fiber *fiber)
+/* A string of a handle, as the library's getters return it: "" and an error for a NULL handle. */
+static const char *handle_string(const void *handle, const char *name, const char *s)
 {
-    if (!fiber) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
+    if (!handle) {
+        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "%s must not be NULL", name);
         return "";
     }
     clear_error();
-    return fiber->model;
+    return s;
+}
+
+const char *hairis_fiber_model(const hairis_fiber *fiber)
+{
+    return handle_string(fiber, "fiber", fiber ? fiber->model : "");
 }
 
 const char *hairis_fiber_parameters(const hairis_fiber *fiber)
 {
-    if (!fiber) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "fiber must not be NULL");
-        return "";
-    }
-    clear_error();
-    return fiber->parameters;
+    return handle_string(fiber, "fiber", fiber ? fiber->parameters : "");
 }
 
 /* The fake's f·|cos θ_i|: grey, 0.1 cos θ_i, fading with |h|. */
@@ -703,24 +704,20 @@ void hairis_tables_destroy(hairis_tables *tables)
     clear_error();
 }
 
-static const char *tables_string(const hairis_tables *t, const char *s)
+const char *hairis_tables_model(const hairis_tables *t)
 {
-    if (!t) {
-        fail(HAIRIS_ERROR_INVALID_ARGUMENT, "tables must not be NULL");
-        return "";
-    }
-    clear_error();
-    return s;
+    return handle_string(t, "tables", t ? t->model : "");
 }
-
-const char *hairis_tables_model(const hairis_tables *t) { return tables_string(t, t ? t->model : ""); }
 
 const char *hairis_tables_parameters(const hairis_tables *t)
 {
-    return tables_string(t, t ? t->parameters : "");
+    return handle_string(t, "tables", t ? t->parameters : "");
 }
 
-const char *hairis_tables_info(const hairis_tables *t) { return tables_string(t, t ? t->info : ""); }
+const char *hairis_tables_info(const hairis_tables *t)
+{
+    return handle_string(t, "tables", t ? t->info : "");
+}
 
 int hairis_tables_match_fiber(const hairis_tables *t, const hairis_fiber *f)
 {
