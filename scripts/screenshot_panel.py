@@ -165,23 +165,26 @@ def setup():
     show_tab("RENDER")
 
 
+def save_tab(name):
+    """Screenshots the Properties editor as <name>_full.png and its panels down to the last open
+    one as panel_<name>.png."""
+    pixels = screenshot(properties_area(),
+                        os.path.join(ARGS.keep or ARGS.workdir, name + "_full.png"))
+    save_crop(pixels, 0, last_open_panel_end(pixels),
+              os.path.join(ARGS.output, "panel_%s.png" % name))
+
+
 @STEPS.add
 def render_tab():
     """Screenshots the Render tab: down to Hair Sampling Strategy and the library status."""
-    pixels = screenshot(properties_area(),
-                        os.path.join(ARGS.keep or ARGS.workdir, "render_full.png"))
-    save_crop(pixels, 0, last_open_panel_end(pixels),
-              os.path.join(ARGS.output, "panel_render.png"))
+    save_tab("render")
     show_tab("MATERIAL")
 
 
 @STEPS.add
 def material_tab():
     """Screenshots the Material tab: slots, Surface node view, Hairis Sampling Tables."""
-    pixels = screenshot(properties_area(),
-                        os.path.join(ARGS.keep or ARGS.workdir, "material_full.png"))
-    save_crop(pixels, 0, last_open_panel_end(pixels),
-              os.path.join(ARGS.output, "panel_material.png"))
+    save_tab("material")
 
 
 @STEPS.add

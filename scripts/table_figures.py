@@ -30,6 +30,13 @@ def positive_norm(data):
     return LogNorm(vmin=bottom, vmax=top)
 
 
+def save(fig, d, name, title):
+    """Gives the figure its title and writes it to ``d`` as <name>.png."""
+    fig.suptitle(title, fontsize=10)
+    fig.savefig(os.path.join(d, name + ".png"), dpi=110)
+    plt.close(fig)
+
+
 def draw_far(d, label):
     far = np.load(os.path.join(d, "table_far.npy"))
     nodes = np.degrees(np.load(os.path.join(d, "table_theta_r.npy")))
@@ -44,10 +51,8 @@ def draw_far(d, label):
         ax.set_xlabel("φ = φ_i − φ_o (°)", fontsize=8)
     axes[0][0].set_ylabel("θ_i (°)", fontsize=8)
     fig.colorbar(image, ax=axes[0].tolist(), fraction=0.02)
-    fig.suptitle("far part, R: direct-scattering distribution f·cos θ_i per sr — " + label,
-                 fontsize=10)
-    fig.savefig(os.path.join(d, "table_far.png"), dpi=110)
-    plt.close(fig)
+    save(fig, d, "table_far",
+         "far part, R: direct-scattering distribution f·cos θ_i per sr — " + label)
 
 
 def draw_multiple(d, label):
@@ -63,9 +68,8 @@ def draw_multiple(d, label):
         ax.set_xlabel("θ_r (°)", fontsize=8)
         fig.colorbar(image, ax=ax, fraction=0.05)
     axes[0][0].set_ylabel("θ_i (°)", fontsize=8)
-    fig.suptitle("far part, G: multiple-scattering distribution per sr — " + label, fontsize=10)
-    fig.savefig(os.path.join(d, "table_multiple.png"), dpi=110)
-    plt.close(fig)
+    save(fig, d, "table_multiple",
+         "far part, G: multiple-scattering distribution per sr — " + label)
 
 
 def draw_near(d, label):
@@ -86,10 +90,8 @@ def draw_near(d, label):
         ax.set_xlabel("θ_o (°)", fontsize=8)
         fig.colorbar(image, ax=ax, fraction=0.05)
     axes[0].set_ylabel("θ_i (°)", fontsize=8)
-    fig.suptitle("near part: each lobe's M_p·cos θ_i density over θ_i per θ_o node — " + label,
-                 fontsize=10)
-    fig.savefig(os.path.join(d, "table_near.png"), dpi=110)
-    plt.close(fig)
+    save(fig, d, "table_near",
+         "near part: each lobe's M_p·cos θ_i density over θ_i per θ_o node — " + label)
 
 
 def draw_huang(d, label):
@@ -115,9 +117,7 @@ def draw_huang(d, label):
             ax.set_xlabel("φ_i − φ_o (deg)")
             ax.set_ylabel("θ_i (deg)")
     fig.colorbar(image, ax=axes, shrink=0.8, label="density per sr")
-    fig.suptitle("huang part: the density TABLE samples per view node — " + label, fontsize=10)
-    fig.savefig(os.path.join(d, "table_huang.png"), dpi=110)
-    plt.close(fig)
+    save(fig, d, "table_huang", "huang part: the density TABLE samples per view node — " + label)
 
 
 def main():

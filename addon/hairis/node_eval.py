@@ -522,32 +522,29 @@ def _mix_node(node, output, stack):
         a, b = (_in(node, n, 3, stack) for n in ("A_Vector", "B_Vector"))
         return combine(lambda t_, a_, b_: _mix(factor_of(t_), a_, b_), t, a, b, components=3)
     if kind == "RGBA":
-        blend = _blend(node, node.blend_type)
-        clamp_result = bool(getattr(node, "clamp_result", False))
-        t = _in(node, "Factor_Float", 1, stack)
-        a, b = (_in(node, n, 3, stack) for n in ("A_Color", "B_Color"))
-
-        def run(t_, a_, b_):
-            with np.errstate(all="ignore"):
-                result = blend(factor_of(t_), a_, b_)
-            return np.clip(result, 0.0, 1.0) if clamp_result else result
-
-        return combine(run, t, a, b, components=3)
+        return _mix_colors(node, stack, ("Factor_Float", "A_Color", "B_Color"), factor_of,
+                           bool(getattr(node, "clamp_result", False)))
     raise Unsupported(node, "with data type %s is not supported" % kind)
 
 
-def _mix_rgb(node, output, stack):
+def _mix_colors(node, stack, inputs, factor_of, clamp_result):
+    """The node's blend mode applied to its (factor, colour, colour) ``inputs``, the factor
+    through ``factor_of``, the result clamped to [0, 1] when ``clamp_result``."""
     blend = _blend(node, node.blend_type)
-    use_clamp = bool(getattr(node, "use_clamp", False))
-    t = _in(node, "Fac", 1, stack)
-    a, b = (_in(node, n, 3, stack) for n in ("Color1", "Color2"))
+    t = _in(node, inputs[0], 1, stack)
+    a, b = (_in(node, n, 3, stack) for n in inputs[1:])
 
     def run(t_, a_, b_):
         with np.errstate(all="ignore"):
-            result = blend(np.clip(t_, 0.0, 1.0), a_, b_)
-        return np.clip(result, 0.0, 1.0) if use_clamp else result
+            result = blend(factor_of(t_), a_, b_)
+        return np.clip(result, 0.0, 1.0) if clamp_result else result
 
     return combine(run, t, a, b, components=3)
+
+
+def _mix_rgb(node, output, stack):
+    return _mix_colors(node, stack, ("Fac", "Color1", "Color2"),
+                       lambda t: np.clip(t, 0.0, 1.0), bool(getattr(node, "use_clamp", False)))
 
 
 def _rgb_mode(node):

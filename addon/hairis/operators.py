@@ -111,35 +111,35 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         name="Force", description="Bake even when the tables are current", default=False)
 
     def _prepare(self, context):
+        """(library, jobs, bake options), or the operator's result when there is nothing to
+        bake."""
         problem = compat.version_problem()
         if problem:
             self.report({"ERROR"}, problem)
-            return None, None
+            return {"CANCELLED"}
         try:
             library = native.load_library()
         except native.LibraryUnavailable as error:
             self.report({"ERROR"}, str(error))
-            return None, None
+            return {"CANCELLED"}
         jobs, messages = collect_jobs(library, self.material, self.force)
         for level, text in messages:
             self.report({level}, text)
         if any(level == "ERROR" for level, _ in messages) and not jobs:
-            return None, None
+            return {"CANCELLED"}
         if not jobs:
             self.report({"INFO"}, "sampling tables are current")
-            return library, []
+            return {"FINISHED"}
         settings = context.scene.hairis
         options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads)
-        return library, (jobs, options)
+        return library, jobs, options
 
     def execute(self, context):
         """Bakes synchronously, with the window manager's progress indicator."""
-        library, work = self._prepare(context)
-        if library is None:
-            return {"CANCELLED"}
-        if not work:
-            return {"FINISHED"}
-        jobs, options = work
+        prepared = self._prepare(context)
+        if isinstance(prepared, set):
+            return prepared
+        library, jobs, options = prepared
         wm = context.window_manager
         wm.progress_begin(0.0, float(len(jobs)))
         failed = 0
@@ -167,12 +167,10 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         """Bakes in a worker thread while staying modal (Esc cancels)."""
         if context.window is None or bpy.app.background:
             return self.execute(context)
-        library, work = self._prepare(context)
-        if library is None:
-            return {"CANCELLED"}
-        if not work:
-            return {"FINISHED"}
-        jobs, options = work
+        prepared = self._prepare(context)
+        if isinstance(prepared, set):
+            return prepared
+        library, jobs, options = prepared
         self._jobs = jobs
         self._results = queue.Queue()
         self._cancel = threading.Event()

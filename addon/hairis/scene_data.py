@@ -8,6 +8,7 @@ import numpy as np
 
 from . import hair_mix
 from .hair_material import HairParameters
+from .surfaces import ImageData
 
 DEFAULT_ALBEDO = (0.8, 0.8, 0.8)
 """Cycles' default surface (no material): a 0.8 grey diffuse."""
@@ -104,16 +105,9 @@ class LightData:
 
 
 @dataclass
-class EnvironmentData:
+class EnvironmentData(ImageData):
     """A world whose Background Color is an Environment Texture (through a Mapping node)."""
 
-    image_name: str
-    path: str = None
-    """An image file the library reads, or None when ``pixels`` hold the image."""
-    pixels: np.ndarray = None
-    """(height, width, channels) floats, bottom row first, for packed or generated images."""
-    color_space: str = "linear"
-    """'linear' or 'srgb' (the image's colour space)."""
     matrix: np.ndarray = None
     """Row-major 4×4 world → texture map before the Mapping (Texture Coordinate Object)."""
     mapping: str = "point"

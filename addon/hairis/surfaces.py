@@ -94,8 +94,8 @@ NORMAL_INPUTS = ("Normal", "Clearcoat Normal", "Coat Normal", "Tangent")
 
 
 @dataclass
-class TextureData:
-    """An Image Texture node's image and sampling, as ``hairis_scene_add_texture`` takes it."""
+class ImageData:
+    """An image the library reads from a file or takes as pixels (textures and worlds)."""
 
     image_name: str
     path: str = None
@@ -103,6 +103,13 @@ class TextureData:
     pixels: np.ndarray = None
     """(height, width, channels) floats, bottom row first (packed, generated, edited images)."""
     color_space: str = "linear"
+    """'linear' or 'srgb' (the image's colour space)."""
+
+
+@dataclass
+class TextureData(ImageData):
+    """An Image Texture node's image and sampling, as ``hairis_scene_add_texture`` takes it."""
+
     interpolation: str = "linear"
     extension: str = "repeat"
     mapping: str = "none"

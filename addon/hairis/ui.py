@@ -105,6 +105,16 @@ def _wrap(text, width):
     return lines
 
 
+def draw_props(layout, data, names, active):
+    """Draws ``data``'s properties ``names`` in a sub-column, greyed out unless ``active``;
+    returns the sub-column."""
+    sub = layout.column()
+    sub.active = active
+    for name in names:
+        sub.prop(data, name)
+    return sub
+
+
 def engine_is_hairis(context):
     """True when the scene renders with Hairis."""
     return context.engine == ENGINE
@@ -123,44 +133,43 @@ class HairisPanel:
         return context.engine in cls.COMPAT_ENGINES
 
 
-class HAIRIS_RENDER_PT_sampling(HairisPanel, bpy.types.Panel):
+class RenderPanel(HairisPanel):
+    """Base of the Render tab's panels: split properties without decorators, as in Cycles."""
+
+    bl_context = "render"
+
+    def draw(self, context):
+        """Sets the layout up and draws the scene's Hairis settings (``draw_settings``)."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        self.draw_settings(layout, context.scene.hairis)
+
+
+class HAIRIS_RENDER_PT_sampling(RenderPanel, bpy.types.Panel):
     """Samples, seed and threads."""
 
     bl_label = "Sampling"
-    bl_context = "render"
 
-    def draw(self, context):
+    def draw_settings(self, layout, settings):
         """Draws the panel."""
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.hairis
         column = layout.column()
         column.prop(settings, "integrator")
-        sub = column.column()
-        sub.active = settings.integrator == "DUAL_SCATTERING"
-        sub.prop(settings, "dual_hair_volume")
-        sub.prop(settings, "dual_exact_bounces")
-        sub.prop(settings, "dual_bounce_limit")
-        column.prop(settings, "seed")
-        column.prop(settings, "max_bounces")
-        column.prop(settings, "max_transparent_bounces")
-        column.prop(settings, "threads")
+        draw_props(column, settings, ("dual_hair_volume", "dual_exact_bounces",
+                                      "dual_bounce_limit"),
+                   settings.integrator == "DUAL_SCATTERING")
+        for name in ("seed", "max_bounces", "max_transparent_bounces", "threads"):
+            column.prop(settings, name)
 
 
-class HAIRIS_RENDER_PT_sampling_render(HairisPanel, bpy.types.Panel):
+class HAIRIS_RENDER_PT_sampling_render(RenderPanel, bpy.types.Panel):
     """F12's adaptive sampling, time limit and denoising, with Cycles' names and meanings."""
 
     bl_label = "Render"
-    bl_context = "render"
     bl_parent_id = "HAIRIS_RENDER_PT_sampling"
 
-    def draw(self, context):
+    def draw_settings(self, layout, settings):
         """Draws the panel."""
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.hairis
         heading = layout.column(align=True, heading="Noise Threshold")
         row = heading.row(align=True)
         row.prop(settings, "use_adaptive_sampling", text="")
@@ -182,46 +191,32 @@ class HAIRIS_RENDER_PT_sampling_render(HairisPanel, bpy.types.Panel):
             layout.label(text="This Blender was built without OpenImageDenoise", icon="INFO")
 
 
-class HAIRIS_RENDER_PT_sampling_viewport(HairisPanel, bpy.types.Panel):
+class HAIRIS_RENDER_PT_sampling_viewport(RenderPanel, bpy.types.Panel):
     """The viewport's sample count."""
 
     bl_label = "Viewport"
-    bl_context = "render"
     bl_parent_id = "HAIRIS_RENDER_PT_sampling"
 
-    def draw(self, context):
+    def draw_settings(self, layout, settings):
         """Draws the panel."""
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        layout.prop(context.scene.hairis, "preview_samples", text="Max Samples")
+        layout.prop(settings, "preview_samples", text="Max Samples")
 
 
-class HAIRIS_RENDER_PT_strategy(HairisPanel, bpy.types.Panel):
+class HAIRIS_RENDER_PT_strategy(RenderPanel, bpy.types.Panel):
     """The hair sampling strategy and its tables."""
 
     bl_label = "Hair Sampling Strategy"
-    bl_context = "render"
 
-    def draw(self, context):
+    def draw_settings(self, layout, settings):
         """Draws the panel."""
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.hairis
         column = layout.column()
         column.prop(settings, "strategy")
-        sub = column.column()
         # Dual Scattering samples Huang with the strategy (its MIS needs the sampler's density).
-        sub.active = settings.integrator != "DUAL_SCATTERING"
-        sub.prop(settings, "huang_sampling")
-        sub = column.column()
-        sub.active = settings.strategy in {"TABLE", "GAUSSIAN"}
-        sub.prop(settings, "multiple_weight")
-        sub.prop(settings, "n_h")
-        sub = column.column()
-        sub.active = settings.needs_tables
-        sub.prop(settings, "auto_bake")
+        draw_props(column, settings, ("huang_sampling",),
+                   settings.integrator != "DUAL_SCATTERING")
+        draw_props(column, settings, ("multiple_weight", "n_h"),
+                   settings.strategy in {"TABLE", "GAUSSIAN"})
+        sub = draw_props(column, settings, ("auto_bake",), settings.needs_tables)
         sub.operator("hairis.bake_tables", icon="RENDER_STILL")
         layout.separator()
         draw_library_status(layout)
@@ -279,25 +274,33 @@ class HAIRIS_PT_context_material(HairisPanel, bpy.types.Panel):
             layout.template_ID(space, "pin_id")
 
 
-class HAIRIS_MATERIAL_PT_surface(HairisPanel, bpy.types.Panel):
-    """The material's surface node tree (Cycles nodes)."""
+class SurfacePanel(HairisPanel):
+    """Base of the Surface panels: the node tree of the ``bl_context`` data block (material or
+    world), or its ``plain_color`` property when it uses no nodes."""
 
     bl_label = "Surface"
+    plain_color = ""
+
+    def draw(self, context):
+        """Draws the node view, or the plain colour without nodes."""
+        layout = self.layout
+        layout.use_property_split = True
+        id_data = getattr(context, self.bl_context)
+        if not draw_node_input(layout, id_data, "Surface"):
+            layout.prop(id_data, self.plain_color)
+
+
+class HAIRIS_MATERIAL_PT_surface(SurfacePanel, bpy.types.Panel):
+    """The material's surface node tree (Cycles nodes)."""
+
     bl_context = "material"
+    plain_color = "diffuse_color"
 
     @classmethod
     def poll(cls, context):
         """Materials that are not grease pencil."""
         material = context.material
         return material and not material.grease_pencil and engine_is_hairis(context)
-
-    def draw(self, context):
-        """Draws the node view."""
-        layout = self.layout
-        layout.use_property_split = True
-        material = context.material
-        if not draw_node_input(layout, material, "Surface"):
-            layout.prop(material, "diffuse_color")
 
 
 class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
@@ -342,24 +345,16 @@ class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
         rebake.force = True
 
 
-class HAIRIS_WORLD_PT_surface(HairisPanel, bpy.types.Panel):
+class HAIRIS_WORLD_PT_surface(SurfacePanel, bpy.types.Panel):
     """The world's surface node tree (a Background node)."""
 
-    bl_label = "Surface"
     bl_context = "world"
+    plain_color = "color"
 
     @classmethod
     def poll(cls, context):
         """Scenes with a world."""
         return context.world and engine_is_hairis(context)
-
-    def draw(self, context):
-        """Draws the node view, or the world colour without nodes."""
-        layout = self.layout
-        layout.use_property_split = True
-        world = context.world
-        if not draw_node_input(layout, world, "Surface"):
-            layout.prop(world, "color")
 
 
 class HAIRIS_LIGHT_PT_light(HairisPanel, bpy.types.Panel):

@@ -52,6 +52,17 @@ def parse_args():
     return parser.parse_args(argv)
 
 
+def assert_raises(kind, call, text, failure):
+    """Asserts that ``call()`` raises ``kind`` with ``text`` in its message (``failure`` says
+    what went wrong when it raises nothing); returns the error."""
+    try:
+        call()
+    except kind as error:
+        assert text in str(error), error
+        return error
+    raise AssertionError(failure)
+
+
 def result(outcome):
     """Prints the result line run_test.py reads (PASSED, FAILED or SKIPPED)."""
     print(RESULT_PREFIX + outcome, flush=True)
@@ -152,6 +163,15 @@ def bundled_library(package):
     return os.path.join(os.path.dirname(package.__file__), "lib", "libhairis.so")
 
 
+def require_library(package, override=None):
+    """The library to render with (``override``, else the one bundled in ``package``); ends the
+    test as skipped while it does not exist."""
+    path = override or bundled_library(package)
+    if not os.path.isfile(path):
+        skip("libhairis.so is not built yet (looked for %s)" % path)
+    return path
+
+
 def use_library(path):
     """Points the add-on at ``path`` through HAIRIS_LIBRARY ('' or None: the bundled one)."""
     if path:
@@ -197,6 +217,12 @@ def run(tests):
 
 
 # ---- Scenes ----------------------------------------------------------------------------------
+
+def configure(target, **values):
+    """Sets each of ``values`` on ``target`` (particle settings, engine settings)."""
+    for name, value in values.items():
+        setattr(target, name, value)
+
 
 def reset():
     """An empty file (the add-on stays enabled)."""
@@ -424,6 +450,22 @@ def make_test_scene(children=None, with_curves=True):
     return scene
 
 
+def make_sphere_and_curves(resolution):
+    """A small Hairis scene: Curves in front of a sphere under a sun and a sky, seen at
+    ``resolution``."""
+    scene = reset()
+    scene.render.engine = "HAIRIS"
+    make_camera(scene, location=(0.0, -3.2, 0.0), resolution=resolution, percentage=100)
+    make_world(scene, color=(0.4, 0.5, 0.7), strength=1.0)
+    hair = make_hair_material("Hair", "MELANIN", **{"Melanin": 0.3, "Roughness": 0.3})
+    skin = make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
+    make_curves(scene, hair, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), scale=1.6)
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(0.0, 1.0, 0.0))
+    bpy.context.view_layer.objects.active.data.materials.append(skin)
+    make_light(scene, "SUN", "Sun", energy=3.0, angle=0.05, rotation=(0.6, 0.3, 0.0))
+    return scene
+
+
 # ---- Hairis against Cycles -------------------------------------------------------------------
 
 def make_diffuse_material(name, color):
@@ -466,6 +508,19 @@ def match_engines(scene, samples, bounces):
     settings.max_bounces = bounces
     settings.threads = 0
     bpy.context.view_layer.update()
+
+
+def use_table(scene, bounces, threads=0):
+    """Hairis at TABLE with Auto Bake and ``bounces``; ``threads`` above 0 fixes both engines'
+    thread count, so that timings compare like with like."""
+    settings = scene.hairis
+    settings.max_bounces = bounces
+    settings.strategy = "TABLE"
+    settings.auto_bake = True
+    if threads:
+        settings.threads = threads
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = threads
 
 
 def set_samples(scene, samples):
@@ -685,9 +740,17 @@ def render_pixels(scene, engine, seed, workdir, name=None, alpha=False):
     return pixels.reshape(height, width, 4)[..., :4 if alpha else 3].astype(np.float64), seconds
 
 
-COMPARE_SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
-COMPARE_SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
+def compare_counts(prefix="HAIRIS_COMPARE", samples=32, seeds=8):
+    """A comparison's (samples per image, images per engine): the defaults given, each replaced
+    by ``<prefix>_SAMPLES`` and ``<prefix>_SEEDS`` when set."""
+    return (int(os.environ.get(prefix + "_SAMPLES", samples)),
+            int(os.environ.get(prefix + "_SEEDS", seeds)))
+
+
+COMPARE_SAMPLES, COMPARE_SEEDS = compare_counts()
 """Samples per image and images per engine of the comparisons (environment overrides)."""
+COMPARE_BOUNCES, COMPARE_BLOCK = 4, 4
+"""The comparisons' bounce limit and the side of the pixel blocks compare_stats compares."""
 ENGINES = ("CYCLES", "HAIRIS")
 
 
@@ -695,8 +758,7 @@ def setup_compare():
     """:func:`setup` for a test that renders with libhairis (skipped while it is not built);
     returns the arguments."""
     args, package = setup()
-    if not os.path.isfile(bundled_library(package)):
-        skip("libhairis.so is not built yet (looked for %s)" % bundled_library(package))
+    require_library(package)
     return args
 
 
@@ -783,6 +845,18 @@ def make_textured_principled(name, path, pixels, **inputs):
     texture.image = bpy.data.images.load(path)
     tree.links.new(texture.outputs["Color"], socket(node, "Base Color"))
     return material, node
+
+
+def link_hair_random(tree, node, name, low, high):
+    """Feeds ``node``'s input ``name`` from Hair Info Random through a Map Range onto
+    ``low``..``high``; returns the Map Range node."""
+    info = tree.nodes.new("ShaderNodeHairInfo")
+    remap = tree.nodes.new("ShaderNodeMapRange")
+    socket(remap, "To Min").default_value = low
+    socket(remap, "To Max").default_value = high
+    tree.links.new(info.outputs["Random"], socket(remap, "Value"))
+    tree.links.new(remap.outputs["Result"], socket(node, name))
+    return remap
 
 
 def vary_melanin(material, random_color=0.6, random_roughness=0.3):
@@ -893,11 +967,23 @@ class RecordingLayout:
         return [entry[1] for entry in self.log if entry[0] == "label"]
 
 
+class PanelStandIn:
+    """A panel instance's stand-in: its class's attributes and methods, and a RecordingLayout."""
+
+    def __init__(self, panel_class):
+        self.panel_class = panel_class
+        self.layout = RecordingLayout()
+
+    def __getattr__(self, name):
+        value = getattr(self.panel_class, name)
+        return types.MethodType(value, self) if isinstance(value, types.FunctionType) else value
+
+
 def draw_panel(panel_class, context):
-    """Runs a panel's draw() on a RecordingLayout; returns the layout."""
-    layout = RecordingLayout()
-    panel_class.draw(types.SimpleNamespace(layout=layout), context)
-    return layout
+    """Runs a panel's draw() on a :class:`PanelStandIn`; returns the layout."""
+    panel = PanelStandIn(panel_class)
+    panel_class.draw(panel, context)
+    return panel.layout
 
 
 def vector(values):

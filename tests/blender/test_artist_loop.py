@@ -3,6 +3,7 @@ settings, Render Region, passes, the compositor's Denoise and the viewport's wor
 Skipped (exit 77) until the library is built into the zip.
 """
 
+import contextlib
 import os
 import sys
 import types
@@ -14,9 +15,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
-LIBRARY_PATH = helpers.bundled_library(PACKAGE)
-if not os.path.isfile(LIBRARY_PATH):
-    helpers.skip("libhairis.so is not built yet (looked for %s)" % LIBRARY_PATH)
+helpers.require_library(PACKAGE)
 helpers.use_library(None)
 native = helpers.module("native")
 engine = helpers.module("engine")
@@ -28,17 +27,7 @@ WAIT = 120.0  # seconds a test waits for the worker before it fails
 
 def make_scene(samples=64, resolution=(48, 36)):
     """Curves in front of a sphere under a sun and a sky, ANALYTIC (no tables to bake)."""
-    scene = helpers.reset()
-    scene.render.engine = "HAIRIS"
-    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=resolution, percentage=100)
-    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=1.0)
-    hair = helpers.make_hair_material("Hair", "MELANIN", **{"Melanin": 0.3, "Roughness": 0.3})
-    skin = helpers.make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    helpers.make_curves(scene, hair, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0),
-                        scale=1.6)
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(0.0, 1.0, 0.0))
-    bpy.context.view_layer.objects.active.data.materials.append(skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=0.05, rotation=(0.6, 0.3, 0.0))
+    scene = helpers.make_sphere_and_curves(resolution)
     settings = scene.hairis
     settings.strategy = "ANALYTIC"
     settings.samples = samples
@@ -64,6 +53,17 @@ def pass_pixels(render_pass):
         values = values.reshape(-1, render_pass.channels)
         render_pass.rect.foreach_get(values)
     return values.reshape(-1, render_pass.channels)
+
+
+@contextlib.contextmanager
+def replaced(name, value):
+    """Sets the engine class's attribute ``name`` to ``value`` for the block."""
+    original = getattr(Engine, name)
+    setattr(Engine, name, value)
+    try:
+        yield
+    finally:
+        setattr(Engine, name, original)
 
 
 class Recorder:
@@ -113,12 +113,8 @@ def test_f12_refines_on_screen():
     assert done == sorted(done) and len(set(done)) == len(done), done
     # An early image differs from the final one (it has fewer samples).
     assert not np.array_equal(early[0][2], shows.calls[-1][2])
-    Engine.display_updates = False
-    try:
-        with Recorder("_show", show_record) as quiet:
-            once = f12(scene, "once")
-    finally:
-        Engine.display_updates = True
+    with replaced("display_updates", False), Recorder("_show", show_record) as quiet:
+        once = f12(scene, "once")
     assert quiet.calls == []
     np.testing.assert_array_equal(progressive, once)
     np.testing.assert_array_equal(progressive, shows.calls[-1][2][..., :3])
@@ -159,13 +155,8 @@ def test_cancel_keeps_partial_image():
         calls.append(1)
         return len(calls) > 3
 
-    original = Engine.stop_requested
-    Engine.stop_requested = stop_requested
-    try:
-        with Recorder("_show", show_record) as shows:
-            pixels = f12(scene, "cancelled")
-    finally:
-        Engine.stop_requested = original
+    with replaced("stop_requested", stop_requested), Recorder("_show", show_record) as shows:
+        pixels = f12(scene, "cancelled")
     assert shows.calls and shows.calls[-1][0] < 1 << 20
     assert np.all(np.isfinite(pixels)) and pixels[..., :3].mean() > 0.05, pixels.mean()
 

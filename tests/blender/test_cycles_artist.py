@@ -25,8 +25,7 @@ import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
 SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
-BOUNCES = 4
-BLOCK = 4
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 STRANDS = 1500
 SCALP_Z = 0.2
 """Hair grows where the head's undeformed vertices have z above this (the sphere's radius is 1),

@@ -24,8 +24,7 @@ import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
 SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
-BOUNCES = 4
-BLOCK = 4
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
 EXTRA_HAIR = ()
 """Functions of the scene adding more hair (other models' materials) to the comparison."""

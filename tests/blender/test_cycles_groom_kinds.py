@@ -24,10 +24,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
-SEEDS = int(os.environ.get("HAIRIS_GROOM_KINDS_SEEDS", "6"))
-SAMPLES = int(os.environ.get("HAIRIS_GROOM_KINDS_SAMPLES", "16"))
-BOUNCES = 4
-BLOCK = 4
+SAMPLES, SEEDS = helpers.compare_counts("HAIRIS_GROOM_KINDS", samples=16, seeds=6)
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 
 
 def add_radius_modifier(obj):
@@ -79,21 +77,13 @@ def make_scene():
     skin = helpers.make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
     simple = helpers.make_particle_hair(scene, count=120, location=(-0.8, 0.3, 0.2), scale=0.45,
                                         hair_material=brown, skin_material=skin)
-    settings = simple.modifiers["Hair"].particle_system.settings
-    settings.child_type = "SIMPLE"
-    settings.rendered_child_count = 12
-    settings.child_radius = 0.15
-    settings.clump_factor = 0.6
-    settings.roughness_1 = 0.05
-    settings.kink = "CURL"
-    settings.kink_amplitude = 0.04
-    settings.kink_frequency = 3.0
+    helpers.configure(simple.modifiers["Hair"].particle_system.settings, child_type="SIMPLE",
+                      rendered_child_count=12, child_radius=0.15, clump_factor=0.6,
+                      roughness_1=0.05, kink="CURL", kink_amplitude=0.04, kink_frequency=3.0)
     braided = helpers.make_particle_hair(scene, count=150, children=8, location=(0.1, 0.6, -0.5),
                                          scale=0.45, hair_material=red, skin_material=skin)
-    settings = braided.modifiers["Hair"].particle_system.settings
-    settings.kink = "BRAID"
-    settings.kink_amplitude = 0.05
-    settings.clump_factor = -0.3
+    helpers.configure(braided.modifiers["Hair"].particle_system.settings, kink="BRAID",
+                      kink_amplitude=0.05, clump_factor=-0.3)
     if helpers.VERSION >= (4, 0, 0):
         curls = helpers.make_fresh_curves(scene, "Curls", blond, 90, 8, 0.006, 4, (0.7, 0.0, -0.3),
                                           0.3)

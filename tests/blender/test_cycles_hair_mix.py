@@ -24,10 +24,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
-SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "16"))
-SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "5"))
-BOUNCES = 4
-BLOCK = 4
+SAMPLES, SEEDS = helpers.compare_counts(samples=16, seeds=5)
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 GREY = {"Melanin": 0.1, "Melanin Redness": 0.0, "Roughness": 0.35, "Radial Roughness": 0.4}
 
 

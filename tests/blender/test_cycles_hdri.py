@@ -23,8 +23,7 @@ import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
 SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
-BOUNCES = 4
-BLOCK = 4
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 HDRI_SIZE = (64, 32)
 SUN = (44, 9)
 """The hot spot's top-left texel (x, y from the top): above the horizon."""

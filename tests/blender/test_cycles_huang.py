@@ -40,13 +40,9 @@ import helpers  # noqa: E402
 ARGS, PACKAGE = helpers.setup()
 if helpers.VERSION < (4, 0, 0):
     helpers.skip("Blender %s has no Huang model" % bpy.app.version_string)
-if not os.path.isfile(helpers.bundled_library(PACKAGE)):
-    helpers.skip("libhairis.so is not built yet (looked for %s)"
-                 % helpers.bundled_library(PACKAGE))
-SAMPLES = int(os.environ.get("HAIRIS_COMPARE_SAMPLES", "32"))
-SEEDS = int(os.environ.get("HAIRIS_COMPARE_SEEDS", "8"))
-BOUNCES = 4
-BLOCK = 4
+helpers.require_library(PACKAGE)
+SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 
 
 def make_scene(huang_sampling):
@@ -65,6 +61,13 @@ def render_stack(scene, engine):
     return np.stack(images), seconds
 
 
+def render_table(scene):
+    """Hairis' SEEDS renders at TABLE with Auto Bake (:func:`render_stack`)."""
+    scene.hairis.strategy = "TABLE"
+    scene.hairis.auto_bake = True
+    return render_stack(scene, "HAIRIS")
+
+
 def test_hairis_matches_cycles_on_huang_hair():
     """Cycles' Huang image is Hairis' with Cycles' Huang sampling, within the noise: with the
     tables' baked f on light samples (the add-on's defaults: Table, Auto Bake) and with Cycles'
@@ -72,9 +75,7 @@ def test_hairis_matches_cycles_on_huang_hair():
     scene = make_scene("CYCLES")
     cycles, cycles_time = render_stack(scene, "CYCLES")
     no_tables, no_tables_time = render_stack(scene, "HAIRIS")
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
-    hairis, hairis_time = render_stack(scene, "HAIRIS")
+    hairis, hairis_time = render_table(scene)
     print("render time for %d x %d samples: hairis (cycles sampling, baked f; bakes included) "
           "%.1f s, hairis (cycles sampling, cycles eval) %.1f s"
           % (SEEDS, SAMPLES, hairis_time, no_tables_time))
@@ -85,9 +86,7 @@ def test_hairis_matches_cycles_on_huang_hair():
     scene.hairis.strategy = "UNIFORM"
     scene.hairis.huang_sampling = "STRATEGY"
     eval_image, eval_time = render_stack(scene, "HAIRIS")
-    scene.hairis.strategy = "TABLE"
-    scene.hairis.auto_bake = True
-    table_image, table_time = render_stack(scene, "HAIRIS")
+    table_image, table_time = render_table(scene)
     print("render time for %d x %d samples: cycles %.1f s, hairis (cycles sampling) %.1f s, "
           "hairis (uniform, eval) %.1f s, hairis (table, eval; bakes included) %.1f s"
           % (SEEDS, SAMPLES, cycles_time, hairis_time, eval_time, table_time))
@@ -141,12 +140,7 @@ def vary_per_strand(scene):
     node.parametrization = "MELANIN"
     helpers.socket(node, "Melanin").default_value = 0.95
     helpers.socket(node, "Melanin Redness").default_value = 0.6
-    info = blond.nodes.new("ShaderNodeHairInfo")
-    remap = blond.nodes.new("ShaderNodeMapRange")
-    helpers.socket(remap, "To Min").default_value = 0.1
-    helpers.socket(remap, "To Max").default_value = 0.6
-    blond.links.new(info.outputs["Random"], helpers.socket(remap, "Value"))
-    blond.links.new(remap.outputs["Result"], helpers.socket(node, "Melanin"))
+    helpers.link_hair_random(blond, node, "Melanin", 0.1, 0.6)
     dark = bpy.data.materials["Dark"].node_tree.nodes["Principled Hair BSDF"]
     helpers.socket(dark, "Random Roughness").default_value = 0.5
     bpy.context.view_layer.update()

@@ -29,8 +29,7 @@ import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
 SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
-BOUNCES = 4
-BLOCK = 4
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 STRATEGY = os.environ.get("HAIRIS_COMPARE_STRATEGY", "TABLE")
 
 
@@ -51,13 +50,7 @@ def make_scene():
 
     dyed = bpy.data.materials["Dyed"]
     tree = dyed.node_tree
-    node = tree.nodes["Principled Hair BSDF"]
-    info = tree.nodes.new("ShaderNodeHairInfo")
-    remap = tree.nodes.new("ShaderNodeMapRange")
-    helpers.socket(remap, "To Min").default_value = 0.2
-    helpers.socket(remap, "To Max").default_value = 0.6
-    tree.links.new(info.outputs["Random"], helpers.socket(remap, "Value"))
-    tree.links.new(remap.outputs["Result"], helpers.socket(node, "Roughness"))
+    helpers.link_hair_random(tree, tree.nodes["Principled Hair BSDF"], "Roughness", 0.2, 0.6)
     bpy.context.view_layer.update()
     return scene
 

@@ -20,8 +20,7 @@ import helpers  # noqa: E402
 
 ARGS = helpers.setup_compare()
 SAMPLES, SEEDS = helpers.COMPARE_SAMPLES, helpers.COMPARE_SEEDS
-BOUNCES = 4
-BLOCK = 4
+BOUNCES, BLOCK = helpers.COMPARE_BOUNCES, helpers.COMPARE_BLOCK
 V4 = helpers.VERSION >= (4, 0, 0)
 
 

@@ -263,12 +263,8 @@ def test_camera_orthographic_and_scale():
     np.testing.assert_allclose(np.linalg.norm(camera.camera_to_world[:3, :3], axis=0), 1.0,
                                atol=1e-6)
     scene.camera.data.type = "PANO"
-    try:
-        export.export_context()
-    except export.ExportError as error:
-        assert "panoramic" in str(error)
-    else:
-        raise AssertionError("a panoramic camera must be refused")
+    helpers.assert_raises(export.ExportError, export.export_context, "panoramic",
+                          "a panoramic camera must be refused")
 
 
 def test_mesh():
@@ -743,12 +739,8 @@ def test_no_camera():
     """A scene without a camera is refused with ExportError."""
     scene = helpers.make_test_scene(with_curves=False)
     scene.camera = None
-    try:
-        export.export_context()
-    except export.ExportError as error:
-        assert "no camera" in str(error)
-    else:
-        raise AssertionError("export without a camera must fail")
+    helpers.assert_raises(export.ExportError, export.export_context, "no camera",
+                          "export without a camera must fail")
 
 
 def test_render_mode_export_through_engine():
@@ -765,11 +757,9 @@ def test_render_mode_export_through_engine():
     os.environ["HAIRIS_EXPORT_DUMP"] = dump
     helpers.use_library(os.path.join(ARGS.workdir, "missing", "libhairis.so"))
     try:
-        bpy.ops.render.render()
-    except RuntimeError as error:
-        assert "hairis native library not found at" in str(error), error
-    else:
-        raise AssertionError("rendering without the library must report an error")
+        helpers.assert_raises(RuntimeError, bpy.ops.render.render,
+                              "hairis native library not found at",
+                              "rendering without the library must report an error")
     finally:
         del os.environ["HAIRIS_EXPORT_DUMP"]
         helpers.use_library(None)
@@ -909,12 +899,7 @@ def test_map_range_of_hair_random_into_roughness():
     of the same per-strand random that feeds an unlinked Random."""
     helpers.make_test_scene(with_curves=False)
     tree, node = _hair_tree()
-    info = tree.nodes.new("ShaderNodeHairInfo")
-    remap = tree.nodes.new("ShaderNodeMapRange")
-    helpers.socket(remap, "To Min").default_value = 0.15
-    helpers.socket(remap, "To Max").default_value = 0.6
-    tree.links.new(info.outputs["Random"], helpers.socket(remap, "Value"))
-    tree.links.new(remap.outputs["Result"], helpers.socket(node, "Roughness"))
+    remap = helpers.link_hair_random(tree, node, "Roughness", 0.15, 0.6)
     # A constant chain folds into the fiber: Value → Coat.
     value = tree.nodes.new("ShaderNodeValue")
     value.outputs[0].default_value = 0.45
@@ -1064,11 +1049,9 @@ def test_groom_memory_estimate():
     original = memory.available_memory_bytes
     memory.available_memory_bytes = lambda: need - 1
     try:
-        export.export_context()
-    except export.ExportError as error:
-        assert "%d object(s)" % len(exported.curves) in str(error), str(error)
-    else:
-        raise AssertionError("a groom above the available memory was exported")
+        helpers.assert_raises(export.ExportError, export.export_context,
+                              "%d object(s)" % len(exported.curves),
+                              "a groom above the available memory was exported")
     finally:
         memory.available_memory_bytes = original
 

@@ -32,9 +32,7 @@ import helpers  # noqa: E402
 import library_probe  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
-LIBRARY = helpers.bundled_library(PACKAGE)
-if not os.path.isfile(LIBRARY):
-    helpers.skip("libhairis.so is not built yet (looked for %s)" % LIBRARY)
+LIBRARY = helpers.require_library(PACKAGE)
 helpers.use_library(None)
 native = helpers.module("native")
 NATIVE_SOURCE = native.__file__

@@ -18,9 +18,7 @@ import helpers  # noqa: E402
 
 ARGS, PACKAGE = helpers.setup()
 OVERRIDE = os.environ.get("HAIRIS_TEST_LIBRARY", "")
-LIBRARY_PATH = OVERRIDE or helpers.bundled_library(PACKAGE)
-if not os.path.isfile(LIBRARY_PATH):
-    helpers.skip("libhairis.so is not built yet (looked for %s)" % LIBRARY_PATH)
+helpers.require_library(PACKAGE, OVERRIDE)
 helpers.use_library(OVERRIDE or None)
 native = helpers.module("native")
 engine = helpers.module("engine")
@@ -37,21 +35,11 @@ TILE = 8
 
 def make_scene():
     """A small, dense hair scene: Curves in front of the camera, a sphere, sun and sky."""
-    scene = helpers.reset()
-    scene.render.engine = "HAIRIS"
+    scene = helpers.make_sphere_and_curves((40, 32))
     # Every pixel gets every sample: the checks below count on fixed sample counts.
     scene.hairis.use_adaptive_sampling = False
     # Round tubes (3D Curves): the dual-scattering ratios below were measured on them.
     scene.cycles_curves.shape = "THICK"
-    helpers.make_camera(scene, location=(0.0, -3.2, 0.0), resolution=(40, 32), percentage=100)
-    helpers.make_world(scene, color=(0.4, 0.5, 0.7), strength=1.0)
-    hair = helpers.make_hair_material("Hair", "MELANIN", **{"Melanin": 0.3, "Roughness": 0.3})
-    skin = helpers.make_surface_material("Skin", (0.7, 0.5, 0.4, 1.0))
-    helpers.make_curves(scene, hair, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0),
-                        scale=1.6)
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(0.0, 1.0, 0.0))
-    bpy.context.view_layer.objects.active.data.materials.append(skin)
-    helpers.make_light(scene, "SUN", "Sun", energy=3.0, angle=0.05, rotation=(0.6, 0.3, 0.0))
     settings = scene.hairis
     settings.samples = SAMPLES
     settings.threads = 0

@@ -89,13 +89,10 @@ def test_render_refuses_unsupported_version():
     compat.running_version = lambda: (6, 1, 0)
     try:
         for call in (bpy.ops.render.render, bpy.ops.hairis.bake_tables):
-            try:
-                call()
-            except RuntimeError as error:
-                assert "Blender 6.1.0" in str(error) and "3.4 to 5.x" in str(error), error
-                assert "Traceback" not in str(error), error
-            else:
-                raise AssertionError("%s must refuse Blender 6.1.0" % call)
+            error = helpers.assert_raises(RuntimeError, call, "Blender 6.1.0",
+                                          "%s must refuse Blender 6.1.0" % call)
+            assert "3.4 to 5.x" in str(error), error
+            assert "Traceback" not in str(error), error
         layout = helpers.draw_panel(preferences.HairisPreferences, bpy.context)
         assert any("Blender 6.1.0" in label for label in layout.labels()), layout.labels()
     finally:
@@ -133,12 +130,9 @@ def test_library_status_message():
     assert not status.ok
     assert status.message == ("hairis native library not found at %s: no such file" % MISSING), \
         status.message
-    try:
-        native.load_library()
-    except native.LibraryUnavailable as error:
-        assert str(error) == status.message
-    else:
-        raise AssertionError("load_library must raise")
+    error = helpers.assert_raises(native.LibraryUnavailable, native.load_library, "",
+                                  "load_library must raise")
+    assert str(error) == status.message, error
 
 
 def test_preferences_and_panels_draw():
@@ -186,24 +180,17 @@ def test_render_reports_missing_library():
     """F12 with the library missing: an error naming it, Blender keeps running."""
     helpers.make_test_scene(with_curves=False)
     for _ in range(2):  # twice: a failed render must leave nothing behind
-        try:
-            bpy.ops.render.render()
-        except RuntimeError as error:
-            assert "hairis native library not found at %s" % MISSING in str(error), error
-        else:
-            raise AssertionError("the render must fail")
+        helpers.assert_raises(RuntimeError, bpy.ops.render.render,
+                              "hairis native library not found at %s" % MISSING,
+                              "the render must fail")
     assert bpy.context.scene.render.engine == "HAIRIS"
 
 
 def test_bake_operator_reports_missing_library():
     """The bake operator reports the missing library instead of raising a traceback."""
     helpers.make_test_scene(with_curves=False)
-    try:
-        bpy.ops.hairis.bake_tables()
-    except RuntimeError as error:
-        assert "hairis native library not found at" in str(error), error
-    else:
-        raise AssertionError("the bake must report an error")
+    helpers.assert_raises(RuntimeError, bpy.ops.hairis.bake_tables,
+                          "hairis native library not found at", "the bake must report an error")
 
 
 def test_disable_and_enable_again():

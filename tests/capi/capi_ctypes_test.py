@@ -37,12 +37,10 @@ except ImportError:  # pragma: no cover - reported as a skip
 
 OPTIONS = None  # parsed command line
 
-OK = 0
-ERROR_INVALID_ARGUMENT = 1
-ERROR_IO = 2
-ERROR_INVALID_TABLE = 3
-ERROR_CANCELLED = 4
-ERROR_INTERNAL = 5
+# The status codes: native.py's (set by main()), which TestPrototypes checks against the headers.
+OK = ERROR_INVALID_ARGUMENT = ERROR_IO = ERROR_INVALID_TABLE = None
+ERROR_CANCELLED = ERROR_INTERNAL = None
+STATUS_NAMES = None
 
 KINDS = ("chiang", "huang", "marschner", "bake", "sampler", "diffuse", "principled", "glossy",
          "emission", "mix", "add", "texture", "sun", "point", "area", "world", "camera", "render",
@@ -220,12 +218,17 @@ def prototype_problems(expected, declared, who):
     return problems
 
 
-def header_prototypes():
+def header_texts():
+    """The text of each --header."""
     texts = []
     for path in OPTIONS.header:
         with open(path) as handle:
             texts.append(handle.read())
-    return parse_prototypes(texts)
+    return texts
+
+
+def header_prototypes():
+    return parse_prototypes(header_texts())
 
 
 # ---- The library -----------------------------------------------------------------------------
@@ -263,6 +266,18 @@ def defaults(kind):
     text = lib().hairis_defaults(kind.encode())
     assert text is not None, last_error()
     return text.decode()
+
+
+def recording_progress(answer):
+    """A progress callback that records each fraction and returns ``answer`` (1 cancels);
+    returns (the fractions, the callback)."""
+    fractions = []
+
+    def progress(_user, fraction):
+        fractions.append(fraction)
+        return answer
+
+    return fractions, PROGRESS_FN(progress)
 
 
 def make_fiber(options=""):
@@ -320,6 +335,14 @@ class TestPrototypes(unittest.TestCase):
         if not OPTIONS.header:
             raise unittest.SkipTest("no --header")
         cls.expected = header_prototypes()
+
+    def test_native_status_codes_match_the_headers(self):
+        block = re.search(r"/\*\* Status codes\. \*/\s*enum \{(.*?)\};", "\n".join(header_texts()),
+                          re.S)
+        self.assertIsNotNone(block, "no status code enum in the headers")
+        declared = {int(value): name
+                    for name, value in re.findall(r"(HAIRIS_\w+) = (\d+)", block.group(1))}
+        self.assertEqual(declared, STATUS_NAMES)
 
     def test_native_prototypes_match_the_headers(self):
         problems = prototype_problems(self.expected, PROTOTYPES, "addon/hairis/native.py")
@@ -543,13 +566,7 @@ class TestTables(unittest.TestCase):
 
     def test_bake_with_progress_and_write_and_load(self):
         fiber = make_fiber()
-        seen = []
-
-        def progress(_user, fraction):
-            seen.append(fraction)
-            return 0
-
-        callback = PROGRESS_FN(progress)
+        seen, callback = recording_progress(0)
         tables = lib().hairis_tables_bake(fiber, TINY_BAKE, callback, None)
         self.assertTrue(tables, last_error())
         self.assertEqual(last_error(), "")
@@ -586,13 +603,7 @@ class TestTables(unittest.TestCase):
 
     def test_cancelled_bake(self):
         fiber = make_fiber()
-        calls = []
-
-        def cancel(_user, fraction):
-            calls.append(fraction)
-            return 1
-
-        callback = PROGRESS_FN(cancel)
+        calls, callback = recording_progress(1)
         self.assertIsNone(lib().hairis_tables_bake(fiber, TINY_BAKE, callback, None))
         self.assertEqual(last_error(), "cancelled")
         self.assertEqual(len(calls), 1, "no progress call after cancelling")
@@ -896,14 +907,9 @@ class TestRender(unittest.TestCase):
     def test_cancel_from_python(self):
         scene = self.make_scene(None)
         rgba = np.zeros((self.H, self.W, 4), np.float32)
-        calls = []
-
-        def progress(_user, fraction):
-            calls.append(fraction)
-            return 1
-
+        calls, callback = recording_progress(1)
         status = lib().hairis_render(scene, self.settings("analytic", 1 << 16), ptr(rgba),
-                                     PROGRESS_FN(progress), None)
+                                     callback, None)
         self.assertEqual(status, ERROR_CANCELLED)
         self.assertIn("cancelled", last_error())
         self.assertEqual(len(calls), 1)
@@ -1238,7 +1244,7 @@ class TestSurfaces(unittest.TestCase):
 
 
 def main():
-    global OPTIONS, PROTOTYPES, PROGRESS_FN, UPDATE_FN
+    global OPTIONS, PROTOTYPES, PROGRESS_FN, UPDATE_FN, STATUS_NAMES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--library", required=True, help="libhairis.so")
     parser.add_argument("--header", action="append", default=[],
@@ -1257,6 +1263,8 @@ def main():
     PROTOTYPES = native.PROTOTYPES
     PROGRESS_FN = native.PROGRESS_FN
     UPDATE_FN = native.UPDATE_FN
+    STATUS_NAMES = native.STATUS_NAMES
+    globals().update({name[len("HAIRIS_"):]: code for code, name in STATUS_NAMES.items()})
     program = unittest.main(argv=[sys.argv[0]] + rest, exit=False, verbosity=2)
     result = program.result
     failed = len(result.failures) + len(result.errors)
