@@ -39,6 +39,11 @@ def head_scene(samples, model="CHIANG"):
     return scene
 
 
+def huang_head_scene(samples):
+    """head_scene with Huang fibers at Blender's defaults for them (aspect 0.85, lobes at 1)."""
+    return head_scene(samples, "HUANG")
+
+
 def hair_mask(make_scene, hair, workdir):
     """(height, width) bool: the pixels the material named ``hair`` covers at least half of,
     from a Cycles render of ``make_scene(MASK_SAMPLES)`` with that hair emitting white and
