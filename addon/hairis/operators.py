@@ -111,8 +111,8 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         name="Force", description="Bake even when the tables are current", default=False)
 
     def _prepare(self, context):
-        """(library, jobs, bake options), or the operator's result when there is nothing to
-        bake."""
+        """(library, jobs, bake options), or the operator's result ({'CANCELLED'} or
+        {'FINISHED'}) when it stops before baking."""
         problem = compat.version_problem()
         if problem:
             self.report({"ERROR"}, problem)

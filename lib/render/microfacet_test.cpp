@@ -127,7 +127,8 @@ TEST(Microfacet, GgxVisibleNormalSamplerMatchesItsDensity) {
 }
 
 TEST(Microfacet, Gtr1SamplerMatchesItsDensity) {
-    for (const auto &[theta, alpha] : {std::pair{0.4, 0.3f}, {1.2, 0.6f}, {0.9, 1.0f}}) {
+    for (const auto &[theta, a] : {std::pair{0.4, 0.3f}, {1.2, 0.6f}, {0.9, 1.0f}}) {
+        const float alpha = a;  // a lambda may not capture a structured binding in C++17
         const Vec3 wo = testing::polar_direction(theta, -1.1);
         const Chi2Result r = testing::chi2_direction_test(
             [&](Sample3 u) -> std::optional<Vec3> {

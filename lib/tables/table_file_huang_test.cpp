@@ -278,7 +278,6 @@ TEST(HuangTableFile, EncodingIsDeterministic) { EXPECT_EQ(encode(baked()), encod
 
 // ---- The TABLE strategy from a loaded file -------------------------------------------------
 
-using testing::huang_hit;
 
 std::shared_ptr<const Sampler> table_sampler(const SamplingTables &tables) {
     StrategyInputs in;

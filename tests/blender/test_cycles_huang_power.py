@@ -5,11 +5,11 @@ The scene is test_cycles_hair_power's head of hair with Huang fibers
 Table strategy with Auto Bake and Huang Sampling Cycles, so BSDF samples are Cycles' chained
 sampler with its weight and light samples are shaded with the baked f. The comparison, its
 sizing and its negative control (every light and the world 2% brighter) are
-hair_power.check's (tests/blender/POWER.md).
+hair_power.check's (POWER.md).
 
-Blender 3.4 has no Huang model. Blender 4.5 is skipped: its Huang hair is a few tenths of a
-percent darker than Cycles 4.5's, which a test that sees 1% finds in some runs but not all
-(tests/allowed_skips.txt; POWER.md has the figures).
+Blender 3.4 has no Huang model. Blender 4.5 is skipped: its Huang hair differs from Cycles
+4.5's by a small residual bias, which a test that sees 1% finds in some runs and not in others
+(POWER.md has the figures).
 """
 
 import os
@@ -25,7 +25,7 @@ ARGS = helpers.setup_compare()
 if helpers.VERSION < (4, 0, 0):
     helpers.skip("Blender %s has no Huang model" % bpy.app.version_string)
 if helpers.VERSION < (5, 0, 0):
-    helpers.skip("Blender %s: Huang hair is a few tenths of a percent darker than Cycles'"
+    helpers.skip("Blender %s: Huang hair differs from Cycles 4.5's by a small residual bias"
                  % bpy.app.version_string)
 SAMPLES = int(os.environ.get("HAIRIS_POWER_SAMPLES", "96"))
 SEEDS = int(os.environ.get("HAIRIS_POWER_SEEDS", "16"))

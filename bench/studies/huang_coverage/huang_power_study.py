@@ -1,5 +1,5 @@
 """Hairis against Cycles 4.5/5.0 on Huang hair alone, with the power to see a 1% bias there
-(Blender 4.0+; 3.4 has no Huang model), at other sample and seed counts than the CI test's.
+(Blender 4.0+; 3.4 has no Huang model), at any sample and seed count.
 
     python3 tests/blender/run_test.py --bpy-python .venvs/bpy-4.5/bin/python \
         --expect-version 4.5 --install extension --extension-zip build/hairis-extension.zip \
@@ -8,7 +8,7 @@
 
 The comparison of tests/blender/test_cycles_huang_power.py (hair_power.check on
 hair_power.huang_head_scene) with its verdict printed rather than raised, at
-HAIRIS_POWER_SAMPLES samples and HAIRIS_POWER_SEEDS seeds.
+HAIRIS_POWER_SAMPLES samples and HAIRIS_POWER_SEEDS seeds (the CI test's 96 and 16 by default).
 """
 
 import os
