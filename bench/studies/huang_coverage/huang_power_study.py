@@ -8,7 +8,7 @@
 
 The comparison of tests/blender/test_cycles_huang_power.py (hair_power.check on
 hair_power.huang_head_scene) with its verdict printed rather than raised, at
-HAIRIS_POWER_SAMPLES samples and HAIRIS_POWER_SEEDS seeds (the CI test's 96 and 16 by default).
+HAIRIS_POWER_SAMPLES samples and HAIRIS_POWER_SEEDS seeds (the test's 96 and 16 by default).
 """
 
 import os
