@@ -28,9 +28,8 @@ def head_scene(samples, model="CHIANG"):
     (hair against the sky and over the skin); the head's Principled Hair BSDF set to
     ``model`` (its other inputs as the node leaves them)."""
     scene = helpers.make_compare_scene(samples, BOUNCES, "TABLE", resolution=RESOLUTION,
-                                       curves_offset=math.radians(-4.0))
+                                       curves_offset=math.radians(-4.0), strands=2000)
     bpy.data.objects.remove(bpy.data.objects["Curls"])
-    bpy.data.objects["Head"].particle_systems[0].settings.count = 2000
     bpy.data.materials[HAIR].node_tree.nodes["Principled Hair BSDF"].model = model
     camera = scene.camera
     camera.location = (-0.9, -3.2, -0.5)

@@ -321,15 +321,27 @@ def make_light(scene, kind, name, location=(0.0, 0.0, 5.0), rotation=(0.3, 0.2, 
 
 def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.1), scale=1.5,
                        hair_material=None, skin_material=None):
-    """A UV sphere with a hair particle system (``children``: None or rendered count)."""
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=16,
-                                         ring_count=8)
+    """A UV sphere with a hair particle system (``children``: None or rendered count).
+
+    Without children the strands grow from the sphere's vertices in order, so every Blender
+    process makes the same groom: Blender places particles on faces, and children, anew in
+    each process, which would make a comparison's verdict change from run to run."""
+    rings = 8
+    segments = 16
+    while children is None and segments * (rings - 1) + 2 < count:
+        rings += 1
+        segments = 2 * rings
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=segments,
+                                         ring_count=rings)
     sphere = bpy.context.view_layer.objects.active
     sphere.name = "Head"
     sphere.scale = (scale, scale, scale)
     sphere.data.materials.append(skin_material)
     sphere.data.materials.append(hair_material)
-    add_hair_particles(sphere, count, material_index=2, children=children)
+    settings = add_hair_particles(sphere, count, material_index=2, children=children)
+    if children is None:
+        settings.emit_from = "VERT"
+        settings.use_emit_random = False
     return sphere
 
 
@@ -541,14 +553,14 @@ def make_comparison_lights(scene):
 
 
 def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_offset=None,
-                       extras=()):
+                       extras=(), strands=300):
     """The Hairis-against-Cycles scene: particle hair, Curves, a diffuse sphere, three kinds
     of light and a world colour, with both engines set up alike (``match_cycles``).
 
     Both hair materials are Chiang's (the node's default model); the particle hair keeps the
     node's default Offset (2°), the Curves object's takes ``curves_offset`` (radians) when
     given. ``extras``: functions of the scene that add more objects (other hair models)
-    before both engines are set up.
+    before both engines are set up; ``strands``: the head's number of hairs.
     """
     scene = reset()
     make_camera(scene, location=(0.0, -3.2, 0.0), resolution=resolution, percentage=100)
@@ -562,7 +574,7 @@ def make_compare_scene(samples, bounces, strategy, resolution=(64, 48), curves_o
     dyed = make_hair_material("Dyed", "COLOR", **dyed_inputs)
     skin = make_diffuse_material("Skin", (0.7, 0.5, 0.4, 1.0))
     make_curves(scene, dyed, location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.0), scale=1.4)
-    make_particle_hair(scene, count=300, location=(-0.3, 1.2, -0.5), scale=0.8,
+    make_particle_hair(scene, count=strands, location=(-0.3, 1.2, -0.5), scale=0.8,
                        hair_material=hair, skin_material=skin)
     make_comparison_lights(scene)
     for extra in extras:
