@@ -139,6 +139,23 @@ def corner_normals(mesh):
     return normals.reshape(-1, 3)
 
 
+def flat_triangles(mesh):
+    """(loop triangles,) bool: the triangles Cycles shades with their own geometric normal.
+
+    Blender 4.1+ gives a mesh one normals domain, and Cycles shades every triangle of a 'FACE'
+    mesh flat; earlier, flat faces are flat unless Auto Smooth makes split normals of them. A
+    flat non-planar quad's corner normal is the polygon's, not its triangles'."""
+    count = len(mesh.loop_triangles)
+    domain = getattr(mesh, "normals_domain", None)
+    if domain is not None:
+        return np.full(count, domain == "FACE")
+    if getattr(mesh, "use_auto_smooth", False) or getattr(mesh, "has_custom_normals", False):
+        return np.zeros(count, bool)
+    smooth = np.empty(count, bool)
+    mesh.loop_triangles.foreach_get("use_smooth", smooth)
+    return ~smooth
+
+
 def render_uv_layer(mesh):
     """The UV map Cycles reads for an Image Texture's default coordinates (the active render
     one), or None."""

@@ -456,6 +456,14 @@ class _Exporter:
             loops = np.empty(triangle_count * 3, np.int32)
             mesh.loop_triangles.foreach_get("loops", loops)
             normals = compat.corner_normals(mesh)[loops].reshape(-1, 3, 3).astype(np.float64)
+            flat = compat.flat_triangles(mesh)
+            if flat.any():
+                corners = positions.reshape(-1, 3).astype(np.float64)[indices.reshape(-1, 3)[flat]]
+                ng = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+                length = np.linalg.norm(ng, axis=1)
+                own = length > 0.0  # degenerate triangles keep their corner normals
+                rows = np.flatnonzero(flat)[own]
+                normals[rows] = (ng[own] / length[own, None])[:, None, :]
             uvs = None
             layer = compat.render_uv_layer(mesh)
             if layer is not None:

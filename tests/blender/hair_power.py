@@ -30,7 +30,8 @@ def head_scene(samples, model="CHIANG"):
     scene = helpers.make_compare_scene(samples, BOUNCES, "TABLE", resolution=RESOLUTION,
                                        curves_offset=math.radians(-4.0), strands=2000)
     bpy.data.objects.remove(bpy.data.objects["Curls"])
-    bpy.data.materials[HAIR].node_tree.nodes["Principled Hair BSDF"].model = model
+    if model != "CHIANG":  # Blender 3.4's node has Chiang's model alone, and no model property
+        bpy.data.materials[HAIR].node_tree.nodes["Principled Hair BSDF"].model = model
     camera = scene.camera
     camera.location = (-0.9, -3.2, -0.5)
     camera.data.lens = 100.0

@@ -336,6 +336,8 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
     sphere = bpy.context.view_layer.objects.active
     sphere.name = "Head"
     sphere.scale = (scale, scale, scale)
+    if children is None:
+        scatter_vertices(sphere.data, 0.35 * math.pi / rings, seed=count)
     sphere.data.materials.append(skin_material)
     sphere.data.materials.append(hair_material)
     settings = add_hair_particles(sphere, count, material_index=2, children=children)
@@ -343,6 +345,20 @@ def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.
         settings.emit_from = "VERT"
         settings.use_emit_random = False
     return sphere
+
+
+def scatter_vertices(mesh, spread, seed):
+    """Moves each vertex of a unit sphere ``mesh`` by about ``spread`` radians along the sphere
+    (a fixed random draw), so that hairs grown from its vertices do not line up in rings."""
+    co = np.empty(len(mesh.vertices) * 3)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    step = np.random.default_rng(seed).normal(scale=spread, size=co.shape)
+    step -= np.sum(step * co, axis=1, keepdims=True) * co
+    co += step
+    co /= np.linalg.norm(co, axis=1, keepdims=True)
+    mesh.vertices.foreach_set("co", co.reshape(-1))
+    mesh.update()
 
 
 def make_groom_head(scene, hair_material, skin_material, children, radius_scale):

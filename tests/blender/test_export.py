@@ -316,11 +316,18 @@ def _sphere(name, smooth, location=(0.0, 0.0, 0.0), scale=(1.0, 1.0, 1.0)):
 
 def test_mesh_normals_and_uvs():
     """Corner normals: radial on a smooth sphere (its vertex normals, through a non-uniform
-    scale), the face normal on a flat one; the UV map per corner as the loops hold it."""
+    scale); on a flat one each triangle's own normal, as Cycles shades flat faces, also where
+    its quads are not planar (their polygon normal is then another); the UV map per corner as
+    the loops hold it."""
     helpers.reset()
     helpers.make_camera(bpy.context.scene)
     _sphere("Smooth", True, location=(0.0, 0.0, 0.0), scale=(1.0, 1.0, 2.0))
     flat = _sphere("Flat", False, location=(3.0, 0.0, 0.0))
+    helpers.scatter_vertices(flat.data, 0.1, seed=1)
+    flat.data.calc_loop_triangles()
+    polygon_normals = [np.array(flat.data.polygons[t.polygon_index].normal)
+                       for t in flat.data.loop_triangles]
+    bpy.context.view_layer.update()
     data = export.export_context()
     by_name = {m.name: m for m in data.meshes}
     mesh = by_name["Smooth"]
@@ -338,6 +345,9 @@ def test_mesh_normals_and_uvs():
     face = face[keep] / np.linalg.norm(face[keep], axis=1, keepdims=True)
     for k in range(3):
         np.testing.assert_allclose(mesh.normals[keep, k], face, atol=1e-5)
+    # The quads are bent enough that a polygon's normal would fail the check above.
+    polygon_normals = np.array(polygon_normals)[keep]
+    assert np.abs(polygon_normals - face).max() > 0.01, np.abs(polygon_normals - face).max()
     # UVs: corner k of triangle t is loop loop_triangles[t].loops[k] of the active UV map.
     evaluated = flat.evaluated_get(bpy.context.evaluated_depsgraph_get())
     source = evaluated.to_mesh()
