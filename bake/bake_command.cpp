@@ -131,6 +131,10 @@ void add_bake_command(CLI::App &app, int &exit_code) {
     cmd->add_flag("!--no-huang-f", b.huang_f,
                   "Huang fibers: bake no f part, so that renders shade with Cycles' noisy eval instead of the "
                   "baked expectation");
+    cmd->add_option("--huang-f-refinement", b.huang_f_refinement,
+                    "Huang fibers: multiplies the orders of the f part's quadrature, which leaves less error "
+                    "towards single lights and bakes for longer")
+        ->check(CLI::Range(1, kMaxHuangFRefinement))->capture_default_str();
     cmd->add_option("--threads", b.threads, "worker threads, 0 for all cores (the output does not depend on it)")
         ->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--output,-o", flags->output, "the EXR file to write (atomically)")->required();

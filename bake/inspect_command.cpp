@@ -43,8 +43,8 @@ int run_inspect(const std::string &path) {
         int width = h->phi_count, height = rows;
         if (h->has_f()) {
             std::printf("  f  rows %d-%d: the same cells (RGB expectation of f cos theta_i of TT, TRT and TRRT+, "
-                        "what renders shade with)\n",
-                        rows, 2 * rows - 1);
+                        "what renders shade with; quadrature refinement %d)\n",
+                        rows, 2 * rows - 1, h->f_refinement);
             height += rows;
         } else {
             std::printf("  (no f part: renders shade with Cycles' noisy eval; bake without --no-huang-f)\n");

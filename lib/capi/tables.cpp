@@ -31,6 +31,7 @@ hairis_tables *make_tables(TableSet set) {
             {"huang_theta_i", std::to_string(h->theta_i_count)},
             {"huang_phi", std::to_string(h->phi_count)},
             {"huang_f", h->has_f() ? "1" : "0"}};
+        if (h->has_f()) info.push_back({"huang_f_refinement", std::to_string(h->f_refinement)});
         if (set.has_multiple()) {  // the multiple part (dual scattering)
             info.push_back({"theta_r", std::to_string(set.theta_r_count())});
             info.push_back({"theta_i", std::to_string(set.theta_i_count)});

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <vector>
@@ -52,20 +53,26 @@ Baked bake(const HuangFiber &fiber, const HuangBakeOptions &o) {
     return {std::move(set), std::move(table), std::move(f)};
 }
 
+// The f part's rule as the bake documents it: its orders times the refinement.
 HuangQuadrature rule_of(const HuangBakeOptions &o) {
     HuangQuadrature q;
-    q.first_order = o.f_first_order;
-    q.second_order = o.f_second_order;
-    q.tt_order = o.f_tt_order;
+    q.first_order = o.f_first_order * o.f_refinement;
+    q.second_order = o.f_second_order * o.f_refinement;
+    q.tt_order = o.f_tt_order * o.f_refinement;
     return q;
 }
 
 Rgb rest_of(const std::array<Rgb, 4> &lobes) { return lobes[1] + lobes[2] + lobes[3]; }
 
-TEST(HuangFTable, OnItsPointsItIsTheExpectationOfTtTrtAndTrrt) {
+class HuangFTablePoints : public ::testing::TestWithParam<int> {};
+
+// With f_refinement k, at the rule (3k, 2k) and TT at 8k; the sampling part keeps its rule.
+TEST_P(HuangFTablePoints, OnItsPointsItIsTheExpectationOfTtTrtAndTrrt) {
     const HuangFiber fiber = make_fiber(0.85f, 0.3f);
-    const HuangBakeOptions o = options(6, 3, 12, 16);
+    HuangBakeOptions o = options(6, 3, 12, 16);
+    o.f_refinement = GetParam();
     const Baked b = bake(fiber, o);
+    EXPECT_EQ(b.set.f_refinement, o.f_refinement);
     const std::vector<double> &points = b.f.sin_theta_points();
     int checked = 0;
     for (int q : {0, 1, 2})
@@ -90,6 +97,44 @@ TEST(HuangFTable, OnItsPointsItIsTheExpectationOfTtTrtAndTrrt) {
                 }
         }
     EXPECT_EQ(checked, 3 * 3 * 16);
+}
+
+INSTANTIATE_TEST_SUITE_P(Refinements, HuangFTablePoints, ::testing::Values(1, 2));
+
+// A finer f part is closer to the expectation at a much finer rule: the refinement reaches the
+// bake (a bake that ignored it would give the same error twice), and it is what it is for.
+TEST(HuangFTable, RefinementBringsTheFPartTowardsAFinerRule) {
+    const HuangFiber fiber = make_fiber(0.85f, 0.3f);
+    HuangBakeOptions o = options(4, 2, 12, 16);
+    HuangQuadrature fine;
+    fine.first_order = 12;
+    fine.second_order = 8;
+    fine.tt_order = 32;
+    double errors[2] = {0, 0};
+    for (int k : {1, 2}) {
+        o.f_refinement = k;
+        const Baked b = bake(fiber, o);
+        double abs_sum = 0, ref_sum = 0;
+        for (int q = 0; q < 2; ++q)
+            for (int r = 0; r < 4; ++r) {
+                const Vec3 wo = direction_of(b.set.theta_o_nodes[size_t(r)], b.set.phi_o_nodes[size_t(q)]);
+                const HuangExpectation e = fiber.expectation({wo, 0.0f, 1.0f}, fine);
+                const std::vector<double> &points = b.f.sin_theta_points();
+                for (int i = 0; i < o.theta_i_count; ++i)
+                    for (int j = 0; j < o.phi_count; ++j) {
+                        const double phi = -kPi + kTwoPi * (j + 0.5) / o.phi_count;
+                        const Vec3 wi = direction_of(float(std::asin(points[size_t(i)])),
+                                                     b.set.phi_o_nodes[size_t(q)] + float(phi));
+                        const double want = luminance(rest_of(e.lobes(wi)));
+                        abs_sum += std::fabs(luminance(b.f.value(q, r, i, j)) - want);
+                        ref_sum += want;
+                    }
+            }
+        errors[k - 1] = abs_sum / ref_sum;
+    }
+    std::printf("L1 error of the f part against the rule (12, 8): %.4f at refinement 1, %.4f at 2\n",
+                errors[0], errors[1]);
+    EXPECT_LT(errors[1], 0.7 * errors[0]);
 }
 
 // Σ |f_table − f| / Σ f over random views and a grid of ω_i (the error that reaches an image

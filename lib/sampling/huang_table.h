@@ -146,6 +146,8 @@ struct HuangTableSet {
     /// The baked expectation of f·|cos θ_i| of TT, TRT and TRRT+, RGB per cell in values'
     /// order (huang_f_table.h), or empty: renders then use Cycles' one-sample eval.
     std::vector<float> f;
+    /// The factor of the f part's quadrature orders it was baked with (HuangBakeOptions).
+    int f_refinement = 1;
 
     int theta_o_count() const { return int(theta_o_nodes.size()); }
     int phi_o_count() const { return int(phi_o_nodes.size()); }

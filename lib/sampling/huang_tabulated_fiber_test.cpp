@@ -255,12 +255,12 @@ TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoi
         Moments cv, plain;
         for (int n = 0; n < draws; ++n) {
             CyclesLcg node_lcg = lcg;
-            const Rgb strand = own_point.f_estimate(wi, lcg);
-            const Rgb expected = table + node_point.f_reflection(wi) + strand - node_point.f_estimate(wi, node_lcg);
+            const Rgb own_eval = own_point.f_estimate(wi, lcg);
+            const Rgb expected = table + node_point.f_reflection(wi) + own_eval - node_point.f_estimate(wi, node_lcg);
             const Rgb f = point.f(wi);
             for (int c = 0; c < 3; ++c) ASSERT_NEAR(f[c], expected[c], 1e-6f * (1.0f + std::fabs(expected[c]))) << n;
             cv.add(f.g);
-            plain.add(strand.g);
+            plain.add(own_eval.g);
         }
         // On the same draws the corrected table is far less noisy than the strand's own eval.
         EXPECT_LT(cv.variance(), 0.5 * plain.variance()) << wi.x << " " << wi.y << " " << wi.z;

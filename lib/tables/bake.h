@@ -18,6 +18,9 @@ namespace hairis {
 
 /// The resolution of a Huang table (sampling/huang_table.h): θ_o nodes, φ_o nodes, θ_i cells
 /// and cells of φ_i − φ_o (HuangBakeOptions takes its defaults from here).
+/// The largest huang_f_refinement: the rule's finest order stays within GaussLegendre's nodes.
+constexpr int kMaxHuangFRefinement = 4;
+
 struct HuangResolution {
     int theta_o = 24;
     int phi_o = 4;
@@ -44,6 +47,9 @@ struct BakeOptions {
     /// A huang2022 fiber's f part (huang_f_table.h): the baked expectation renders shade with;
     /// 0 leaves renders with Cycles' noisy one-sample eval.
     bool huang_f = true;
+    /// Multiplies the Gauss orders of the f part's rule (HuangBakeOptions): the finer rule
+    /// leaves less of the f part's error towards single lights and takes longer to bake.
+    int huang_f_refinement = 1;
 
     /// Names the first option out of range.
     Status validate() const;
@@ -61,6 +67,7 @@ void describe(Fields &f, BakeOptions &o) {
     f.field("threads", o.threads, 0, 1024);
     f.field("huang_multiple", o.huang_multiple);
     f.field("huang_f", o.huang_f);
+    f.field("huang_f_refinement", o.huang_f_refinement, 1, kMaxHuangFRefinement);
     f.field("huang_theta_o", o.huang.theta_o, 1, kMaxThetaRNodes);
     f.field("huang_phi_o", o.huang.phi_o, 1, kMaxPhiONodes);
     f.field("huang_theta_i", o.huang.theta_i, 1, kMaxTableAxisCells);

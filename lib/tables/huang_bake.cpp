@@ -51,8 +51,12 @@ Status HuangBakeOptions::validate() const {
                                check::count_in_range("threads", threads, 0, 1024),
                                check::count_in_range("f_first_order", f_first_order, 1, 32),
                                check::count_in_range("f_second_order", f_second_order, 1, 32),
-                               check::count_in_range("f_tt_order", f_tt_order, 0, 32)))
+                               check::count_in_range("f_tt_order", f_tt_order, 0, 32),
+                               check::count_in_range("f_refinement", f_refinement, 1, 32)))
         return s;
+    if (const int finest = std::max({f_first_order, f_second_order, f_tt_order}) * f_refinement; finest > 32)
+        return Error{"f_refinement " + std::to_string(f_refinement) + " makes the f part's finest order " +
+                     std::to_string(finest) + "; at most 32"};
     if (evaluator != "expectation" && evaluator != "estimate")
         return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};
     const long long cells = (long long)theta_o_count * phi_o_count * theta_i_count * phi_count;
@@ -91,13 +95,16 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
     rule.second_order = o.second_order;
     rule.tt_order = o.f_tt_order;
     HuangQuadrature f_rule;
-    f_rule.first_order = o.f_first_order;
-    f_rule.second_order = o.f_second_order;
-    f_rule.tt_order = o.f_tt_order;
+    f_rule.first_order = o.f_first_order * o.f_refinement;
+    f_rule.second_order = o.f_second_order * o.f_refinement;
+    f_rule.tt_order = o.f_tt_order * o.f_refinement;
     // The sampling values reuse the f part's evaluations when both use one rule at one point.
-    const bool shared_rule = o.f && expectation && p_is_one(o) && o.f_first_order == o.first_order &&
-                             o.f_second_order == o.second_order;
-    if (o.f) t.f.assign(3 * t.values.size(), 0.0f);
+    const bool shared_rule = o.f && expectation && p_is_one(o) && f_rule.first_order == o.first_order &&
+                             f_rule.second_order == o.second_order && f_rule.tt_order == o.f_tt_order;
+    if (o.f) {
+        t.f.assign(3 * t.values.size(), 0.0f);
+        t.f_refinement = o.f_refinement;
+    }
     const int p = o.points;
     std::atomic<bool> bad{false};
 
@@ -217,6 +224,7 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
     o.phi_count = options.huang.phi;
     o.threads = options.threads;
     o.f = options.huang_f;
+    o.f_refinement = options.huang_f_refinement;
     if (Status s = o.validate()) return Error{"the Huang resolution (huang_theta_o, huang_phi_o, huang_theta_i, huang_phi): " + s->message};
     // The file's image: one row per (φ_o node, θ_o node, θ_i cell), refused before the bake.
     const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count *

@@ -38,6 +38,9 @@ struct HuangBakeOptions {
     /// TT's entry rule in both parts (HuangQuadrature::tt_order; 0: first_order): the brightest
     /// lobe needs a finer rule than TRT to be baked within a few percent at its peak.
     int f_tt_order = 8;
+    /// Multiplies f_first_order, f_second_order and f_tt_order in the f part (the sampling
+    /// part keeps its rule): TRT's two microfacets are the f part's largest error left.
+    int f_refinement = 1;
 
     /// Names the first option out of range.
     Status validate() const;

@@ -16,6 +16,7 @@
 #include "core/math.h"
 #include "core/options.h"
 #include "sampling/huang_table.h"
+#include "tables/bake.h"
 
 namespace hairis {
 
@@ -407,7 +408,7 @@ Status read_huang_axes(const OIIO::ImageSpec &spec, HuangTableSet &h, HuangLayou
 }
 
 // hairis:huang_f: there exactly when the parts name an f part, starting after the Huang part.
-Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layout) {
+Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layout, int &refinement) {
     if (with_f != (spec.find_attribute("hairis:huang_f") != nullptr))
         return file_error(with_f ? "hairis:parts names an f part but there is no string attribute hairis:huang_f "
                                    "(\"row=...\")"
@@ -417,6 +418,7 @@ Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layou
     if (!fr) return fr.error();
     int f_row = -1;
     fr.value().field("row", f_row, 0, kMaxTableCells);
+    fr.value().field("refinement", refinement, 1, kMaxHuangFRefinement);
     if (Status e = fr.value().finish()) return file_error(e->message);
     if (f_row != layout.rows)
         return file_error("hairis:huang_f must start at row " + std::to_string(layout.rows) + ", after the Huang part");
@@ -502,7 +504,7 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, b
     HuangLayout layout;
     if (Status s = check_huang_parts(spec, multiple)) return *s;
     if (Status s = read_huang_axes(spec, *h, layout)) return *s;
-    if (Status s = read_huang_f(spec, with_f, layout)) return *s;
+    if (Status s = read_huang_f(spec, with_f, layout, h->f_refinement)) return *s;
     if (multiple) {
         if (Status s = read_huang_multiple(spec, with_f, t, layout)) return *s;
     }
@@ -557,7 +559,13 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     if (const HuangTableSet *h = t.huang.get()) {
         spec.attribute("hairis:parts", std::string("huang") + (h->has_f() ? ",f" : "") +
                                            (t.has_multiple() ? ",multiple" : ""));
-        if (h->has_f()) spec.attribute("hairis:huang_f", format_options({{"row", std::to_string(layout.huang_rows)}}));
+        if (h->has_f()) {
+            // The refinement is written only when not 1, so that readers from before it read
+            // the default bake's files.
+            std::vector<std::pair<std::string, std::string>> f_options = {{"row", std::to_string(layout.huang_rows)}};
+            if (h->f_refinement != 1) f_options.push_back({"refinement", std::to_string(h->f_refinement)});
+            spec.attribute("hairis:huang_f", format_options(f_options));
+        }
         if (t.has_multiple()) {
             spec.attribute("hairis:multiple", format_options({{"row", std::to_string(layout.huang_rows + layout.f_rows)},
                                                               {"theta_r", std::to_string(t.theta_r_count())},

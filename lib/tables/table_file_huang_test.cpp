@@ -239,6 +239,25 @@ TEST(HuangTableFile, TheFPartRoundTripsWhereTheFormatSays) {
     EXPECT_EQ(read_image(encode(with_distinct_f(distinct_tables()))).spec.get_string_attribute("hairis:parts"), "huang,f");
 }
 
+// The f part's refinement is recorded when it is not 1 (files of the default bake stay readable
+// by readers from before it) and comes back; out of range it is refused by name.
+TEST(HuangTableFile, TheFPartsRefinementRoundTrips) {
+    TableSet t = with_distinct_f(distinct_tables());
+    EXPECT_EQ(read_image(encode(t)).spec.get_string_attribute("hairis:huang_f"), "row=24");
+    auto h = std::make_shared<HuangTableSet>(*t.huang);
+    h->f_refinement = 3;
+    t.huang = h;
+    const std::vector<unsigned char> bytes = encode(t);
+    EXPECT_EQ(read_image(bytes).spec.get_string_attribute("hairis:huang_f"), "row=24;refinement=3");
+    const Expected<TableSet> back = decode_table_exr(bytes.data(), bytes.size());
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back.value().huang->f_refinement, 3);
+    const std::vector<unsigned char> plain = encode(with_distinct_f(distinct_tables()));
+    EXPECT_EQ(decode_table_exr(plain.data(), plain.size()).value().huang->f_refinement, 1);
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:huang_f", "row=24;refinement=9"); }),
+                   "refinement");
+}
+
 TEST(HuangTableFile, RefusesADamagedFPart) {
     const TableSet t = with_distinct_f(distinct_with_multiple());
     expect_refused(tamper(t, [](Image &im) { im.at(1, 25, 3) = 0.5f; }), "A must be 1 in the f part");

@@ -1947,14 +1947,34 @@ static void test_huang(void)
     CHECK(huang_tables && strcmp(hairis_tables_model(huang_tables), "huang2022") == 0, "model huang2022");
     CHECK(huang_tables && strcmp(hairis_tables_info(huang_tables),
                                  "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;"
-                                 "huang_f=1;theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
+                                 "huang_f=1;huang_f_refinement=1;theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
           "info \"%s\" (with the multiple part)", huang_tables ? hairis_tables_info(huang_tables) : "");
     char table_only_options[TEXT];
     snprintf(table_only_options, TEXT, "%s;huang_multiple=0", small);
     hairis_tables *table_only = hairis_tables_bake(huang, table_only_options, NULL, NULL);
     CHECK(table_only && strcmp(hairis_tables_info(table_only),
-                               "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;huang_f=1") == 0,
+                               "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;huang_f=1;"
+                               "huang_f_refinement=1") == 0,
           "huang_multiple=0: the Huang table alone, \"%s\"", table_only ? hairis_tables_info(table_only) : "");
+    /* A refined f part says so, also after a round trip through a file; 5 is out of range. */
+    char refined_options[TEXT];
+    snprintf(refined_options, TEXT, "%s;huang_multiple=0;huang_f_refinement=2", small);
+    hairis_tables *refined = hairis_tables_bake(huang, refined_options, NULL, NULL);
+    CHECK(refined && strstr(hairis_tables_info(refined), "huang_f_refinement=2") != NULL,
+          "huang_f_refinement=2: \"%s\"", refined ? hairis_tables_info(refined) : hairis_last_error());
+    const char *temp_dir = getenv("TMPDIR");
+    char refined_path[TEXT];
+    snprintf(refined_path, TEXT, "%s/hairis_capi_refined_%ld.exr", temp_dir && *temp_dir ? temp_dir : "/tmp",
+             (long)getpid());
+    CHECK(refined && hairis_tables_write(refined, refined_path) == HAIRIS_OK, "write refined: %s", hairis_last_error());
+    hairis_tables *refined_loaded = hairis_tables_load_file(refined_path);
+    CHECK(refined_loaded && strstr(hairis_tables_info(refined_loaded), "huang_f_refinement=2") != NULL,
+          "the refinement survives the file: \"%s\"",
+          refined_loaded ? hairis_tables_info(refined_loaded) : hairis_last_error());
+    hairis_tables_destroy(refined_loaded);
+    hairis_tables_destroy(refined);
+    remove(refined_path);
+    expect_bake_refused(huang, "huang_f_refinement=5", "huang_f_refinement");
     char no_f_options[TEXT];
     snprintf(no_f_options, TEXT, "%s;huang_multiple=0;huang_f=0", small);
     hairis_tables *no_f = hairis_tables_bake(huang, no_f_options, NULL, NULL);

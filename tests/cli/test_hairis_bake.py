@@ -122,6 +122,19 @@ class HairisBakeTest(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         for text in ["(no f part", "cells:           3456", "image:           16 x 216"]:
             self.assertIn(text, r.stdout)
+        # A refined f part is another bake, and inspect names its refinement.
+        refined = self.path("hr.exr")
+        r = run("bake", "--set", "model=huang", *small, "--no-huang-multiple",
+                "--huang-f-refinement", "2", "-q", "-o", refined)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(out, "rb") as fa, open(refined, "rb") as fb:
+            self.assertNotEqual(fa.read(), fb.read(), "--huang-f-refinement changed nothing")
+        r = run("inspect", refined)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("quadrature refinement 2", r.stdout)
+        r = run("bake", "--set", "model=huang", *small, "--huang-f-refinement", "5", "-o", refined)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--huang-f-refinement", r.stderr)
         # With the multiple part (the default): after the Huang part, one column per n_h.
         multiple = self.path("hm.exr")
         r = run("bake", "--set", "model=huang", *small, "--theta-r", "4", "--theta-i", "8",

@@ -116,7 +116,8 @@ HAIRIS_API int hairis_fiber_eval(const hairis_fiber *fiber, size_t n, const floa
  * source (exact | gaussian), quadrature_points, threads (0: all cores); a huang2022 fiber's
  * tables are its Huang table alone, of huang_theta_o × huang_phi_o view nodes and
  * huang_theta_i × huang_phi cells (the options above but source = exact and threads do not
- * apply to it), with its baked f unless huang_f = 0 and its multiple part unless
+ * apply to it), with its baked f unless huang_f = 0 (huang_f_refinement, 1 to 4, multiplies
+ * the orders of the f part's quadrature: finer and slower) and its multiple part unless
  * huang_multiple = 0. `progress` (may be NULL) is called on the calling thread; non-zero cancels
  * within one θ_r (Huang: θ_o) slice.
  */
@@ -135,7 +136,7 @@ HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables);
 HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables);
 /** What the tables hold, as options: source, theta_r, theta_i, phi, n_h; for huang2022 tables
  * source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi, huang_f (1 when they hold the
- * baked f that renders shade with) and, when they hold the multiple part that
+ * baked f that renders shade with), huang_f_refinement (with the f part) and, when they hold the multiple part that
  * integrator=dual_scattering needs, theta_r, theta_i, n_h. */
 HAIRIS_API const char *hairis_tables_info(const hairis_tables *tables);
 /** 1 when the tables were baked for exactly this fiber's parameters, else 0 (also for NULL
