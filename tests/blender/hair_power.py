@@ -102,7 +102,8 @@ def check(make_scene, hair, samples, seeds, workdir, controls=CONTROLS):
     start, cpu = time.monotonic(), time.process_time()
     mask = hair_mask(make_scene, hair, workdir)
     print("hair mask: %d of %d pixels" % (mask.sum(), mask.size))
-    assert mask.sum() >= mask.size // 3, "the crop is not mostly hair: %d pixels" % mask.sum()
+    # A sanity check on the framing; the power the test needs is checked from the noise.
+    assert mask.sum() >= mask.size // 4, "the crop is hardly hair: %d pixels" % mask.sum()
     masks = {"hair": mask}
     scene = make_scene(samples)
     cycles, cycles_time = render_stack(scene, "CYCLES", "cycles", seeds, workdir)
