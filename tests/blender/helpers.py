@@ -321,23 +321,25 @@ def make_light(scene, kind, name, location=(0.0, 0.0, 5.0), rotation=(0.3, 0.2, 
 
 def make_particle_hair(scene, count=200, children=None, location=(0.5, -0.25, 0.1), scale=1.5,
                        hair_material=None, skin_material=None):
-    """A UV sphere with a hair particle system (``children``: None or rendered count).
+    """A sphere with a hair particle system (``children``: None or rendered count).
 
-    Without children the strands grow from the sphere's vertices in order, so every Blender
-    process makes the same groom: Blender places particles on faces, and children, anew in
-    each process, which would make a comparison's verdict change from run to run."""
-    rings = 8
-    segments = 16
-    while children is None and segments * (rings - 1) + 2 < count:
-        rings += 1
-        segments = 2 * rings
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=segments,
-                                         ring_count=rings)
+    Without children the strands grow from the vertices of an icosphere that has enough of
+    them, in order, so every Blender process makes the same groom: Blender places particles on
+    faces, and children, anew in each process, which would make a comparison's verdict change
+    from run to run. An icosphere's vertices do not line up in rings, and its faces are
+    triangles, flat however they are shaded."""
+    if children is None:
+        subdivisions = 1
+        while 10 * 4 ** (subdivisions - 1) + 2 < count:  # its vertex count
+            subdivisions += 1
+        bpy.ops.mesh.primitive_ico_sphere_add(radius=1.0, location=location,
+                                              subdivisions=subdivisions)
+    else:
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=16,
+                                             ring_count=8)
     sphere = bpy.context.view_layer.objects.active
     sphere.name = "Head"
     sphere.scale = (scale, scale, scale)
-    if children is None:
-        scatter_vertices(sphere.data, 0.35 * math.pi / rings, seed=count)
     sphere.data.materials.append(skin_material)
     sphere.data.materials.append(hair_material)
     settings = add_hair_particles(sphere, count, material_index=2, children=children)

