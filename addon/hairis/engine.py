@@ -656,14 +656,16 @@ class HairisRenderEngine(bpy.types.RenderEngine):
 
         def bake_later(index, material, fiber, _status):
             cached = tables.cached_tables(
-                library, fiber, need_multiple=settings.integrator == "DUAL_SCATTERING")
+                library, fiber, need_multiple=settings.integrator == "DUAL_SCATTERING",
+                refinement=settings.huang_f_refinement)
             if cached is not None:
                 return cached
             bakes.append((index, material.hair.as_dict(),
                           tables.bake_options(library, n_h=int(settings.n_h),
                                               threads=settings.threads,
-                                              multiple=settings.integrator == "DUAL_SCATTERING"),
-                          tables.cache_path(fiber.parameters)))
+                                              multiple=settings.integrator == "DUAL_SCATTERING",
+                                              refinement=settings.huang_f_refinement),
+                          tables.cache_path(fiber.parameters, settings.huang_f_refinement)))
             return None
 
         found = self._resolve_tables(library, data, settings, bake_later)
@@ -713,7 +715,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                     if material.source is not None:
                         status = tables.check_material(
                             library, material.source, fiber,
-                            need_multiple=settings.integrator == "DUAL_SCATTERING")
+                            need_multiple=settings.integrator == "DUAL_SCATTERING",
+                            refinement=settings.huang_f_refinement)
                     else:
                         status = tables.TableStatus("MISSING", "material %r has no sampling "
                                                     "tables" % material.name)
@@ -750,16 +753,18 @@ class HairisRenderEngine(bpy.types.RenderEngine):
 
     def _auto_bake(self, library, material, fiber, settings, status):
         cached = tables.cached_tables(library, fiber,
-                                      need_multiple=settings.integrator == "DUAL_SCATTERING")
+                                      need_multiple=settings.integrator == "DUAL_SCATTERING",
+                                      refinement=settings.huang_f_refinement)
         if cached is not None:
             self.report({"INFO"}, "%s: using tables auto-baked earlier in this session"
                         % status.message)
             return cached
         self.update_stats("", "Baking sampling tables for %s" % material.name)
         options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads,
-                                      multiple=settings.integrator == "DUAL_SCATTERING")
+                                      multiple=settings.integrator == "DUAL_SCATTERING",
+                                      refinement=settings.huang_f_refinement)
         baked = library.bake_tables(fiber, options, ProgressReporter(self))
-        tables.write_cache(baked, fiber)
+        tables.write_cache(baked, fiber, settings.huang_f_refinement)
         self.report({"INFO"}, "%s: baked them for this render (Bake Sampling Tables stores them "
                     "with the .blend)" % status.message)
         return baked

@@ -28,7 +28,7 @@ class BakeJob:
     blend_saved: bool
 
 
-def collect_jobs(library, material_name="", force=False):
+def collect_jobs(library, material_name="", force=False, refinement=1):
     """(jobs, messages): hair materials whose tables are missing or stale (all if ``force``).
 
     Messages are (level, text) pairs for materials skipped or refused.
@@ -56,7 +56,8 @@ def collect_jobs(library, material_name="", force=False):
         if not force:
             try:
                 with library.fiber_principled(node) as fiber:
-                    status = tables.check_material(library, material, fiber)
+                    status = tables.check_material(library, material, fiber,
+                                                   refinement=refinement)
             except native.HairisError as error:
                 messages.append(("ERROR", "material %r: %s" % (material.name, error)))
                 continue
@@ -122,7 +123,9 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         except native.LibraryUnavailable as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        jobs, messages = collect_jobs(library, self.material, self.force)
+        settings = context.scene.hairis
+        jobs, messages = collect_jobs(library, self.material, self.force,
+                                      settings.huang_f_refinement)
         for level, text in messages:
             self.report({level}, text)
         if any(level == "ERROR" for level, _ in messages) and not jobs:
@@ -130,8 +133,8 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
         if not jobs:
             self.report({"INFO"}, "sampling tables are current")
             return {"FINISHED"}
-        settings = context.scene.hairis
-        options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads)
+        options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads,
+                                      refinement=settings.huang_f_refinement)
         return library, jobs, options
 
     def execute(self, context):

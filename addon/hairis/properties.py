@@ -135,6 +135,17 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     threads: IntProperty(
         name="Threads", description="Number of render and bake threads, all cores if 0",
         default=0, min=0, max=1024)
+    huang_bake: EnumProperty(
+        name="Huang Bake",
+        description="How finely the tables of Huang hair bake the f that shades its light "
+                    "samples",
+        items=(("FAST", "Fast",
+                "Bakes in seconds, with the baked f slightly off Cycles towards single lights",
+                0),
+               ("FINE", "Fine",
+                "Bakes the f on a finer quadrature, closer to Cycles, in many times the time",
+                1)),
+        default="FAST")
     auto_bake: BoolProperty(
         name="Auto Bake",
         description="Bake missing or stale sampling tables when rendering, since the Table "
@@ -156,6 +167,11 @@ class HairisRenderSettings(bpy.types.PropertyGroup):
     def needs_tables(self):
         """True when rendering needs every hair material's tables."""
         return self.strategy == "TABLE" or self.integrator == "DUAL_SCATTERING"
+
+    @property
+    def huang_f_refinement(self):
+        """The bake option huang_f_refinement that ``huang_bake`` stands for."""
+        return 2 if self.huang_bake == "FINE" else 1
 
     @property
     def n_h_value(self):

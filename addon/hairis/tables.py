@@ -69,14 +69,17 @@ def hair_materials(materials=None):
     return [m for m in materials if shader_nodes.hair_node(m) is not None]
 
 
-def bake_options(library, n_h=None, threads=0, multiple=True):
+def bake_options(library, n_h=None, threads=0, multiple=True, refinement=1):
     """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``.
 
     ``multiple``: also bake a Huang fiber's multiple-scattering part, which only Dual
-    Scattering reads and which costs several times the rest of the bake."""
+    Scattering reads and which costs several times the rest of the bake. ``refinement``: the
+    Huang f part's quadrature refinement (Huang Bake)."""
     options = library.bake_options_defaults()
     if "huang_multiple" in options:  # a library that bakes Huang tables
         options["huang_multiple"] = 1 if multiple else 0
+    if "huang_f_refinement" in options:
+        options["huang_f_refinement"] = int(refinement)
     values = {int(v) for v in options["n_h"].split(",")} | set(N_H_CHOICES)
     if n_h is not None:
         values.add(int(n_h))
@@ -108,11 +111,12 @@ def image_tables(library, image):
     return library.load_tables_file(path)
 
 
-def check_material(library, material, fiber, need_multiple=False):
+def check_material(library, material, fiber, need_multiple=False, refinement=1):
     """Full check (load, validate, match ``fiber``) of a material's tables: a TableStatus.
 
     ``need_multiple``: the tables must hold multiple-scattering tables (Dual Scattering), which
-    Huang tables baked before Dual Scattering covered Huang lack.
+    Huang tables baked before Dual Scattering covered Huang lack. ``refinement``: the Huang f
+    part's quadrature refinement the scene asks for (Huang Bake).
     """
     image = material.hairis.table_image
     if image is None:
@@ -131,6 +135,11 @@ def check_material(library, material, fiber, need_multiple=False):
         return TableStatus("STALE", "material %r: its Huang tables have no baked f, which "
                            "renders shade Huang hair with (baked with huang_f=0 or by an "
                            "earlier hairis); bake them again" % material.name)
+    baked_refinement = tables.info.get("huang_f_refinement")
+    if baked_refinement is not None and baked_refinement != str(refinement):
+        tables.close()
+        return TableStatus("STALE", "material %r: its Huang tables' f was baked at another "
+                           "Huang Bake than the scene's; bake them again" % material.name)
     if need_multiple and not tables.n_h_values:
         tables.close()
         return TableStatus("STALE", "material %r: its tables have no multiple-scattering part, "
@@ -208,17 +217,19 @@ def store_image(material, path, stored_path, pack, parameters, model):
     return image
 
 
-def cache_path(parameters):
-    """The per-session cache file for tables auto-baked during a render."""
+def cache_path(parameters, refinement=1):
+    """The per-session cache file for tables auto-baked during a render (one per Huang f
+    refinement)."""
     folder = bpy.app.tempdir or tempfile.gettempdir()
-    digest = hashlib.sha1(parameters.encode("utf-8")).hexdigest()[:16]
+    key = parameters if refinement == 1 else "%s;huang_f_refinement=%d" % (parameters, refinement)
+    digest = hashlib.sha1(key.encode("utf-8")).hexdigest()[:16]
     return os.path.join(folder, "hairis_autobake_%s.exr" % digest)
 
 
-def cached_tables(library, fiber, need_multiple=False):
+def cached_tables(library, fiber, need_multiple=False, refinement=1):
     """Tables from the auto-bake cache when present and matching ``fiber`` (and holding
     multiple-scattering tables if ``need_multiple``), else None."""
-    path = cache_path(fiber.parameters)
+    path = cache_path(fiber.parameters, refinement)
     if not os.path.isfile(path):
         return None
     try:
@@ -231,9 +242,9 @@ def cached_tables(library, fiber, need_multiple=False):
     return None
 
 
-def write_cache(tables, fiber):
+def write_cache(tables, fiber, refinement=1):
     """Writes auto-baked tables to the cache; returns the path, or None if writing failed."""
-    path = cache_path(fiber.parameters)
+    path = cache_path(fiber.parameters, refinement)
     try:
         tables.write(path)
     except native.HairisError:

@@ -216,7 +216,7 @@ class HAIRIS_RENDER_PT_strategy(RenderPanel, bpy.types.Panel):
                    settings.integrator != "DUAL_SCATTERING")
         draw_props(column, settings, ("multiple_weight", "n_h"),
                    settings.strategy in {"TABLE", "GAUSSIAN"})
-        sub = draw_props(column, settings, ("auto_bake",), settings.needs_tables)
+        sub = draw_props(column, settings, ("huang_bake", "auto_bake"), settings.needs_tables)
         sub.operator("hairis.bake_tables", icon="RENDER_STILL")
         layout.separator()
         draw_library_status(layout)

@@ -355,7 +355,9 @@ def test_packed_tables_render_without_their_file():
 
 def test_huang_tables_without_their_f_are_stale():
     """Blender 4.0+: Huang tables that hold no baked f (an earlier hairis, or huang_f=0) are
-    stale, so that auto-bake replaces them; with the f part the same bake is current."""
+    stale, so that auto-bake replaces them; with the f part the same bake is current. Tables
+    whose f was baked at another Huang Bake than the scene's are stale too, and Huang Bake
+    reaches the bake options and the auto-bake cache."""
     helpers.skip_without_huang()
     material = bpy.data.materials["Hair"]
     node = next(n for n in material.node_tree.nodes
@@ -379,8 +381,30 @@ def test_huang_tables_without_their_f_are_stale():
                 states[huang_f] = (status.state, status.message)
                 if status.tables is not None:
                     status.tables.close()
+            # The huang_f=1 bake above has refinement 1: current for Fast, stale for Fine.
+            fine = bpy.context.scene.hairis
+            fine.huang_bake = "FINE"
+            assert fine.huang_f_refinement == 2
+            status = tables.check_material(lib, material, fiber,
+                                           refinement=fine.huang_f_refinement)
+            states["fine"] = (status.state, status.message)
+            path = os.path.join(ARGS.workdir, "huang_fine.exr")
+            with lib.bake_tables(fiber, dict(small, huang_f_refinement=2)) as baked:
+                assert baked.info["huang_f_refinement"] == "2", baked.info
+                baked.write(path)
+            material.hairis.table_image = bpy.data.images.load(path, check_existing=False)
+            status = tables.check_material(lib, material, fiber, refinement=2)
+            states["fine bake"] = (status.state, status.message)
+            if status.tables is not None:
+                status.tables.close()
+            fine.huang_bake = "FAST"
+            assert tables.cache_path(fiber.parameters, 2) != tables.cache_path(fiber.parameters)
         assert states[0][0] == "STALE" and "no baked f" in states[0][1], states
         assert states[1][0] == "OK", states
+        assert states["fine"][0] == "STALE" and "Huang Bake" in states["fine"][1], states
+        assert states["fine bake"][0] == "OK", states
+        assert tables.bake_options(lib, refinement=2)["huang_f_refinement"] == 2
+        assert tables.bake_options(lib)["huang_f_refinement"] == 1
         # Auto-bake leaves the multiple part out unless Dual Scattering reads it.
         assert tables.bake_options(lib, multiple=False)["huang_multiple"] == 0
         assert tables.bake_options(lib)["huang_multiple"] == 1

@@ -115,6 +115,7 @@ def test_engine_and_properties_registered():
     assert settings.strategy == "TABLE" and settings.multiple_weight == 0.0
     assert settings.n_h == "2" and settings.n_h_value == 2
     assert settings.seed == 0 and settings.threads == 0 and settings.auto_bake is True
+    assert settings.huang_bake == "FAST" and settings.huang_f_refinement == 1
     assert [item.identifier for item in
             settings.bl_rna.properties["n_h"].enum_items] == ["1", "2", "4", "8", "16"]
     assert [item.identifier for item in settings.bl_rna.properties["strategy"].enum_items] == \
