@@ -56,22 +56,10 @@ DirectionCones::DirectionCones(const std::vector<Vec3d> &directions, int bands) 
     }
 }
 
-DirectionCones::Side DirectionCones::side(const Cone &cone, Vec3d l, double c) {
-    // A member at angle ≤ ρ from the axis, the axis at δ from l: the member's angle to l is in
-    // [max(0, δ − ρ), min(π, δ + ρ)], and dot(d, l) = |l| cos of it.
-    const double len = length(l);
-    if (!cone.decidable || !(len > 0.0) || !std::isfinite(len)) return Side::Mixed;
-    const double cos_delta = std::clamp(dot(cone.axis, l) / len, -1.0, 1.0);
-    const double sin_delta = std::sqrt(1.0 - cos_delta * cos_delta);
-    const double highest = cos_delta >= cone.cos_radius ? 1.0
-                                                        : cos_delta * cone.cos_radius + sin_delta * cone.sin_radius;
-    const double lowest = cos_delta <= -cone.cos_radius ? -1.0
-                                                        : cos_delta * cone.cos_radius - sin_delta * cone.sin_radius;
+DirectionCones::Threshold::Threshold(Vec3d l, double c) : l_(l), c_(c), len_(length(l)) {
+    usable_ = len_ > 0.0 && std::isfinite(len_);
     // The margin scales with |l|, as the rounding of dot(d, l) does.
-    const double margin = kMargin * std::max(1.0, len);
-    if (len * highest < c - margin) return Side::Below;
-    if (len * lowest >= c + margin) return Side::AtOrAbove;
-    return Side::Mixed;
+    margin_ = kMargin * std::max(1.0, len_);
 }
 
 }  // namespace hairis

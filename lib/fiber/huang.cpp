@@ -218,6 +218,73 @@ bool exit_tir(const Closure &c, const Vec3d &wtr, Vec3d l) {
     return dot(-wtr, l) < 1.0 / c.eta - kTirSlack;
 }
 
+// The expectation's exits, one per precomputed path and ω_i: tt_exit and trt_exit with what
+// does not depend on ω_i (the Smith Λ of the path's own cosine, the exit's energy scale, the
+// visibility of w_tr against the exit normals) computed once per path.
+struct ExitTerms {
+    double alpha2, inv_eta;
+
+    double lambda(double cos_m) const {  // ggx::smith_lambda
+        const double c2 = cos_m * cos_m;
+        if (c2 >= 1.0) return 0.0;
+        const double tan2 = std::max(1.0 / c2 - 1.0, 0.0);
+        return 0.5 * (std::sqrt(1.0 + alpha2 * tan2) - 1.0);
+    }
+    double distribution(double cos_mh) const {  // ggx::distribution
+        const double c2 = std::min(cos_mh * cos_mh, 1.0);
+        const double d = (1.0 - c2) + alpha2 * c2;
+        return alpha2 / (kPi * d * d);
+    }
+    double transmittance(double cos_i) const {  // 1 − fresnel(cos_i, 1/η), leaving the fiber
+        const double c = std::fabs(cos_i);
+        const double sin2_t = (1.0 - c * c) / (inv_eta * inv_eta);
+        if (sin2_t >= 1.0) return 0.0;
+        const double cos_t = std::sqrt(1.0 - sin2_t);
+        const double r_s = (c - inv_eta * cos_t) / (c + inv_eta * cos_t);
+        const double r_p = (inv_eta * c - cos_t) / (inv_eta * c + cos_t);
+        return 1.0 - 0.5 * (r_s * r_s + r_p * r_p);
+    }
+    // tt_exit for one path.
+    double tt(const Vec3d &wt, const Vec3d &n2, double lambda2, const Vec3d &l) const {
+        if (!(dot(l, wt) >= inv_eta - kTirSlack)) return 0.0;
+        const Vec3d hh = -wt + inv_eta * l;
+        const double rcp = 1.0 / length(hh);
+        const Vec3d h2 = hh * rcp;
+        const double cos_mh2 = dot(n2, h2);
+        if (!(cos_mh2 >= 0.0)) return 0.0;
+        const double cos_hi2 = dot(-wt, h2), cos_ho2 = dot(-l, h2), cos_mo2 = dot(-l, n2);
+        return transmittance(cos_hi2) * distribution(cos_mh2) / (1.0 + lambda2 + lambda(cos_mo2)) * cos_hi2 *
+               cos_ho2 * rcp * rcp;
+    }
+    // trt_exit for one path whose w_tr faces n3 and m3, without the energy scale: T₃ D₃ G₃
+    // c_hi3 c_ho3 / |ĥ₃|² written over one common denominator (ĥ₃ = w_tr + l/η unnormalized,
+    // Fresnel's two ratios, GGX's D and the Smith G₂ of §6.2), one division per term.
+    double trt(const Vec3d &wtr, const Vec3d &n3, const Vec3d &m3, double lambda3, const Vec3d &l) const {
+        const double cos_ln3 = dot(l, n3), cos_lm3 = dot(l, m3);
+        if (!(cos_ln3 < 0.0) || !(cos_lm3 < 0.0)) return 0.0;
+        const Vec3d hh = wtr + inv_eta * l;
+        const double len2 = dot(hh, hh), len = std::sqrt(len2);
+        const double n_h = dot(n3, hh), i_h = dot(hh, wtr), o_h = -dot(hh, l);
+        if (n_h < 0.0 || !(i_h > 0.0) || !(o_h > 0.0)) return 0.0;
+        // Fresnel at cos_hi3 = i_h / |ĥ|, leaving the fiber: T = 1 − ½(a²/b² + e²/d²).
+        const double c = i_h / len;
+        const double sin2_t = (1.0 - c * c) / (inv_eta * inv_eta);
+        if (sin2_t >= 1.0) return 0.0;
+        const double cos_t = std::sqrt(1.0 - sin2_t);
+        const double a = c - inv_eta * cos_t, b = c + inv_eta * cos_t;
+        const double e = inv_eta * c - cos_t, d = inv_eta * c + cos_t;
+        const double b2d2 = b * b * d * d;
+        const double t_num = b2d2 - 0.5 * (a * a * d * d + e * e * b * b);
+        // D = α² / (π q²), q = 1 − c² + α² c² at c = cos_mh3 = n_h / |ĥ|.
+        const double c2 = std::min(n_h * n_h / len2, 1.0);
+        const double q = (1.0 - c2) + alpha2 * c2;
+        // 1 + Λ(cos_m3) + Λ(cos_mo3), Λ(c) = ½(√(1 + α² tan²) − 1) = ½(√(c² + α²(1 − c²)) / |c| − 1).
+        const double co = std::fabs(cos_ln3), co2 = co * co;
+        const double g_num = co * (0.5 + lambda3) + (co2 >= 1.0 ? 0.5 : 0.5 * std::sqrt(co2 + alpha2 * (1.0 - co2)));
+        return t_num * alpha2 * i_h * o_h * co / (b2d2 * kPi * q * q * g_num * len2 * len2);
+    }
+};
+
 }  // namespace
 
 namespace {
@@ -442,7 +509,7 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
             HuangExpectation::TtPath path;
             path.wt = e.wt;
             path.n2 = e.n2;
-            path.cos_m2 = e.cos_m2;
+            path.lambda2 = ggx::smith_lambda(alpha_, e.cos_m2);
             path.coefficient = base * m_tt_ * c.ellipse.arc(e.gamma2) * e.t1 * e.s1 * e.s2 * e.g1o * e.cos_m1 / e.cos_o1;
             path.colour = e.at;
             out.tt_.push_back(path);
@@ -481,14 +548,15 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
                     continue;
                 }
                 for (int i = 0; i < 3; ++i) out.trrt_always_[i] += trrt[i];
+                // trt_exit is 0 for every ω_i unless w_tr faces both exit normals.
+                if (!(b.cos_m3 > 0.0) || !(dot(b.wtr, b.m3) > 0.0)) continue;
                 HuangExpectation::TrtPath path;
                 path.wtr = b.wtr;
                 path.n3 = b.n3;
                 path.m3 = b.m3;
-                path.cos_m3 = b.cos_m3;
-                path.scale3 = b.s3;
+                path.lambda3 = ggx::smith_lambda(alpha_, b.cos_m3);
                 path.coefficient = weight * m_trt_ * c.ellipse.arc(b.gamma3) * e.t1 * e.s1 * b.r2 *
-                                   e.s2 * e.g1o * b.g2o * e.cos_m1 * e.cos_m2 / (e.cos_o1 * b.cos_mo2);
+                                   e.s2 * e.g1o * b.g2o * e.cos_m1 * e.cos_m2 / (e.cos_o1 * b.cos_mo2) * b.s3;
                 for (int i = 0; i < 3; ++i) path.colour[i] = e.at[i] * b.atr[i];
                 out.trt_.push_back(path);
             }
@@ -532,20 +600,22 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
     const double factor = (2.0 / 3.0) * p.res_delta / p.denominator;
     const double inv_eta2 = 1.0 / (c.eta * c.eta);
     Colour tt{}, trt{}, trrt = trrt_always_;
+    const ExitTerms exits{c.alpha * c.alpha, 1.0 / c.eta};
     for (const TtPath &path : tt_) {
-        const double x = path.coefficient * tt_exit(c, path.wt, path.n2, path.cos_m2, l);
+        const double x = path.coefficient * exits.tt(path.wt, path.n2, path.lambda2, l);
         if (!std::isfinite(x)) continue;
         for (int k = 0; k < 3; ++k) tt[k] += x * path.colour[k];
     }
     // A TRT exit below cos_min from −w_tr is totally reflected (exit_tir).
     const double cos_min = 1.0 / c.eta - kTirSlack;
+    const DirectionCones::Threshold tir(l, cos_min);
     for (const DirectionCones::Cone &cone : trt_cones_.cones()) {
-        const DirectionCones::Side side = DirectionCones::side(cone, l, cos_min);
+        const DirectionCones::Side side = tir.side(cone);
         if (side == DirectionCones::Side::Below) continue;
         for (std::uint32_t j = cone.begin; j < cone.end; ++j) {
             const TrtPath &path = trt_[j];
             if (side == DirectionCones::Side::Mixed && exit_tir(c, path.wtr, l)) continue;
-            const double x = path.coefficient * trt_exit(c, path.wtr, path.n3, path.m3, path.cos_m3, path.scale3, l);
+            const double x = path.coefficient * exits.trt(path.wtr, path.n3, path.m3, path.lambda3, l);
             if (!std::isfinite(x)) continue;
             for (int k = 0; k < 3; ++k) trt[k] += x * path.colour[k];
         }
@@ -597,9 +667,10 @@ void HuangExpectation::TirPaths::group() {
 
 std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double cos_min) const {
     double sr = 0.0, sg = 0.0, sb = 0.0;
+    const DirectionCones::Threshold threshold(l, cos_min);
     for (std::size_t c = 0; c < cone_sums.size(); ++c) {
         const DirectionCones::Cone &cone = cones.cones()[c];
-        switch (DirectionCones::side(cone, l, cos_min)) {
+        switch (threshold.side(cone)) {
         case DirectionCones::Side::Below:
             sr += cone_sums[c][0];
             sg += cone_sums[c][1];

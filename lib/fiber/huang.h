@@ -141,14 +141,19 @@ class HuangExpectation {
 
   private:
     friend class HuangFiber;
-    struct TtPath {  // f adds coefficient·colour·T₂·D₂·G₂·c_hi2·c_ho2/|ĥ₂|²
+    /// f adds coefficient·colour·T₂·D₂·G₂·c_hi2·c_ho2/|ĥ₂|²; Λ(cos_m2) does not depend on ω_i,
+    /// so it is computed once per path.
+    struct TtPath {
         Vec3d wt, n2;
-        double coefficient = 0, cos_m2 = 0;
+        double coefficient = 0, lambda2 = 0;
         std::array<double, 3> colour{};
     };
-    struct TrtPath {  // one TRT exit; its TRRT+ term is in trrt_always_
+    /// One TRT exit (its TRRT+ term is in trrt_always_); the coefficient includes the exit's
+    /// energy scale. Only paths whose w_tr faces both exit normals are kept: the others never
+    /// pass the exit's visibility test.
+    struct TrtPath {
         Vec3d wtr, n3, m3;
-        double coefficient = 0, cos_m3 = 0, scale3 = 0;
+        double coefficient = 0, lambda3 = 0;
         std::array<double, 3> colour{};
     };
     /// TRRT+ terms that count only when the exit is totally reflecting, as columns grouped

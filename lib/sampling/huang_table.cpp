@@ -224,6 +224,8 @@ Status HuangTableSet::validate() const {
         if (name.empty() || name.find_first_of("=;") != std::string::npos || !std::isfinite(value))
             return Error{"Huang table parameter \"" + name + "\" must have a plain name and a finite value"};
     if (Status s = HuangTable::check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values)) return s;
+    if (Status s = check::count_in_range("the Huang table's f_refinement", f_refinement, 1, kMaxHuangFRefinement))
+        return s;
     if (f.empty()) return std::nullopt;
     if (f.size() != 3 * values.size())
         return Error{"the Huang table's f part must hold 3 values (RGB) per cell, " + std::to_string(3 * values.size()) +

@@ -136,6 +136,10 @@ class HuangTable {
 /// The parameters a Huang table records: the fiber's, in HuangParams' order and names.
 std::vector<std::pair<std::string, double>> huang_parameters(const HuangParams &params);
 
+/// The largest f refinement (HuangBakeOptions::f_refinement): the rule's finest order stays
+/// within GaussLegendre's nodes.
+inline constexpr int kMaxHuangFRefinement = 4;
+
 /// A baked Huang table as plain data: what a table file holds.
 struct HuangTableSet {
     std::string model = "huang2022";
@@ -146,13 +150,15 @@ struct HuangTableSet {
     /// The baked expectation of f·|cos θ_i| of TT, TRT and TRRT+, RGB per cell in values'
     /// order (huang_f_table.h), or empty: renders then use Cycles' one-sample eval.
     std::vector<float> f;
-    /// The factor of the f part's quadrature orders it was baked with (HuangBakeOptions).
+    /// The factor of the f part's quadrature orders it was baked with (HuangBakeOptions), in
+    /// [1, kMaxHuangFRefinement].
     int f_refinement = 1;
 
     int theta_o_count() const { return int(theta_o_nodes.size()); }
     int phi_o_count() const { return int(phi_o_nodes.size()); }
     /// The model, plain parameter names with finite values, what HuangTable::check checks,
-    /// and an f part that is empty or 3 finite non-negative values per cell.
+    /// an f part that is empty or 3 finite non-negative values per cell, and f_refinement in
+    /// range.
     Status validate() const;
     bool has_f() const { return !f.empty(); }
 };

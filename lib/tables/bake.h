@@ -16,9 +16,6 @@
 
 namespace hairis {
 
-/// The largest huang_f_refinement: the rule's finest order stays within GaussLegendre's nodes.
-constexpr int kMaxHuangFRefinement = 4;
-
 /// The resolution of a Huang table (sampling/huang_table.h): θ_o nodes, φ_o nodes, θ_i cells
 /// and cells of φ_i − φ_o (HuangBakeOptions takes its defaults from here).
 struct HuangResolution {

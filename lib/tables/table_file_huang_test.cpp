@@ -258,6 +258,19 @@ TEST(HuangTableFile, TheFPartsRefinementRoundTrips) {
                    "refinement");
 }
 
+// A hand-built set can hold any refinement; the encoder refuses what the reader would.
+TEST(HuangTableFile, TheEncoderRefusesARefinementOutOfRange) {
+    TableSet t = with_distinct_f(distinct_tables());
+    for (int k : {0, kMaxHuangFRefinement + 1}) {
+        auto h = std::make_shared<HuangTableSet>(*t.huang);
+        h->f_refinement = k;
+        t.huang = h;
+        const Expected<std::vector<unsigned char>> bytes = encode_table_exr(t);
+        ASSERT_FALSE(bytes.ok()) << "refinement " << k;
+        EXPECT_NE(bytes.error().message.find("f_refinement"), std::string::npos) << bytes.error().message;
+    }
+}
+
 TEST(HuangTableFile, RefusesADamagedFPart) {
     const TableSet t = with_distinct_f(distinct_with_multiple());
     expect_refused(tamper(t, [](Image &im) { im.at(1, 25, 3) = 0.5f; }), "A must be 1 in the f part");
