@@ -73,7 +73,7 @@ def collect_jobs(library, material_name="", force=False, refinement=1):
 def run_job(library, job, options, progress=None):
     """Bakes and writes one job's tables (no ``bpy``: safe in a worker thread).
 
-    Returns (parameters, model) of the written tables.
+    Returns (parameters, model, Huang f refinement or 0) of the written tables.
     """
     with library.fiber_principled(job.node) as fiber:
         with library.bake_tables(fiber, options, progress) as baked:
@@ -81,17 +81,17 @@ def run_job(library, job, options, progress=None):
             if folder:
                 os.makedirs(folder, exist_ok=True)
             baked.write(job.path)
-            return baked.parameters, baked.model
+            return baked.parameters, baked.model, int(baked.info.get("huang_f_refinement", 0))
 
 
-def finish_job(operator, job, parameters, model):
+def finish_job(operator, job, parameters, model, refinement=0):
     """Stores a finished job's file as the material's table image (main thread)."""
     material = bpy.data.materials.get(job.material_name)
     if material is None:
         operator.report({"WARNING"}, "material %r was removed during the bake" % job.material_name)
         return
     tables.store_image(material, job.path, job.stored_path, not job.blend_saved, parameters,
-                       model)
+                       model, refinement)
     if not job.blend_saved:
         operator.report({"WARNING"}, "the .blend is not saved: tables of %r were written to %s and "
                         "packed into the file; save the .blend and bake again to keep them next "
@@ -152,12 +152,12 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
                     wm.progress_update(number + value)
                     return False
                 try:
-                    parameters, model = run_job(library, job, options, progress)
+                    baked = run_job(library, job, options, progress)
                 except native.HairisError as error:
                     failed += 1
                     self.report({"ERROR"}, "material %r: %s" % (job.material_name, error))
                     continue
-                finish_job(self, job, parameters, model)
+                finish_job(self, job, *baked)
         finally:
             wm.progress_end()
         if failed:
@@ -200,7 +200,7 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
                 self._progress[:] = [number, value]
                 return self._cancel.is_set()
             try:
-                parameters, model = run_job(library, job, options, progress)
+                payload = run_job(library, job, options, progress)
             except native.HairisCancelled:
                 self._results.put(("CANCELLED", job, None))
                 break
@@ -210,7 +210,7 @@ class HAIRIS_OT_bake_tables(bpy.types.Operator):
             except Exception as error:  # noqa: BLE001 - reported on the main thread
                 self._results.put(("ERROR", job, "%s: %s" % (type(error).__name__, error)))
                 continue
-            self._results.put(("DONE", job, (parameters, model)))
+            self._results.put(("DONE", job, payload))
         self._results.put(("END", None, None))
 
     def modal(self, context, event):

@@ -190,6 +190,10 @@ class HairisMaterialSettings(bpy.types.PropertyGroup):
         description="The fiber parameters the tables were baked for (name=value;...)")
     baked_model: StringProperty(
         name="Baked Model", description="The fiber model the tables were baked for")
+    baked_huang_f_refinement: IntProperty(
+        name="Baked Huang Bake", min=0, default=0,
+        description="The Huang f refinement the tables were baked with (0: not a Huang bake, "
+        "or not recorded)")
 
     @classmethod
     def register(cls):

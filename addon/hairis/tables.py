@@ -148,8 +148,9 @@ def check_material(library, material, fiber, need_multiple=False, refinement=1):
     return TableStatus("OK", "material %r: tables are current" % material.name, tables)
 
 
-def quick_state(library, material):
-    """A cheap check for the UI (no table load): 'OK', 'MISSING', 'STALE' or 'ERROR'."""
+def quick_state(library, material, refinement=1):
+    """A cheap check for the UI (no table load): 'OK', 'MISSING', 'STALE', 'OTHER_BAKE' (a
+    Huang f baked at another Huang Bake than ``refinement``) or 'ERROR'."""
     settings = material.hairis
     image = settings.table_image
     if image is None:
@@ -162,7 +163,10 @@ def quick_state(library, material):
             current = fiber.parameters
     except (TableError, native.HairisError):
         return "ERROR"
-    return "OK" if current == settings.baked_parameters else "STALE"
+    if current != settings.baked_parameters:
+        return "STALE"
+    baked = settings.baked_huang_f_refinement
+    return "OTHER_BAKE" if baked and baked != refinement else "OK"
 
 
 def table_filename(material):
@@ -186,8 +190,9 @@ def output_path(material):
     return path, path, False
 
 
-def store_image(material, path, stored_path, pack, parameters, model):
-    """Loads ``path`` as the material's table image (float, Non-Color) and records the bake.
+def store_image(material, path, stored_path, pack, parameters, model, refinement=0):
+    """Loads ``path`` as the material's table image (float, Non-Color) and records the bake
+    (``refinement``: its Huang f refinement, 0 for other models).
 
     Main thread only (writes ``bpy.data``). An image already pointing at ``path`` is
     reloaded; otherwise a new datablock replaces the old one (removed if nothing else uses it).
@@ -212,6 +217,7 @@ def store_image(material, path, stored_path, pack, parameters, model):
     settings.table_image = image
     settings.baked_parameters = parameters
     settings.baked_model = model
+    settings.baked_huang_f_refinement = int(refinement)
     if old is not None and old != image and old.users == 0:
         bpy.data.images.remove(old)
     return image

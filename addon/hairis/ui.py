@@ -326,11 +326,13 @@ class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
         column.template_ID(settings, "table_image", open="image.open")
         if status.ok:
             library = native.load_library(status.path)
-            state = tables.quick_state(library, material)
+            state = tables.quick_state(library, material,
+                                       context.scene.hairis.huang_f_refinement)
             text, icon = {
                 "OK": ("Tables are current", "CHECKMARK"),
                 "MISSING": ("No tables baked", "ERROR"),
                 "STALE": ("Tables are stale: the hair parameters changed", "ERROR"),
+                "OTHER_BAKE": ("Tables are stale: baked at the other Huang Bake", "ERROR"),
                 "ERROR": ("The hair node cannot be read", "ERROR"),
             }[state]
             column.label(text=text, icon=icon)

@@ -24,6 +24,7 @@ native = helpers.module("native")
 engine = helpers.module("engine")
 export = helpers.module("export")
 tables = helpers.module("tables")
+operators = helpers.module("operators")
 STATUS = native.library_status()
 assert STATUS.ok, "the library exists but does not load: " + STATUS.message
 FAKE = STATUS.version.endswith("-fake")
@@ -364,6 +365,7 @@ def test_huang_tables_without_their_f_are_stale():
                 if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
     node.model = "HUANG"
     saved = material.hairis.table_image
+    saved_record = (material.hairis.baked_parameters, material.hairis.baked_model)
     lib = library()
     small = {"huang_theta_o": 4, "huang_phi_o": 2, "huang_theta_i": 8, "huang_phi": 8,
              "huang_multiple": 0}
@@ -388,11 +390,17 @@ def test_huang_tables_without_their_f_are_stale():
             status = tables.check_material(lib, material, fiber,
                                            refinement=fine.huang_f_refinement)
             states["fine"] = (status.state, status.message)
+            # The Bake operator's steps: the bake records its refinement with the image, which
+            # the panel's quick state compares with the scene's Huang Bake.
             path = os.path.join(ARGS.workdir, "huang_fine.exr")
-            with lib.bake_tables(fiber, dict(small, huang_f_refinement=2)) as baked:
-                assert baked.info["huang_f_refinement"] == "2", baked.info
-                baked.write(path)
-            material.hairis.table_image = bpy.data.images.load(path, check_existing=False)
+            job = operators.BakeJob(material.name, tables.principled_struct(lib, params), path,
+                                    path, True)
+            parameters, model, refinement = operators.run_job(
+                lib, job, dict(small, huang_f_refinement=2))
+            assert (model, refinement) == ("huang2022", 2), (model, refinement)
+            tables.store_image(material, path, path, False, parameters, model, refinement)
+            states["fine quick"] = tables.quick_state(lib, material, 2)
+            states["fast quick"] = tables.quick_state(lib, material, 1)
             status = tables.check_material(lib, material, fiber, refinement=2)
             states["fine bake"] = (status.state, status.message)
             if status.tables is not None:
@@ -403,6 +411,7 @@ def test_huang_tables_without_their_f_are_stale():
         assert states[1][0] == "OK", states
         assert states["fine"][0] == "STALE" and "Huang Bake" in states["fine"][1], states
         assert states["fine bake"][0] == "OK", states
+        assert (states["fine quick"], states["fast quick"]) == ("OK", "OTHER_BAKE"), states
         assert tables.bake_options(lib, refinement=2)["huang_f_refinement"] == 2
         assert tables.bake_options(lib)["huang_f_refinement"] == 1
         # Auto-bake leaves the multiple part out unless Dual Scattering reads it.
@@ -411,6 +420,8 @@ def test_huang_tables_without_their_f_are_stale():
     finally:
         node.model = "CHIANG"
         material.hairis.table_image = saved
+        material.hairis.baked_parameters, material.hairis.baked_model = saved_record
+        material.hairis.baked_huang_f_refinement = 0
 
 
 TESTS = [
