@@ -119,6 +119,7 @@ struct Entry {
     Vec3d wt, n2, m2;
     double gamma2 = 0, phi_t_mapped = 0;
     double t1 = 0, s1 = 0, s2 = 0, g1o = 0, cos_m1 = 0, cos_o1 = 0, cos_m2 = 0;
+    double ct = 1, path = 0;  // at = exp(σ / ct · path)
     Colour at{};
 };
 
@@ -145,6 +146,8 @@ Entry entry(const Closure &c, double gamma1, Vec3d n1, Vec3d m1, Vec3d h1) {
                             : -length(c.ellipse.point(gamma1) - c.ellipse.point(e.gamma2 + kPi));
     const double ct = cos_theta(e.wt);
     for (int k = 0; k < 3; ++k) e.at[k] = std::exp(c.sigma[k] / ct * path);
+    e.ct = ct;
+    e.path = path;
     e.s2 = c.scale(e.cos_m2, 1.0 / c.eta);
     e.ok = true;
     return e;
@@ -170,6 +173,7 @@ struct Bounce {
     bool ok = false, vis = false;
     Vec3d wtr, n3, m3;
     double r2 = 0, gamma3 = 0, cos_m3 = 0, s3 = 0, g2o = 0, cos_mo2 = 0;
+    double ct = 1, path = 0;  // atr = exp(−σ / ct · path)
     Colour atr{};
 };
 
@@ -193,6 +197,8 @@ Bounce bounce(const Closure &c, double gamma1, const Entry &e, Vec3d h2) {
                             : length(c.ellipse.point(b.gamma3) - c.ellipse.point(e.gamma2));
     const double ct = cos_theta(b.wtr);
     for (int k = 0; k < 3; ++k) b.atr[k] = std::exp(-c.sigma[k] / ct * path);
+    b.ct = ct;
+    b.path = path;
     b.cos_mo2 = dot(-b.wtr, e.n2);
     b.g2o = ggx::shadowing_ratio(c.alpha, e.cos_m2, b.cos_mo2);
     return b;
@@ -797,27 +803,36 @@ Rgb HuangPoint::f_reflection(Vec3 wi) const {
     return Rgb(float(r_lobe(c, p, l) / p.denominator));
 }
 
-Rgb HuangPoint::f_estimate(Vec3 wi, CyclesLcg &lcg) const {
-    const huang::View &p = view_;
-    if (p.empty) return {};
-    const HuangFiber &fiber = *fiber_;
-    const Closure c = closure_of(fiber, p);
-    const Vec3d l = to_closure(p, to_huang(wi));
-    if (faces_no_mesonormal(c, l)) return {};
-    const double r = r_lobe(c, p, l);
+namespace {
+
+// The TT, TRT and TRRT+ sums of one Cycles eval (§7) before the closure's common factors.
+struct ResidualSums {
     Colour tt{}, trt{}, trrt{};
+};
+
+// The Simpson nodes' microfacet chains of one Cycles eval at l, drawn from `lcg` as Cycles
+// draws them: their sums for the closure's σ in `own` and, when `other_sigma` is given, for
+// that σ along the same chains in `other` (the geometry does not depend on σ).
+void chain_sums(const Closure &c, const huang::View &p, Vec3d l, CyclesLcg &lcg, const Colour *other_sigma,
+                ResidualSums &own, ResidualSums *other) {
     for (int k = 0; k <= p.res_intervals && p.res_intervals > 0; ++k) {
         const SimpsonNode node = simpson_node(c, p, p.res_intervals, p.res_delta, k);
         const double u1 = lcg.next(), u2 = lcg.next();
         const Vec3d h1 = ggx::sample_visible(c.alpha, c.v, node.meso, u1, u2);
         const Entry e = entry(c, node.gamma, node.meso, node.macro, h1);
         if (!e.ok) continue;
+        Colour at_other{};
+        if (other_sigma)
+            for (int i = 0; i < 3; ++i) at_other[i] = std::exp((*other_sigma)[i] / e.ct * e.path);
         const double w = node.weight;
         if (c.m_tt > 0.0) {
             const double x = w * c.m_tt * c.ellipse.arc(e.gamma2) * e.t1 * e.s1 * e.s2 * e.g1o *
                              e.cos_m1 / e.cos_o1 * tt_exit(c, e.wt, e.n2, e.cos_m2, l);
             if (std::isfinite(x))
-                for (int i = 0; i < 3; ++i) tt[i] += x * e.at[i];
+                for (int i = 0; i < 3; ++i) {
+                    own.tt[i] += x * e.at[i];
+                    if (other) other->tt[i] += x * at_other[i];
+                }
         }
         if (c.m_trt <= 0.0) continue;
         const double u3 = lcg.next(), u4 = lcg.next();
@@ -825,26 +840,62 @@ Rgb HuangPoint::f_estimate(Vec3 wi, CyclesLcg &lcg) const {
         const Bounce b = bounce(c, node.gamma, e, h2);
         if (!b.ok) continue;
         const Colour q = residual_series(e.t1, b.r2, e.at);
-        if (exit_tir(c, b.wtr, l)) {
-            for (int i = 0; i < 3; ++i) trrt[i] += w * q[i];
-            continue;
+        const Colour q_other = other ? residual_series(e.t1, b.r2, at_other) : Colour{};
+        const bool tir = exit_tir(c, b.wtr, l);
+        if (!tir && !b.vis) continue;
+        if (!tir) {
+            const double x = w * c.m_trt * c.ellipse.arc(b.gamma3) * e.t1 * e.s1 * b.r2 * e.s2 * e.g1o *
+                             b.g2o * e.cos_m1 * e.cos_m2 / (e.cos_o1 * b.cos_mo2) *
+                             trt_exit(c, b.wtr, b.n3, b.m3, b.cos_m3, b.s3, l);
+            if (std::isfinite(x))
+                for (int i = 0; i < 3; ++i) {
+                    own.trt[i] += x * e.at[i] * b.atr[i];
+                    if (other) other->trt[i] += x * at_other[i] * std::exp(-(*other_sigma)[i] / b.ct * b.path);
+                }
         }
-        if (!b.vis) continue;
-        const double x = w * c.m_trt * c.ellipse.arc(b.gamma3) * e.t1 * e.s1 * b.r2 * e.s2 * e.g1o *
-                         b.g2o * e.cos_m1 * e.cos_m2 / (e.cos_o1 * b.cos_mo2) *
-                         trt_exit(c, b.wtr, b.n3, b.m3, b.cos_m3, b.s3, l);
-        if (std::isfinite(x))
-            for (int i = 0; i < 3; ++i) trt[i] += x * e.at[i] * b.atr[i];
-        for (int i = 0; i < 3; ++i) trrt[i] += w * q[i];
+        for (int i = 0; i < 3; ++i) {
+            own.trrt[i] += w * q[i];
+            if (other) other->trrt[i] += w * q_other[i];
+        }
     }
+}
+
+// f·|cos θ_i| from R and the chains' sums (§7's closing factors).
+Colour assemble(const Closure &c, const huang::View &p, Vec3d l, double r, const ResidualSums &s) {
     const double m = chiang::longitudinal_scattering(p.v.y, cos_theta(p.v), l.y, cos_theta(l), 4.0 * c.alpha);
     const double factor = (2.0 / 3.0) * p.res_delta;
     const double inv_eta2 = 1.0 / (c.eta * c.eta);
     Colour sum;
     for (int i = 0; i < 3; ++i)
-        sum[i] = (r + factor * ((tt[i] + trt[i]) * inv_eta2 + trrt[i] * m * kInvTwoPi * (2.0 / kPi))) /
+        sum[i] = (r + factor * ((s.tt[i] + s.trt[i]) * inv_eta2 + s.trrt[i] * m * kInvTwoPi * (2.0 / kPi))) /
                  p.denominator;
-    return rgb_of(sum);
+    return sum;
+}
+
+}  // namespace
+
+Rgb HuangPoint::f_estimate(Vec3 wi, CyclesLcg &lcg) const {
+    const huang::View &p = view_;
+    if (p.empty) return {};
+    const Closure c = closure_of(*fiber_, p);
+    const Vec3d l = to_closure(p, to_huang(wi));
+    if (faces_no_mesonormal(c, l)) return {};
+    const double r = r_lobe(c, p, l);
+    ResidualSums own;
+    chain_sums(c, p, l, lcg, nullptr, own, nullptr);
+    return rgb_of(assemble(c, p, l, r, own));
+}
+
+Rgb HuangPoint::f_estimate_difference(Vec3 wi, CyclesLcg &lcg, const HuangFiber &other) const {
+    const huang::View &p = view_;
+    if (p.empty) return {};
+    const Closure c = closure_of(*fiber_, p);
+    const Vec3d l = to_closure(p, to_huang(wi));
+    if (faces_no_mesonormal(c, l)) return {};
+    ResidualSums own, alt;
+    chain_sums(c, p, l, lcg, &other.sigma(), own, &alt);
+    const Colour a = assemble(c, p, l, 0.0, own), b = assemble(c, p, l, 0.0, alt);
+    return rgb_of({a[0] - b[0], a[1] - b[1], a[2] - b[2]});
 }
 
 std::optional<HuangCyclesSample> HuangPoint::sample_cycles(float u_lobe, float u_offset,

@@ -196,6 +196,10 @@ class HuangPoint final : public FiberPoint {
     /// One Cycles eval: the Simpson nodes with one microfacet chain per node drawn from `lcg`
     /// exactly as Cycles consumes it (§7). Its mean over draws is the expectation.
     Rgb f_estimate(Vec3 wi, CyclesLcg &lcg) const;
+    /// f_estimate(wi, lcg) minus the eval of `other` that replays the same stream, in one
+    /// pass. `other` must draw the same microfacet chains (the same roughness, IOR, offset,
+    /// aspect ratio and lobe multipliers): only its absorption is read. R cancels.
+    Rgb f_estimate_difference(Vec3 wi, CyclesLcg &lcg, const HuangFiber &other) const;
     /// Cycles' sampler (§8): u_lobe = rand.x, u_offset = rand.y (far field), u_microfacet =
     /// rand.z, the rest from `lcg`. nullopt where Cycles returns pdf 0 (or is transparent).
     std::optional<HuangCyclesSample> sample_cycles(float u_lobe, float u_offset, float u_microfacet,

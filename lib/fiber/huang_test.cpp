@@ -425,6 +425,38 @@ TEST(Huang, AlbedoIsCyclesEstimate) {
     }
 }
 
+// f_estimate_difference is the fiber's eval minus another absorption's along the same chains:
+// draw by draw the difference of the two fibers' own evals replaying one stream, at far and
+// near field, a grazing view (total internal reflection at most exits) and a clear fiber.
+TEST(Huang, EstimateDifferenceIsTheDifferenceOfTwoEvalsOnOneStream) {
+    const Rgb sigmas[] = {{0.0f, 0.0f, 0.0f}, {2.0f, 0.7f, 0.05f}};
+    for (const double theta_o : {0.4, 1.45})
+        for (const float h : {0.0f, 0.35f}) {
+            const HuangFiber a = make_fiber(0.3f, 0.8f), b = make_fiber(0.3f, 0.8f, sigmas[h > 0.0f ? 1 : 0]);
+            FiberHit hit;
+            hit.wo = view_at(theta_o);
+            hit.normal = normal_at(0.4);
+            hit.h = h;
+            hit.pixel_coverage = h > 0.0f ? 0.01f : 1.0f;  // near field: a pixel narrower than the fiber
+            const HuangPoint pa = a.at(hit), pb = b.at(hit);
+            ASSERT_EQ(pa.near_field(), h > 0.0f);
+            CyclesLcg lcg{41};
+            double largest = 0.0;
+            for (int n = 0; n < 200; ++n) {
+                const Vec3 wi = light_at(-0.6 + 0.006 * n, 0.031 * n);
+                CyclesLcg replay_a = lcg, replay_b = lcg;
+                const Rgb expected = pa.f_estimate(wi, replay_a) - pb.f_estimate(wi, replay_b);
+                const Rgb d = pa.f_estimate_difference(wi, lcg, b);
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_NEAR(d[k], expected[k], 1e-6 * (1.0 + std::fabs(expected[k]))) << theta_o << " " << n;
+                    largest = std::max(largest, std::fabs(double(expected[k])));
+                }
+                ASSERT_EQ(lcg.state, replay_a.state);  // it draws as one eval does
+            }
+            EXPECT_GT(largest, 1e-3) << "the absorptions must differ visibly at θ_o " << theta_o;
+        }
+}
+
 // Cycles' sampler is an unbiased estimator of its own scattering: the mean weight over many
 // samples is the sampler's albedo. The reference is Cycles itself: a thin clear fiber in a white
 // world with BSDF sampling only renders the sampler's albedo (docs/huang.md §14: bpy 4.5, σ = 0,

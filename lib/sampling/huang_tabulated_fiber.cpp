@@ -8,11 +8,13 @@ namespace hairis {
 
 namespace {
 
-// Whether a strand's microfacet chains are the node's: Cycles draws them from the roughness,
-// IOR, offset and aspect ratio only (absorption and the lobe multipliers scale them).
-bool same_chains(const HuangFiber &a, const HuangFiber &b) {
+// Whether a strand differs from the node in its absorption only: Cycles draws the microfacet
+// chains from the roughness, IOR, offset and aspect ratio, and the lobe multipliers scale
+// them (HuangPoint::f_estimate_difference reads only the other fiber's absorption).
+bool absorption_only(const HuangFiber &a, const HuangFiber &b) {
     return a.roughness() == b.roughness() && a.ior() == b.ior() && a.tilt() == b.tilt() &&
-           a.aspect_ratio() == b.aspect_ratio();
+           a.aspect_ratio() == b.aspect_ratio() && a.m_r() == b.m_r() && a.m_tt() == b.m_tt() &&
+           a.m_trt() == b.m_trt();
 }
 
 }  // namespace
@@ -22,8 +24,8 @@ HuangTabulatedPoint::HuangTabulatedPoint(const HuangTabulatedFiber &model, const
     : FiberPoint(hit), point_(strand ? *strand : model.fiber(), hit),
       query_(model.table().locate(point_.to_huang(hit.wo))), f_(&model.f_table()), lcg_(point_.lcg()) {
     if (!strand || strand == &model.fiber()) return;
-    if (model.strand_shading() == StrandShading::ControlVariate && same_chains(*strand, model.fiber()))
-        node_.emplace(model.fiber(), hit);
+    if (model.strand_shading() == StrandShading::ControlVariate && absorption_only(*strand, model.fiber()))
+        node_ = &model.fiber();
     else
         own_eval_ = true;
 }
@@ -32,11 +34,9 @@ Rgb HuangTabulatedPoint::f(Vec3 wi) const {
     if (point_.near_field() || own_eval_) return point_.f_estimate(wi, lcg_);
     const Rgb tabulated = f_->f_cos(query_, point_.to_huang(wi));
     if (!node_) return point_.f_reflection(wi) + tabulated;
-    // The control variate: both evals replay one stream of the LCG, so they draw the same
-    // chains; R cancels in the difference and is the strand's own in its eval.
-    CyclesLcg node_lcg = lcg_;
-    const Rgb strand = point_.f_estimate(wi, lcg_);
-    return strand - node_->f_estimate(wi, node_lcg) + node_->f_reflection(wi) + tabulated;
+    // The control variate: the strand's eval and the node's along the same chains, in one
+    // pass; R cancels in the difference and is the same for both.
+    return point_.f_estimate_difference(wi, lcg_, *node_) + point_.f_reflection(wi) + tabulated;
 }
 
 const FiberPoint &HuangTabulatedFiber::prepare(const FiberHit &hit, ScratchBuffer &scratch) const {

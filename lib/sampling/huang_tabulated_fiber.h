@@ -6,18 +6,16 @@
 //
 // A strand whose inputs differ from the node's (HuangStrands) is shaded with its own f. When
 // only its absorption differs, the table is a control variate: f = the baked expectation +
-// (the strand's Cycles eval − the node's), both evals drawing the same microfacet chains, so
-// the correction has mean (strand − node) and little noise. A strand of another roughness,
-// IOR or offset draws other chains; it is shaded with its own Cycles eval. The control variate
-// costs two evals; a renderer whose noise is not the eval's can ask for the strand's own eval
-// everywhere (StrandShading::OwnEval).
+// (the strand's Cycles eval − the node's), both evals following the same microfacet chains in
+// one pass, so the correction has mean (strand − node) and little noise, at about one eval's
+// cost. A strand of another roughness, IOR or offset draws other chains; it is shaded with its
+// own Cycles eval. A renderer can ask for the strand's own eval everywhere
+// (StrandShading::OwnEval).
 #pragma once
 
 #include <memory>
 
 #include "core/expected.h"
-#include <optional>
-
 #include "fiber/huang.h"
 #include "fiber/huang_strands.h"
 #include "sampling/huang_f_table.h"
@@ -29,7 +27,7 @@ class HuangTabulatedFiber;
 
 /// How a strand whose inputs differ from the node's is shaded.
 enum class StrandShading {
-    ControlVariate,  ///< the baked f corrected where only the absorption differs (two evals)
+    ControlVariate,  ///< the baked f corrected where only the absorption differs
     OwnEval,         ///< the strand's own Cycles eval (one eval, noisier)
 };
 
@@ -52,8 +50,9 @@ class HuangTabulatedPoint final : public FiberPoint {
     HuangPoint point_;  // the strand's own fiber at the hit
     HuangTableQuery query_;
     const HuangFTable *f_;
-    // A strand of the node's geometry: the node's fiber at the hit, the control variate's.
-    std::optional<HuangPoint> node_;
+    // A strand that differs from the node in absorption only: the node's fiber, whose eval
+    // along the strand's chains is the control variate.
+    const HuangFiber *node_ = nullptr;
     bool own_eval_ = false;  // a strand of another geometry: its Cycles eval alone
     mutable CyclesLcg lcg_;
 };
