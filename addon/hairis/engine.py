@@ -665,7 +665,7 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                                               threads=settings.threads,
                                               multiple=settings.integrator == "DUAL_SCATTERING",
                                               refinement=settings.huang_f_refinement),
-                          tables.cache_path(fiber.parameters, settings.huang_f_refinement)))
+                          tables.fiber_cache_path(fiber, settings.huang_f_refinement)))
             return None
 
         found = self._resolve_tables(library, data, settings, bake_later)

@@ -232,10 +232,16 @@ def cache_path(parameters, refinement=1):
     return os.path.join(folder, "hairis_autobake_%s.exr" % digest)
 
 
+def fiber_cache_path(fiber, refinement=1):
+    """``cache_path`` of ``fiber``'s tables: Huang Bake changes only Huang tables, so other
+    models keep one cache file whatever the setting."""
+    return cache_path(fiber.parameters, refinement if fiber.model == "huang2022" else 1)
+
+
 def cached_tables(library, fiber, need_multiple=False, refinement=1):
     """Tables from the auto-bake cache when present and matching ``fiber`` (and holding
     multiple-scattering tables if ``need_multiple``), else None."""
-    path = cache_path(fiber.parameters, refinement)
+    path = fiber_cache_path(fiber, refinement)
     if not os.path.isfile(path):
         return None
     try:
@@ -250,7 +256,7 @@ def cached_tables(library, fiber, need_multiple=False, refinement=1):
 
 def write_cache(tables, fiber, refinement=1):
     """Writes auto-baked tables to the cache; returns the path, or None if writing failed."""
-    path = cache_path(fiber.parameters, refinement)
+    path = fiber_cache_path(fiber, refinement)
     try:
         tables.write(path)
     except native.HairisError:

@@ -406,7 +406,7 @@ def test_huang_tables_without_their_f_are_stale():
             if status.tables is not None:
                 status.tables.close()
             fine.huang_bake = "FAST"
-            assert tables.cache_path(fiber.parameters, 2) != tables.cache_path(fiber.parameters)
+            assert tables.fiber_cache_path(fiber, 2) != tables.fiber_cache_path(fiber)
         assert states[0][0] == "STALE" and "no baked f" in states[0][1], states
         assert states[1][0] == "OK", states
         assert states["fine"][0] == "STALE" and "Huang Bake" in states["fine"][1], states
@@ -422,6 +422,11 @@ def test_huang_tables_without_their_f_are_stale():
         material.hairis.table_image = saved
         material.hairis.baked_parameters, material.hairis.baked_model = saved_record
         material.hairis.baked_huang_f_refinement = 0
+    # Huang Bake leaves other models' tables alone: one auto-bake cache file for both settings.
+    chiang = tables.principled_struct(lib, tables.material_parameters(material))
+    with lib.fiber_principled(chiang) as fiber:
+        assert fiber.model == "chiang2016", fiber.model
+        assert tables.fiber_cache_path(fiber, 2) == tables.fiber_cache_path(fiber)
 
 
 TESTS = [
