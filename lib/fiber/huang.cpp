@@ -286,7 +286,7 @@ struct ExitTerms {
         const double q = (1.0 - c2) + alpha2 * c2;
         // 1 + Λ(cos_m3) + Λ(cos_mo3), Λ(c) = ½(√(1 + α² tan²) − 1) = ½(√(c² + α²(1 − c²)) / |c| − 1).
         const double co = std::fabs(cos_ln3), co2 = co * co;
-        const double g_num = co * (0.5 + lambda3) + (co2 >= 1.0 ? 0.5 : 0.5 * std::sqrt(co2 + alpha2 * (1.0 - co2)));
+        const double g_num = co * (0.5 + lambda3) + (co2 >= 1.0 ? 0.5 * co : 0.5 * std::sqrt(co2 + alpha2 * (1.0 - co2)));
         return t_num * alpha2 * i_h * o_h * co / (b2d2 * kPi * q * q * g_num * len2 * len2);
     }
 };

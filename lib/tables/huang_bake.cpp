@@ -52,7 +52,7 @@ Status HuangBakeOptions::validate() const {
                                check::count_in_range("f_first_order", f_first_order, 1, 32),
                                check::count_in_range("f_second_order", f_second_order, 1, 32),
                                check::count_in_range("f_tt_order", f_tt_order, 0, 32),
-                               check::count_in_range("f_refinement", f_refinement, 1, 32)))
+                               check::count_in_range("f_refinement", f_refinement, 1, kMaxHuangFRefinement)))
         return s;
     if (const int finest = std::max({f_first_order, f_second_order, f_tt_order}) * f_refinement; finest > 32)
         return Error{"f_refinement " + std::to_string(f_refinement) + " makes the f part's finest order " +

@@ -217,6 +217,13 @@ TEST(HuangBake, RefusesOptionsByName) {
     o.theta_i_count = 4000;
     o.phi_count = 4000;
     EXPECT_NE(message(o).find("cells; at most"), std::string::npos);
+    // The refinement a table set may record, refused before the bake rather than after it.
+    for (int k : {0, kMaxHuangFRefinement + 1}) {
+        o = {};
+        o.f_tt_order = 0;
+        o.f_refinement = k;
+        EXPECT_NE(message(o).find("f_refinement"), std::string::npos) << k;
+    }
 }
 
 // bake_tables on a Huang fiber: its Huang table set at BakeOptions::huang's resolution, the
