@@ -123,9 +123,8 @@ VisibleParametrization::VisibleParametrization(double alpha, Vec3d w, Vec3d m)
     area_ = 0.5 * kPi * (1.0 + wz);
 }
 
-Vec3d VisibleParametrization::normal(double beta, double psi) const {
-    const double cb = std::cos(beta);
-    const Vec3d H = t1_ * std::sin(beta) + t2_ * (cb * std::sin(psi)) + w_ * (cb * std::cos(psi));
+Vec3d VisibleParametrization::normal(double sin_beta, double cos_beta, double psi) const {
+    const Vec3d H = t1_ * sin_beta + t2_ * (cos_beta * std::sin(psi)) + w_ * (cos_beta * std::cos(psi));
     return unstretch(alpha_, H, a_, b_, m_);
 }
 

@@ -8,6 +8,7 @@
 // depend on their square only, as in Cycles.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "core/vec3d.h"
@@ -53,7 +54,9 @@ class VisibleParametrization {
     bool valid() const { return valid_; }
     double psi_min() const { return psi_min_; }
     /// The normal h(β, ψ) in world coordinates.
-    Vec3d normal(double beta, double psi) const;
+    Vec3d normal(double beta, double psi) const { return normal(std::sin(beta), std::cos(beta), psi); }
+    /// h(β, ψ) from sin β and cos β, for many ψ on one line of β.
+    Vec3d normal(double sin_beta, double cos_beta, double psi) const;
     /// The density of (β, ψ): cos²β cos ψ / area (integrates to 1 over the region).
     double density(double beta, double psi) const;
 
@@ -79,7 +82,7 @@ std::vector<VisibleNode> visible_rule(double alpha, Vec3d w, Vec3d m, int beta_o
 /// visible_rule with each ψ line split where any of `events(h)` (a std::array of continuous
 /// functions of the normal) changes sign, so that jumps and kinks of the integrand at those
 /// events (visibility tests, the critical angle) fall between Gauss panels; `scan` points per
-/// line bracket the roots, bisection refines them.
+/// line bracket the roots, the Illinois variant of regula falsi refines them to 1e-12.
 template <typename Events>
 std::vector<VisibleNode> visible_rule_split(double alpha, Vec3d w, Vec3d m, int beta_order, int psi_order,
                                             int scan, const Events &events);
