@@ -226,7 +226,9 @@ bool exit_tir(const Closure &c, const Vec3d &wtr, Vec3d l) {
 
 // The expectation's exits, one per precomputed path and ω_i: tt_exit and trt_exit with what
 // does not depend on ω_i (the Smith Λ of the path's own cosine, the exit's energy scale, the
-// visibility of w_tr against the exit normals) computed once per path.
+// visibility of w_tr against the exit normals) computed once per path. tt_exit and trt_exit
+// stay the literal transcription of Cycles' eval, so that the expectation is checked against
+// an eval that does not share this code.
 struct ExitTerms {
     double alpha2, inv_eta;
 
