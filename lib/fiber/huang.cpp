@@ -53,6 +53,18 @@ struct Ellipse {
         const double ct = std::cos(tilt);
         return {sp * ct, std::sin(tilt), cp * ct};
     }
+    // n(τ', γ) and n(0, γ) from one sine and cosine of γ, with cos τ' and sin τ' given: the
+    // same values as normal(τ', γ) and normal(0, γ).
+    void normals(double cos_tilt, double sin_tilt, double gamma, Vec3d &tilted, Vec3d &untilted) const {
+        double sp = std::sin(gamma), cp = std::cos(gamma);
+        if (!circular()) {
+            const double x = b * sp, z = cp, len = std::hypot(x, z);
+            sp = x / len;
+            cp = z / len;
+        }
+        tilted = {sp * cos_tilt, sin_tilt, cp * cos_tilt};
+        untilted = {sp, 0.0, cp};
+    }
     Vec3d point(double gamma) const { return {std::sin(gamma), 0.0, b * std::cos(gamma)}; }
     double arc(double gamma) const {
         return e2 == 0.0 ? 1.0 : std::sqrt(1.0 - e2 * std::sin(gamma) * std::sin(gamma));
@@ -90,6 +102,8 @@ struct Closure {
     float sqrt_alpha;
     Vec3d v;  // view, closure coordinates
     double sin_phi_v, cos_phi_v;
+    // cos and sin of the tilt τ (entry mesonormals) and of −τ (inner ones), set by closure_of.
+    double cos_tilt = 1, sin_tilt = 0, cos_inner_tilt = 1, sin_inner_tilt = 0;
 
     double scale(double mu, double eta_rel) const {
         return GgxGlassAlbedo::tables().energy_scale(sqrt_alpha, float(mu), float(eta_rel));
@@ -134,8 +148,7 @@ Entry entry(const Closure &c, double gamma1, Vec3d n1, Vec3d m1, Vec3d h1) {
     const double phi_t = dir_phi(e.wt);
     e.phi_t_mapped = c.ellipse.phi_of(phi_t);
     e.gamma2 = 2.0 * e.phi_t_mapped - gamma1;
-    e.n2 = c.ellipse.normal(-c.tilt, e.gamma2);
-    e.m2 = c.ellipse.normal(0.0, e.gamma2);
+    c.ellipse.normals(c.cos_inner_tilt, c.sin_inner_tilt, e.gamma2, e.n2, e.m2);
     e.cos_o1 = dot(-e.wt, n1);
     e.cos_m2 = dot(-e.wt, e.n2);
     e.g1o = ggx::shadowing_ratio(c.alpha, e.cos_m1, e.cos_o1);
@@ -188,8 +201,7 @@ Bounce bounce(const Closure &c, double gamma1, const Entry &e, Vec3d h2) {
     if (!b.vis) return b;
     const double phi_tr = dir_phi(b.wtr);
     b.gamma3 = gamma1 - 2.0 * (e.phi_t_mapped - c.ellipse.phi_of(phi_tr)) + kPi;
-    b.n3 = c.ellipse.normal(-c.tilt, b.gamma3);
-    b.m3 = c.ellipse.normal(0.0, b.gamma3);
+    c.ellipse.normals(c.cos_inner_tilt, c.sin_inner_tilt, b.gamma3, b.n3, b.m3);
     b.cos_m3 = dot(b.n3, b.wtr);
     b.s3 = c.scale(b.cos_m3, 1.0 / c.eta);
     const double path = c.ellipse.circular()
@@ -299,9 +311,14 @@ namespace {
 
 Closure closure_of(const HuangFiber &f, const huang::View &v) {
     const double b = f.aspect_ratio();
-    return Closure{f.roughness(), f.ior(), f.tilt(), Ellipse{b, 1.0 - b * b}, f.sigma(),
-                   f.m_r(), f.m_tt(), f.m_trt(), std::sqrt(float(f.roughness())), v.v,
-                   v.sin_phi_v, v.cos_phi_v};
+    Closure c{f.roughness(), f.ior(), f.tilt(), Ellipse{b, 1.0 - b * b}, f.sigma(),
+              f.m_r(), f.m_tt(), f.m_trt(), std::sqrt(float(f.roughness())), v.v,
+              v.sin_phi_v, v.cos_phi_v};
+    c.cos_tilt = std::cos(c.tilt);
+    c.sin_tilt = std::sin(c.tilt);
+    c.cos_inner_tilt = std::cos(-c.tilt);
+    c.sin_inner_tilt = std::sin(-c.tilt);
+    return c;
 }
 
 // Huang's frame (x tangent, y major axis, z = x × y) → closure coordinates (§0), then the
@@ -326,8 +343,7 @@ SimpsonNode simpson_node(const Closure &c, const huang::View &v, int intervals, 
     SimpsonNode node;
     node.gamma = c.gamma_of_u(v.u_min + k * delta);
     node.weight = ((k == 0 || k == intervals) ? 0.5 : double(k % 2 + 1)) * c.jacobian(node.gamma);
-    node.meso = c.ellipse.normal(c.tilt, node.gamma);
-    node.macro = c.ellipse.normal(0.0, node.gamma);
+    c.ellipse.normals(c.cos_tilt, c.sin_tilt, node.gamma, node.meso, node.macro);
     return node;
 }
 
