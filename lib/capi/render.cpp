@@ -46,7 +46,8 @@ HairShading huang_shading(const SceneHairMaterial &hair, const std::string &name
     inputs.multiple_weight = o.multiple_weight;
     inputs.n_h = o.n_h;
     // Cycles' sampler, not the eval, makes most of that image's noise: a strand of its own
-    // inputs takes its one Cycles eval, which costs less than the control variate saves there.
+    // inputs takes its one Cycles eval: the control variate's lower noise does not pay for its
+    // extra time there.
     if (cycles_sampling) inputs.huang_strand_shading = StrandShading::OwnEval;
     // Every Huang material shades through the strands model, as Chiang's do.
     Expected<HuangStrands> strands = HuangStrands::create(hair.node, hair.huang);

@@ -7,21 +7,6 @@ namespace hairis {
 
 namespace {
 
-template <typename T>
-T fresnel_dielectric_impl(T cos_i, T eta) {
-    // Light arriving from inside sees the inverse index.
-    if (cos_i < T(0)) {
-        eta = T(1) / eta;
-        cos_i = -cos_i;
-    }
-    const T sin2_t = (T(1) - cos_i * cos_i) / (eta * eta);
-    if (sin2_t >= T(1)) return T(1);  // total internal reflection
-    const T cos_t = std::sqrt(T(1) - sin2_t);
-    const T r_s = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    const T r_p = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    return T(0.5) * (r_s * r_s + r_p * r_p);
-}
-
 // Reflectance of one polarization; `parallel` selects which index multiplies which cosine.
 double polarized_reflectance(double eta, double gamma, bool parallel) {
     const double cos_i = std::cos(gamma);
@@ -35,8 +20,6 @@ double polarized_reflectance(double eta, double gamma, bool parallel) {
 
 }  // namespace
 
-float fresnel_dielectric(float cos_i, float eta) { return fresnel_dielectric_impl(cos_i, eta); }
-double fresnel_dielectric(double cos_i, double eta) { return fresnel_dielectric_impl(cos_i, eta); }
 
 double fresnel_bravais(double eta_perp, double eta_par, double gamma) {
     return 0.5 * (polarized_reflectance(eta_perp, gamma, false) +

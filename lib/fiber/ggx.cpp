@@ -7,20 +7,6 @@
 
 namespace hairis::ggx {
 
-double distribution(double alpha, double cos_mh) {
-    const double a2 = alpha * alpha;
-    const double c2 = std::min(cos_mh * cos_mh, 1.0);
-    const double denominator = (1.0 - c2) + a2 * c2;
-    return a2 / (kPi * denominator * denominator);
-}
-
-double smith_lambda(double alpha, double cos_m) {
-    const double c2 = cos_m * cos_m;
-    if (c2 >= 1.0) return 0.0;
-    const double tan2 = std::max(1.0 / c2 - 1.0, 0.0);  // +inf at c = 0
-    return 0.5 * (std::sqrt(1.0 + alpha * alpha * tan2) - 1.0);
-}
-
 double shadowing_g1(double alpha, double cos_m) { return 1.0 / (1.0 + smith_lambda(alpha, cos_m)); }
 
 double shadowing_g2(double alpha, double cos_m1, double cos_m2) {

@@ -8,17 +8,30 @@
 // depend on their square only, as in Cycles.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "core/math.h"
 #include "core/vec3d.h"
 
 namespace hairis::ggx {
 
-/// D(m·h) = α² / (π ((1 − c²) + α² c²)²), c² clamped to 1.
-double distribution(double alpha, double cos_mh);
+/// D(m·h) = α² / (π ((1 − c²) + α² c²)²), c² clamped to 1. Inline: Huang's bake calls it per
+/// path and direction.
+inline double distribution(double alpha, double cos_mh) {
+    const double a2 = alpha * alpha;
+    const double c2 = std::min(cos_mh * cos_mh, 1.0);
+    const double denominator = (1.0 - c2) + a2 * c2;
+    return a2 / (kPi * denominator * denominator);
+}
 /// Smith's Λ(c) = (sqrt(1 + α² (1/c² − 1)) − 1) / 2 (0 at c² ≥ 1; +inf at c = 0).
-double smith_lambda(double alpha, double cos_m);
+inline double smith_lambda(double alpha, double cos_m) {
+    const double c2 = cos_m * cos_m;
+    if (c2 >= 1.0) return 0.0;
+    const double tan2 = std::max(1.0 / c2 - 1.0, 0.0);  // +inf at c = 0
+    return 0.5 * (std::sqrt(1.0 + alpha * alpha * tan2) - 1.0);
+}
 /// G1 = 1 / (1 + Λ(c)).
 double shadowing_g1(double alpha, double cos_m);
 /// Height-correlated G2 = 1 / (1 + Λ(c1) + Λ(c2)).

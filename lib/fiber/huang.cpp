@@ -242,28 +242,8 @@ bool exit_tir(const Closure &c, const Vec3d &wtr, Vec3d l) {
 // stay the literal transcription of Cycles' eval, so that the expectation is checked against
 // an eval that does not share this code.
 struct ExitTerms {
-    double alpha2, inv_eta;
+    double alpha, alpha2, inv_eta;
 
-    double lambda(double cos_m) const {  // ggx::smith_lambda
-        const double c2 = cos_m * cos_m;
-        if (c2 >= 1.0) return 0.0;
-        const double tan2 = std::max(1.0 / c2 - 1.0, 0.0);
-        return 0.5 * (std::sqrt(1.0 + alpha2 * tan2) - 1.0);
-    }
-    double distribution(double cos_mh) const {  // ggx::distribution
-        const double c2 = std::min(cos_mh * cos_mh, 1.0);
-        const double d = (1.0 - c2) + alpha2 * c2;
-        return alpha2 / (kPi * d * d);
-    }
-    double transmittance(double cos_i) const {  // 1 − fresnel(cos_i, 1/η), leaving the fiber
-        const double c = std::fabs(cos_i);
-        const double sin2_t = (1.0 - c * c) / (inv_eta * inv_eta);
-        if (sin2_t >= 1.0) return 0.0;
-        const double cos_t = std::sqrt(1.0 - sin2_t);
-        const double r_s = (c - inv_eta * cos_t) / (c + inv_eta * cos_t);
-        const double r_p = (inv_eta * c - cos_t) / (inv_eta * c + cos_t);
-        return 1.0 - 0.5 * (r_s * r_s + r_p * r_p);
-    }
     // tt_exit for one path.
     double tt(const Vec3d &wt, const Vec3d &n2, double lambda2, const Vec3d &l) const {
         if (!(dot(l, wt) >= inv_eta - kTirSlack)) return 0.0;
@@ -273,8 +253,8 @@ struct ExitTerms {
         const double cos_mh2 = dot(n2, h2);
         if (!(cos_mh2 >= 0.0)) return 0.0;
         const double cos_hi2 = dot(-wt, h2), cos_ho2 = dot(-l, h2), cos_mo2 = dot(-l, n2);
-        return transmittance(cos_hi2) * distribution(cos_mh2) / (1.0 + lambda2 + lambda(cos_mo2)) * cos_hi2 *
-               cos_ho2 * rcp * rcp;
+        return (1.0 - fresnel(cos_hi2, inv_eta)) * ggx::distribution(alpha, cos_mh2) /
+               (1.0 + lambda2 + ggx::smith_lambda(alpha, cos_mo2)) * cos_hi2 * cos_ho2 * rcp * rcp;
     }
     // trt_exit for one path whose w_tr faces n3 and m3, without the energy scale: T₃ D₃ G₃
     // c_hi3 c_ho3 / |ĥ₃|² written over one common denominator (ĥ₃ = w_tr + l/η unnormalized,
@@ -624,7 +604,7 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
     const double factor = (2.0 / 3.0) * p.res_delta / p.denominator;
     const double inv_eta2 = 1.0 / (c.eta * c.eta);
     Colour tt{}, trt{}, trrt = trrt_always_;
-    const ExitTerms exits{c.alpha * c.alpha, 1.0 / c.eta};
+    const ExitTerms exits{c.alpha, c.alpha * c.alpha, 1.0 / c.eta};
     for (const TtPath &path : tt_) {
         const double x = path.coefficient * exits.tt(path.wt, path.n2, path.lambda2, l);
         if (!std::isfinite(x)) continue;
