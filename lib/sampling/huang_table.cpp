@@ -226,8 +226,7 @@ Status HuangTableSet::validate() const {
     if (Status s = HuangTable::check(theta_o_nodes, phi_o_nodes, theta_i_count, phi_count, values)) return s;
     if (Status s = check::count_in_range("the Huang table's f_refinement", f_refinement, 1, kMaxHuangFRefinement))
         return s;
-    if (f.empty()) return std::nullopt;
-    if (f.size() != 3 * values.size())
+    if (!f.empty() && f.size() != 3 * values.size())
         return Error{"the Huang table's f part must hold 3 values (RGB) per cell, " + std::to_string(3 * values.size()) +
                      " in all (got " + std::to_string(f.size()) + ")"};
     for (std::size_t n = 0; n < f.size(); ++n)
@@ -235,6 +234,31 @@ Status HuangTableSet::validate() const {
             return Error{"the Huang table's f part: entry " + std::to_string(n) + " (cell " + std::to_string(n / 3) +
                          ", channel " + std::to_string(n % 3) + ") must be finite and >= 0 (got " +
                          std::to_string(f[n]) + ")"};
+    if (absorption_nodes.empty()) {
+        if (!absorption.empty()) return Error{"the Huang table's absorption part has values but no absorption nodes"};
+        return std::nullopt;
+    }
+    const int k = absorption_count();
+    if (k < 2 || k > kMaxHuangAbsorptionNodes)
+        return Error{"the Huang table's absorption part must have 2 to " + std::to_string(kMaxHuangAbsorptionNodes) +
+                     " absorption nodes (got " + std::to_string(k) + ")"};
+    for (int a = 0; a < k; ++a) {
+        const float node = absorption_nodes[std::size_t(a)];
+        if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > absorption_nodes[std::size_t(a - 1)])))
+            return Error{"the Huang table's absorption node " + std::to_string(a) + " (" + std::to_string(node) +
+                         ") must be in (0, " + std::to_string(int(kMaxHuangAbsorption)) +
+                         "] and greater than the one before"};
+    }
+    if (f.empty()) return Error{"the Huang table's absorption part needs the f part beside it"};
+    if (absorption.size() != std::size_t(k) * values.size())
+        return Error{"the Huang table's absorption part must hold " + std::to_string(k) + " values per cell, " +
+                     std::to_string(std::size_t(k) * values.size()) + " in all (got " +
+                     std::to_string(absorption.size()) + ")"};
+    for (std::size_t n = 0; n < absorption.size(); ++n)
+        if (!(std::isfinite(absorption[n]) && absorption[n] >= 0.0f))
+            return Error{"the Huang table's absorption part: entry " + std::to_string(n) + " (cell " +
+                         std::to_string(n / std::size_t(k)) + ", node " + std::to_string(n % std::size_t(k)) +
+                         ") must be finite and >= 0 (got " + std::to_string(absorption[n]) + ")"};
     return std::nullopt;
 }
 
@@ -244,7 +268,7 @@ Expected<HuangSamplingTable> HuangSamplingTable::from(const HuangTableSet &set) 
     Expected<HuangTable> t =
         HuangTable::create(set.theta_o_nodes, set.phi_o_nodes, set.theta_i_count, set.phi_count, set.values);
     if (!t) return Error{t.error().message, ErrorKind::InvalidTable};
-    HuangSamplingTable out{std::make_shared<const HuangTable>(std::move(t).value()), nullptr,
+    HuangSamplingTable out{std::make_shared<const HuangTable>(std::move(t).value()), nullptr, nullptr,
                            canonical_parameters(set.parameters)};
     if (set.has_f()) {
         Expected<HuangFTable> f = HuangFTable::create(set);

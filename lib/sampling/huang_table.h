@@ -140,6 +140,11 @@ std::vector<std::pair<std::string, double>> huang_parameters(const HuangParams &
 /// within GaussLegendre's nodes.
 inline constexpr int kMaxHuangFRefinement = 4;
 
+/// The most absorption nodes a Huang table's absorption part may have.
+inline constexpr int kMaxHuangAbsorptionNodes = 32;
+/// The largest absorption node: beyond it a strand's TT, TRT and TRRT+ are far below its R.
+inline constexpr float kMaxHuangAbsorption = 1000.0f;
+
 /// A baked Huang table as plain data: what a table file holds.
 struct HuangTableSet {
     std::string model = "huang2022";
@@ -153,23 +158,36 @@ struct HuangTableSet {
     /// The factor of the f part's quadrature orders it was baked with (HuangBakeOptions), in
     /// [1, kMaxHuangFRefinement].
     int f_refinement = 1;
+    /// The absorption part (huang_absorption_table.h), or both empty: for strands whose
+    /// absorption differs from the fiber's. absorption_nodes: K absorption coefficients,
+    /// strictly increasing in (0, kMaxHuangAbsorption]. absorption: K values per cell in
+    /// values' order, absorption[K·n + k] = one channel of the f part at cell n of the fiber
+    /// whose absorption in that channel is absorption_nodes[k]. Only with the f part.
+    std::vector<float> absorption_nodes;
+    std::vector<float> absorption;
 
     int theta_o_count() const { return int(theta_o_nodes.size()); }
     int phi_o_count() const { return int(phi_o_nodes.size()); }
     /// The model, plain parameter names with finite values, what HuangTable::check checks,
-    /// an f part that is empty or 3 finite non-negative values per cell, and f_refinement in
-    /// range.
+    /// an f part that is empty or 3 finite non-negative values per cell, f_refinement in
+    /// range, and an absorption part that is empty or has 2 to kMaxHuangAbsorptionNodes nodes
+    /// in range and their finite non-negative values, beside an f part.
     Status validate() const;
     bool has_f() const { return !f.empty(); }
+    bool has_absorption() const { return !absorption_nodes.empty(); }
+    int absorption_count() const { return int(absorption_nodes.size()); }
 };
 
 /// A Huang table ready to sample, and the fiber parameters it was baked for.
 class HuangFTable;
+class HuangAbsorptionTable;
 
 struct HuangSamplingTable {
     std::shared_ptr<const HuangTable> table;
     /// The baked f (huang_f_table.h), or null when the set has none.
     std::shared_ptr<const HuangFTable> f;
+    /// The absorption part (huang_absorption_table.h), or null when the set has none.
+    std::shared_ptr<const HuangAbsorptionTable> absorption;
     std::string parameters;  ///< canonical_parameters(HuangTableSet::parameters)
 
     /// Builds the table (ErrorKind::InvalidTable when the set is not a valid Huang table).

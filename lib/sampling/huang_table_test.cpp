@@ -308,5 +308,49 @@ TEST(HuangSamplingTable, RefusesAnotherModelAndKeepsTheParameters) {
     EXPECT_EQ(short_values.error().kind, ErrorKind::InvalidTable);
 }
 
+// The absorption part: 2 to kMaxHuangAbsorptionNodes increasing nodes in (0, kMaxHuangAbsorption],
+// K finite non-negative values per cell, only beside an f part; each refusal names what is wrong.
+TEST(HuangTableSet, ValidatesTheAbsorptionPartByName) {
+    HuangTableSet set;
+    set.parameters = huang_parameters(HuangParams{});
+    set.theta_o_nodes = theta_o_nodes();
+    set.phi_o_nodes = phi_o_nodes(kPhiO);
+    set.theta_i_count = kThetaI;
+    set.phi_count = kPhi;
+    set.values = synthetic_values(kPhiO);
+    set.f.assign(3 * set.values.size(), 0.5f);
+    set.absorption_nodes = {0.1f, 0.5f, 2.0f};
+    set.absorption.assign(3 * set.values.size(), 0.25f);
+    EXPECT_FALSE(set.validate().has_value());
+    EXPECT_TRUE(set.has_absorption());
+    auto refusal = [](HuangTableSet s) {
+        const Status status = s.validate();
+        return status ? status->message : std::string("(accepted)");
+    };
+    HuangTableSet bad = set;
+    bad.absorption_nodes = {0.1f};
+    bad.absorption.assign(bad.values.size(), 0.25f);
+    EXPECT_NE(refusal(bad).find("2 to 32 absorption nodes (got 1)"), std::string::npos) << refusal(bad);
+    bad = set;
+    bad.absorption_nodes = {0.1f, 0.1f, 2.0f};
+    EXPECT_NE(refusal(bad).find("absorption node 1"), std::string::npos) << refusal(bad);
+    bad.absorption_nodes = {0.0f, 0.5f, 2.0f};
+    EXPECT_NE(refusal(bad).find("absorption node 0"), std::string::npos) << refusal(bad);
+    bad.absorption_nodes = {0.1f, 0.5f, 2000.0f};
+    EXPECT_NE(refusal(bad).find("absorption node 2"), std::string::npos) << refusal(bad);
+    bad = set;
+    bad.absorption.pop_back();
+    EXPECT_NE(refusal(bad).find("3 values per cell"), std::string::npos) << refusal(bad);
+    bad = set;
+    bad.absorption[7] = -1.0f;
+    EXPECT_NE(refusal(bad).find("entry 7 (cell 2, node 1)"), std::string::npos) << refusal(bad);
+    bad = set;
+    bad.f.clear();
+    EXPECT_NE(refusal(bad).find("needs the f part"), std::string::npos) << refusal(bad);
+    bad = set;
+    bad.absorption_nodes.clear();
+    EXPECT_NE(refusal(bad).find("no absorption nodes"), std::string::npos) << refusal(bad);
+}
+
 }  // namespace
 }  // namespace hairis
