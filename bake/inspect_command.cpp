@@ -49,6 +49,15 @@ int run_inspect(const std::string &path) {
         } else {
             std::printf("  (no f part: renders shade with Cycles' noisy eval; bake without --no-huang-f)\n");
         }
+        const int nodes = h->absorption_count();
+        if (h->has_absorption()) {
+            const int blocks = (nodes + 3) / 4;
+            std::printf("  absorption  rows %d-%d: %d blocks of the same cells, %d absorption nodes (%.6g .. %.6g), "
+                        "4 per block in RGBA (one channel of the f part per node, for strands of other absorption)\n",
+                        height, height + blocks * rows - 1, blocks, nodes, h->absorption_nodes.front(),
+                        h->absorption_nodes.back());
+            height += blocks * rows;
+        }
         if (s.has_multiple()) {
             const int multiple_rows = s.theta_r_count() * s.theta_i_count, bands = int(s.n_h_values.size());
             std::printf("  multiple  rows %d-%d: %d theta_r nodes (%.2f .. %.2f deg) x %d theta_i cells, columns "
@@ -62,13 +71,18 @@ int run_inspect(const std::string &path) {
         } else {
             std::printf("  (no multiple part: integrator=dual_scattering needs a bake without --no-huang-multiple)\n");
         }
-        std::printf("cells:           %zu\n", h->values.size() + h->f.size() / 3 + s.multiple.size());
+        const std::size_t absorption_cells = nodes > 0 ? h->absorption.size() / std::size_t(nodes) : 0;
+        std::printf("cells:           %zu\n", h->values.size() + h->f.size() / 3 + absorption_cells + s.multiple.size());
         std::printf("image:           %d x %d RGBA float (%.1f MB in memory, %.1f MB on disk)\n", width, height,
                     double(width) * height * 16 / 1e6, size_error ? 0.0 : double(bytes) / 1e6);
         std::printf("sampling table:  %.1f MB\n",
                     double(HuangTable::bytes_needed(h->theta_o_count(), h->phi_o_count(), h->theta_i_count,
                                                     h->phi_count)) / 1e6);
         if (h->has_f()) std::printf("baked f:         %.1f MB\n", double(h->f.size() * sizeof(float)) / 1e6);
+        if (h->has_absorption())
+            std::printf("absorption:      %.1f MB (%d nodes, %.6g .. %.6g)\n",
+                        double(h->absorption.size() * sizeof(float)) / 1e6, nodes, h->absorption_nodes.front(),
+                        h->absorption_nodes.back());
         std::printf("valid:           yes (metadata, sizes, values and pixel hash checked)\n");
         return 0;
     }

@@ -32,6 +32,8 @@ hairis_tables *make_tables(TableSet set) {
             {"huang_phi", std::to_string(h->phi_count)},
             {"huang_f", h->has_f() ? "1" : "0"}};
         if (h->has_f()) info.push_back({"huang_f_refinement", std::to_string(h->f_refinement)});
+        info.push_back({"huang_absorption", h->has_absorption() ? "1" : "0"});
+        if (h->has_absorption()) info.push_back({"huang_absorption_nodes", std::to_string(h->absorption_count())});
         if (set.has_multiple()) {  // the multiple part (dual scattering)
             info.push_back({"theta_r", std::to_string(set.theta_r_count())});
             info.push_back({"theta_i", std::to_string(set.theta_i_count)});

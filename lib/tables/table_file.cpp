@@ -11,7 +11,9 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "core/math.h"
 #include "core/options.h"
@@ -25,6 +27,8 @@ namespace {
 using OIIO::TypeDesc;
 
 constexpr int kChannels = 4;
+// The channels in order, for naming them in messages.
+constexpr const char *kChannelNames[kChannels] = {"R", "G", "B", "A"};
 
 std::string sha1_of(const std::vector<float> &pixels) {
     OIIO::SHA1 sha(pixels.data(), pixels.size() * sizeof(float));
@@ -34,6 +38,40 @@ std::string sha1_of(const std::vector<float> &pixels) {
 std::string join_ints(const std::vector<int> &values) {
     std::string out;
     for (size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + std::to_string(values[i]);
+    return out;
+}
+
+// Floats printed with format_number, so that each reads back to the identical float.
+std::string join_floats(const std::vector<float> &values) {
+    std::string out;
+    for (size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + format_number(values[i]);
+    return out;
+}
+
+// The optional parts of a huang2022 file, as hairis:parts names them.
+struct HuangParts {
+    bool f = false, absorption = false, multiple = false;
+};
+
+// The hairis:parts values of huang2022 files: the Huang part, then the f part, the absorption
+// part (which extends the f part, so only after it) and the multiple part, each optional.
+constexpr std::pair<const char *, HuangParts> kHuangParts[] = {
+    {"huang", {false, false, false}},          {"huang,f", {true, false, false}},
+    {"huang,f,absorption", {true, true, false}}, {"huang,multiple", {false, false, true}},
+    {"huang,f,multiple", {true, false, true}},   {"huang,f,absorption,multiple", {true, true, true}}};
+
+std::optional<HuangParts> huang_parts_of(const std::string &parts) {
+    for (const auto &[name, huang_parts] : kHuangParts)
+        if (parts == name) return huang_parts;
+    return std::nullopt;
+}
+
+// "\"huang\", \"huang,f\", ... or \"huang,f,absorption,multiple\"", for messages.
+std::string huang_parts_list() {
+    std::string out;
+    const size_t count = std::size(kHuangParts);
+    for (size_t i = 0; i < count; ++i)
+        out += std::string(i == 0 ? "" : i + 1 == count ? " or " : ", ") + "\"" + kHuangParts[i].first + "\"";
     return out;
 }
 
@@ -68,21 +106,26 @@ std::string image_limits() {
 // Column band k of the G channel: columns [k·phi/K, (k+1)·phi/K).
 int band_of_column(int j, int phi_count, int bands) { return int((long long)j * bands / phi_count); }
 
+// The absorption part's blocks: one per 4 nodes (R, G, B, A), as many as K nodes need.
+long long absorption_blocks(int nodes) { return (nodes + kChannels - 1) / kChannels; }
+
 // Where each part lies in the image (table_file.h): the far part's rows first, then the
 // near-field part's; the width is the widest part's, narrower rows padded with zeros.
 struct Layout {
     int far_rows = 0, near_rows = 0, near_cols = 0;
-    // huang2022: the Huang part, its f part (as many rows), then the multiple part.
-    long long huang_rows = 0, f_rows = 0, multiple_rows = 0;
+    // huang2022: the Huang part, its f part (as many rows), its absorption part (as many rows
+    // per 4 nodes), then the multiple part.
+    long long huang_rows = 0, f_rows = 0, absorption_rows = 0, multiple_rows = 0;
     long long width = 0, height = 0;
     static Layout of(const TableSet &t) {
         Layout l;
         if (const HuangTableSet *h = t.huang.get()) {
             l.huang_rows = (long long)h->phi_o_count() * h->theta_o_count() * h->theta_i_count;
             l.f_rows = h->has_f() ? l.huang_rows : 0;
+            l.absorption_rows = absorption_blocks(h->absorption_count()) * l.huang_rows;
             l.multiple_rows = t.has_multiple() ? (long long)t.theta_r_count() * t.theta_i_count : 0;
             l.width = std::max<long long>(h->phi_count, t.has_multiple() ? (long long)t.n_h_values.size() : 0);
-            l.height = l.huang_rows + l.f_rows + l.multiple_rows;
+            l.height = l.huang_rows + l.f_rows + l.absorption_rows + l.multiple_rows;
             return l;
         }
         l.far_rows = t.theta_r_count() * t.theta_i_count;
@@ -99,9 +142,11 @@ struct Layout {
 // The Huang part: row (q·theta_o_count + r)·theta_i_count + i, column j holds R = the value of
 // φ_o node q, θ_o node r, cell (i, j); G = B = 0, A = 1. The values' order is exactly this.
 // The f part after it (when baked): row huang_rows + the Huang part's row, same column, holds
-// R, G, B = the f part's RGB of that cell, A = 1. The multiple part after those: row
-// huang_rows + f_rows + r·theta_i_count + i, column k holds G = the multiple table at θ_r
-// node r, n_h value k, θ_i cell i; R = B = 0, A = 1. Padding is 0.
+// R, G, B = the f part's RGB of that cell, A = 1. The absorption part after it (when baked):
+// row huang_rows + f_rows + b·huang_rows + the Huang part's row, same column, holds nodes 4b to
+// 4b + 3 of that cell in R, G, B, A (0 past the last node). The multiple part after those: row
+// huang_rows + f_rows + absorption_rows + r·theta_i_count + i, column k holds G = the multiple
+// table at θ_r node r, n_h value k, θ_i cell i; R = B = 0, A = 1. Padding is 0.
 std::vector<float> huang_pixels_of(const TableSet &t) {
     const HuangTableSet &h = *t.huang;
     const Layout l = Layout::of(t);
@@ -116,12 +161,18 @@ std::vector<float> huang_pixels_of(const TableSet &t) {
         float *q = &px[((size_t(l.huang_rows) + n / huang_width) * width + n % huang_width) * kChannels];
         for (int c = 0; c < 3; ++c) q[c] = h.f[3 * n + size_t(c)];
         q[3] = 1.0f;
+        const size_t nodes = size_t(h.absorption_count()), huang_row = n / huang_width;
+        for (size_t k = 0; k < nodes; ++k) {
+            const size_t row = size_t(l.huang_rows + l.f_rows) + (k / kChannels) * size_t(l.huang_rows) + huang_row;
+            px[(row * width + n % huang_width) * kChannels + k % kChannels] = h.absorption[nodes * n + k];
+        }
     }
     const int bands = int(t.n_h_values.size());
     for (int r = 0; r < (t.has_multiple() ? t.theta_r_count() : 0); ++r)
         for (int i = 0; i < t.theta_i_count; ++i)
             for (int k = 0; k < bands; ++k) {
-                const size_t row = size_t(l.huang_rows + l.f_rows) + size_t(r) * size_t(t.theta_i_count) + size_t(i);
+                const size_t row = size_t(l.huang_rows + l.f_rows + l.absorption_rows) +
+                                   size_t(r) * size_t(t.theta_i_count) + size_t(i);
                 float *p = &px[(row * width + size_t(k)) * kChannels];
                 p[1] = t.multiple_at(r, k, i);
                 p[3] = 1.0f;
@@ -359,10 +410,12 @@ Expected<std::vector<int>> n_h_values_of(const OIIO::ImageSpec &spec) {
 }
 
 // A Huang file's rows, as its attributes place them: the Huang part, its f part (as many rows,
-// or none) and the multiple part after them.
+// or none), its absorption part (as many rows per 4 nodes, or none) and the multiple part
+// after them.
 struct HuangLayout {
     int theta_o = 0, phi_o = 0, theta_r = 0;
     long long rows = 0, f_rows = 0;  // φ_o × θ_o × θ_i each
+    long long absorption_rows = 0;
     long long width = 0, height = 0;
 };
 
@@ -427,8 +480,47 @@ Status read_huang_f(const OIIO::ImageSpec &spec, bool with_f, HuangLayout &layou
     return std::nullopt;
 }
 
-// hairis:multiple with its θ_r nodes and n_h values, starting after the f part.
-Status read_huang_multiple(const OIIO::ImageSpec &spec, bool with_f, TableSet &t, HuangLayout &layout) {
+// hairis:huang_absorption: there exactly when the parts name an absorption part, starting after
+// the f part, with 2 to kMaxHuangAbsorptionNodes nodes strictly increasing in
+// (0, kMaxHuangAbsorption].
+Status read_huang_absorption(const OIIO::ImageSpec &spec, bool with_absorption, HuangLayout &layout,
+                             std::vector<float> &nodes) {
+    const std::string name = "hairis:huang_absorption";
+    if (!with_absorption) {
+        if (spec.find_attribute(name)) return file_error("hairis:parts names no absorption part, but the file has " + name);
+        return std::nullopt;
+    }
+    Expected<OptionReader> reader =
+        required_options(spec, name.c_str(),
+                         "hairis:parts names an absorption part but there is no string attribute " + name +
+                             " (\"row=...;nodes=...\")");
+    if (!reader) return reader.error();
+    int row = -1;
+    std::string text;
+    reader.value().field("row", row, 0, kMaxTableCells);
+    reader.value().field("nodes", text);
+    const int count = text.empty() ? 0 : int(std::count(text.begin(), text.end(), ',')) + 1;
+    const std::string allowed = "2 to " + std::to_string(kMaxHuangAbsorptionNodes) +
+                                " numbers strictly increasing in (0, " + format_number(kMaxHuangAbsorption) +
+                                "] separated by ','";
+    if (count < 2 || count > kMaxHuangAbsorptionNodes)
+        return file_error(name + ": nodes must be " + allowed + " (got \"" + text + "\")");
+    nodes.assign(size_t(count), 0.0f);
+    bool valid = !reader.value().read("nodes", nodes.data(), count, 0.0, double(kMaxHuangAbsorption));
+    for (size_t k = 0; k < nodes.size(); ++k)
+        valid = valid && nodes[k] > 0.0f && (k == 0 || nodes[k] > nodes[k - 1]);
+    if (!valid) return file_error(name + ": nodes must be " + allowed + " (got \"" + text + "\")");
+    if (Status e = reader.value().finish()) return file_error(e->message);
+    const long long first = layout.rows + layout.f_rows;
+    if (row != first)
+        return file_error(name + " must start at row " + std::to_string(first) + ", after the f part");
+    layout.absorption_rows = absorption_blocks(count) * layout.rows;
+    layout.height += layout.absorption_rows;
+    return std::nullopt;
+}
+
+// hairis:multiple with its θ_r nodes and n_h values, starting after the f and absorption parts.
+Status read_huang_multiple(const OIIO::ImageSpec &spec, TableSet &t, HuangLayout &layout) {
     Expected<OptionReader> mr = required_options(
         spec, "hairis:multiple",
         "hairis:parts is \"huang,multiple\" but there is no string attribute hairis:multiple "
@@ -439,10 +531,13 @@ Status read_huang_multiple(const OIIO::ImageSpec &spec, bool with_f, TableSet &t
     mr.value().field("theta_r", layout.theta_r, 1, kMaxThetaRNodes);
     mr.value().field("theta_i", t.theta_i_count, 2, kMaxTableAxisCells);
     if (Status e = mr.value().finish()) return file_error(e->message);
-    const long long first = layout.rows + layout.f_rows;
+    const long long first = layout.rows + layout.f_rows + layout.absorption_rows;
+    const char *before = layout.absorption_rows > 0 ? ", after the absorption part"
+                         : layout.f_rows > 0        ? ", after the f part"
+                                                    : ", after the Huang part";
     if (multiple_row != first || layout.theta_r == 0 || t.theta_i_count == 0)
         return file_error("hairis:multiple must give theta_r and theta_i and start at row " + std::to_string(first) +
-                          (with_f ? ", after the f part" : ", after the Huang part"));
+                          before);
     Expected<std::vector<float>> nodes = float_array(spec, "hairis:theta_r_nodes", layout.theta_r);
     if (!nodes) return nodes.error();
     t.theta_r_nodes = std::move(nodes).value();
@@ -457,21 +552,41 @@ Status read_huang_multiple(const OIIO::ImageSpec &spec, bool with_f, TableSet &t
     return std::nullopt;
 }
 
-// The pixels into the Huang part (R), its f part (RGB) and the multiple part (G per n_h), with
-// every unused channel and the padding checked.
+// The pixels into the Huang part (R), its f part (RGB), its absorption part (RGBA per 4 nodes)
+// and the multiple part (G per n_h), with every unused channel and the padding checked.
 Status unpack_huang_pixels(const std::vector<float> &px, const HuangLayout &layout, HuangTableSet &h, TableSet &t) {
     const size_t w = size_t(layout.width), huang_width = size_t(h.phi_count), bands = t.n_h_values.size();
-    const size_t rows = size_t(layout.rows), first_multiple = size_t(layout.rows + layout.f_rows);
+    const size_t rows = size_t(layout.rows), first_absorption = size_t(layout.rows + layout.f_rows);
+    const size_t first_multiple = first_absorption + size_t(layout.absorption_rows);
+    const size_t nodes = size_t(h.absorption_count());
     h.values.resize(rows * huang_width);
     if (layout.f_rows > 0) h.f.resize(3 * h.values.size());
+    h.absorption.resize(nodes * h.values.size());
     t.multiple.assign(size_t(t.theta_r_count()) * bands * size_t(t.theta_i_count), 0.0f);
     for (size_t y = 0; y < size_t(layout.height); ++y)
         for (size_t x = 0; x < w; ++x) {
             const float *p = &px[(y * w + x) * kChannels];
             const bool in_huang = y < rows && x < huang_width;
-            const bool in_f = y >= rows && y < first_multiple && x < huang_width;
+            const bool in_f = y >= rows && y < first_absorption && x < huang_width;
+            const bool in_absorption = y >= first_absorption && y < first_multiple && x < huang_width;
             const bool in_multiple = y >= first_multiple && x < bands;
-            if (in_f) {
+            if (in_absorption) {
+                const size_t block = (y - first_absorption) / rows;
+                const size_t n = ((y - first_absorption) % rows) * huang_width + x;
+                for (size_t c = 0; c < size_t(kChannels); ++c) {
+                    const size_t k = block * kChannels + c;
+                    if (k < nodes) {
+                        h.absorption[nodes * n + k] = p[c];
+                    } else if (p[c] != 0.0f) {
+                        std::string unused;
+                        for (size_t u = nodes % kChannels; u < size_t(kChannels); ++u)
+                            unused += std::string(unused.empty() ? "" : ", ") + kChannelNames[u];
+                        return file_error("the absorption part has " + std::to_string(nodes) +
+                                          " nodes, so its last block's channels past the last node (" + unused +
+                                          ") must be 0 at " + pixel_name((long long)x, (long long)y));
+                    }
+                }
+            } else if (in_f) {
                 if (p[3] != 1.0f)
                     return file_error("A must be 1 in the f part at " + pixel_name((long long)x, (long long)y));
                 const size_t n = (y - rows) * huang_width + x;
@@ -495,18 +610,19 @@ Status unpack_huang_pixels(const std::vector<float> &px, const HuangLayout &layo
     return std::nullopt;
 }
 
-// The Huang part (parts "huang"), its f part ("huang,f") and the multiple part after them
-// ("huang,multiple", "huang,f,multiple"): the layout of huang_pixels_of, sizes checked before
-// the pixels are read.
-Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, bool with_f, bool multiple) {
+// The Huang part (parts "huang"), its f part ("huang,f"), its absorption part
+// ("huang,f,absorption") and the multiple part after them (the same with ",multiple"): the
+// layout of huang_pixels_of, sizes checked before the pixels are read.
+Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, HuangParts parts) {
     const OIIO::ImageSpec &spec = in.spec();
     auto h = std::make_shared<HuangTableSet>();
     HuangLayout layout;
-    if (Status s = check_huang_parts(spec, multiple)) return *s;
+    if (Status s = check_huang_parts(spec, parts.multiple)) return *s;
     if (Status s = read_huang_axes(spec, *h, layout)) return *s;
-    if (Status s = read_huang_f(spec, with_f, layout, h->f_refinement)) return *s;
-    if (multiple) {
-        if (Status s = read_huang_multiple(spec, with_f, t, layout)) return *s;
+    if (Status s = read_huang_f(spec, parts.f, layout, h->f_refinement)) return *s;
+    if (Status s = read_huang_absorption(spec, parts.absorption, layout, h->absorption_nodes)) return *s;
+    if (parts.multiple) {
+        if (Status s = read_huang_multiple(spec, t, layout)) return *s;
     }
     if (Status s = TableImageSize{layout.width, layout.height}.validate()) return file_error(s->message);
     if (spec.width != layout.width || spec.height != layout.height || spec.depth != 1 || spec.x != 0 || spec.y != 0)
@@ -558,6 +674,7 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
     spec.attribute("hairis:parameters", canonical_parameters(t.parameters));
     if (const HuangTableSet *h = t.huang.get()) {
         spec.attribute("hairis:parts", std::string("huang") + (h->has_f() ? ",f" : "") +
+                                           (h->has_absorption() ? ",absorption" : "") +
                                            (t.has_multiple() ? ",multiple" : ""));
         if (h->has_f()) {
             // The refinement is written only when not 1, so that readers from before it read
@@ -566,8 +683,13 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {
             if (h->f_refinement != 1) f_options.push_back({"refinement", std::to_string(h->f_refinement)});
             spec.attribute("hairis:huang_f", format_options(f_options));
         }
+        if (h->has_absorption())
+            spec.attribute("hairis:huang_absorption",
+                           format_options({{"row", std::to_string(layout.huang_rows + layout.f_rows)},
+                                           {"nodes", join_floats(h->absorption_nodes)}}));
         if (t.has_multiple()) {
-            spec.attribute("hairis:multiple", format_options({{"row", std::to_string(layout.huang_rows + layout.f_rows)},
+            const long long multiple_row = layout.huang_rows + layout.f_rows + layout.absorption_rows;
+            spec.attribute("hairis:multiple", format_options({{"row", std::to_string(multiple_row)},
                                                               {"theta_r", std::to_string(t.theta_r_count())},
                                                               {"theta_i", std::to_string(t.theta_i_count)}}));
             spec.attribute("hairis:theta_r_nodes", TypeDesc(TypeDesc::FLOAT, t.theta_r_count()),
@@ -745,15 +867,13 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     t.source = spec.get_string_attribute("hairis:source");
     if (Status s = read_parameters(spec, t)) return *s;
     const std::string parts = spec.get_string_attribute("hairis:parts");
-    if (parts == "huang" || parts == "huang,f" || parts == "huang,multiple" || parts == "huang,f,multiple") {
+    if (const std::optional<HuangParts> huang_parts = huang_parts_of(parts)) {
         if (t.model != "huang2022")
             return file_error("hairis:parts \"" + parts + "\" is for model huang2022 (got \"" + t.model + "\")");
-        return decode_huang(*in, std::move(t), parts.rfind("huang,f", 0) == 0,
-                            parts.size() >= 9 && parts.compare(parts.size() - 9, 9, ",multiple") == 0);
+        return decode_huang(*in, std::move(t), *huang_parts);
     }
     if (t.model == "huang2022")
-        return file_error("huang2022 tables have hairis:parts \"huang\", \"huang,f\", \"huang,multiple\" or "
-                          "\"huang,f,multiple\" (got \"" + parts + "\")");
+        return file_error("huang2022 tables have hairis:parts " + huang_parts_list() + " (got \"" + parts + "\")");
     const int theta_r_count = spec.get_int_attribute("hairis:theta_r_count", 0);
     t.theta_i_count = spec.get_int_attribute("hairis:theta_i_count", 0);
     t.phi_count = spec.get_int_attribute("hairis:phi_count", 0);
@@ -761,9 +881,8 @@ Expected<TableSet> decode_table_exr(const void *data, size_t size) {
     if (Status s = TableResolution{theta_r_count, t.theta_i_count, t.phi_count}.validate())
         return file_error(s->message);
     if (parts != "far" && parts != "far,near")
-        return file_error("hairis:parts must be \"far\", \"far,near\", \"huang\", \"huang,f\", \"huang,multiple\" or "
-                          "\"huang,f,multiple\" (got \"" +
-                          parts + "\")");
+        return file_error("hairis:parts must be \"far\", \"far,near\", " + huang_parts_list() + " (got \"" + parts +
+                          "\")");
     const long long far_rows = (long long)theta_r_count * t.theta_i_count;
     NearFieldData near;
     if (parts == "far,near") {

@@ -26,20 +26,27 @@
 //        part's row, same column:  R, G, B  the expectation of Cycles' f·cos θ_i of TT, TRT and
 //        TRRT+ at the cell's midpoint (huang_f_table.h);  A  1. This is what renders shade
 //        Huang hair with.
-//  multiple (huang2022 files baked for dual scattering, after the Huang and f parts) rows
-//        y = huang_rows + f_rows + r·theta_i_count + i for θ_r node r and θ_i cell i, columns k for
-//        n_h_values[k]:  G  S_multiple(θ_i | θ_r, n_h) per steradian;  R, B  0;  A  1.
+//  absorption (huang2022 files with an f part, after it) ceil(K/4) blocks of huang_rows rows for
+//        K absorption nodes: row huang_rows + f_rows + b·huang_rows + the Huang part's row, same
+//        column:  R, G, B, A  the cell's values at nodes 4b to 4b + 3 (HuangTableSet::absorption),
+//        0 past the last node. This is the f part for strands of other absorption.
+//  multiple (huang2022 files baked for dual scattering, after the Huang, f and absorption parts)
+//        rows y = huang_rows + f_rows + absorption_rows + r·theta_i_count + i for θ_r node r and
+//        θ_i cell i, columns k for n_h_values[k]:  G  S_multiple(θ_i | θ_r, n_h) per steradian;
+//        R, B  0;  A  1.
 // Metadata (EXR header attributes): hairis:format_version (2), hairis:model (string),
 // hairis:source ("exact" or "gaussian"), hairis:parameters ("name=value;..."),
 // hairis:theta_r_count, hairis:theta_i_count, hairis:phi_count (the far part), hairis:theta_r_nodes
 // (float array, radians), hairis:n_h_values ("1,2,..."), hairis:parts ("far", "far,near",
-// "huang", "huang,f", "huang,multiple" or "huang,f,multiple"), hairis:near
-// ("row=...;theta_o=...;theta_i=..."), hairis:huang ("row=0;theta_o=...;phi_o=...;theta_i=...;
-// phi=..."), hairis:huang_f ("row=..."), hairis:huang_theta_o_nodes and
-// hairis:huang_phi_o_nodes (float arrays, radians), hairis:multiple ("row=...;theta_r=...;
-// theta_i=..."; with it a huang file has hairis:theta_r_nodes and hairis:n_h_values, and never
-// the far part's counts), hairis:pixel_sha1 (hex SHA-1 of the float
-// pixels in scanline order, RGBA interleaved, little-endian). Every pixel outside the parts is 0.
+// "huang", "huang,f", "huang,f,absorption", "huang,multiple", "huang,f,multiple" or
+// "huang,f,absorption,multiple"), hairis:near ("row=...;theta_o=...;theta_i=..."), hairis:huang
+// ("row=0;theta_o=...;phi_o=...;theta_i=...;phi=..."), hairis:huang_f ("row=..."),
+// hairis:huang_absorption ("row=...;nodes=...", the K nodes with 9 significant digits),
+// hairis:huang_theta_o_nodes and hairis:huang_phi_o_nodes (float arrays, radians),
+// hairis:multiple ("row=...;theta_r=...;theta_i=..."; with it a huang file has
+// hairis:theta_r_nodes and hairis:n_h_values, and never the far part's counts),
+// hairis:pixel_sha1 (hex SHA-1 of the float pixels in scanline order, RGBA interleaved,
+// little-endian). Every pixel outside the parts is 0.
 // The image has at most kMaxTableAxisCells + 1 columns and kMaxTableCells pixels.
 // Version 1 files (no near part) are refused with a message asking for a re-bake.
 #pragma once

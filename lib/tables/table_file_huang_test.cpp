@@ -120,6 +120,10 @@ void expect_same_huang_part(const TableSet &b, const TableSet &t) {
     EXPECT_TRUE(same_bits(b.multiple, t.multiple));
     ASSERT_EQ(b.huang->f.size(), t.huang->f.size());
     EXPECT_TRUE(same_bits(b.huang->f, t.huang->f));
+    ASSERT_EQ(b.huang->absorption_nodes.size(), t.huang->absorption_nodes.size());
+    EXPECT_TRUE(same_bits(b.huang->absorption_nodes, t.huang->absorption_nodes));
+    ASSERT_EQ(b.huang->absorption.size(), t.huang->absorption.size());
+    EXPECT_TRUE(same_bits(b.huang->absorption, t.huang->absorption));
 }
 
 // The sampling tables of `t` read back from its bytes, which must give back its Huang part bit
@@ -140,6 +144,17 @@ std::optional<SamplingTables> round_trip(const TableSet &t) {
 TableSet with_distinct_f(TableSet t) {
     auto h = std::make_shared<HuangTableSet>(*t.huang);
     for (std::size_t n = 0; n < 3 * h->values.size(); ++n) h->f.push_back(n == 4 ? 0.0f : 3.0f + 0.001f * float(n));
+    t.huang = std::move(h);
+    return t;
+}
+
+// `t` (with an f part) with an absorption part of 5 nodes, so that its second block of 4 has
+// padding, and distinct values (a zero among them); 0.1 and 0.3 are not exact in decimal.
+TableSet with_distinct_absorption(TableSet t) {
+    auto h = std::make_shared<HuangTableSet>(*t.huang);
+    h->absorption_nodes = {0.1f, 0.3f, 1.7f, 12.5f, 1000.0f};
+    for (std::size_t n = 0; n < 5 * h->values.size(); ++n)
+        h->absorption.push_back(n == 6 ? 0.0f : 7.0f + 0.001f * float(n));
     t.huang = std::move(h);
     return t;
 }
@@ -282,6 +297,94 @@ TEST(HuangTableFile, RefusesADamagedFPart) {
     expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,multiple"); }),
                    "names no f part");
     expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,f"); }), "which has no multiple part");
+}
+
+// The absorption part (parts "huang,f,absorption" and "huang,f,absorption,multiple"):
+// round-trips bit for bit, nodes included, and lies after the f part in blocks of the Huang
+// part's rows, block b holding nodes 4b to 4b + 3 of the cell in R, G, B, A (0 past the last
+// node); it pushes the multiple part down by its rows.
+TEST(HuangTableFile, TheAbsorptionPartRoundTripsWhereTheFormatSays) {
+    for (const TableSet &t : {with_distinct_absorption(with_distinct_f(distinct_tables())),
+                              with_distinct_absorption(with_distinct_f(distinct_with_multiple())),
+                              with_distinct_absorption(with_distinct_f(distinct_tables(1, 1, 2, 1)))}) {
+        ASSERT_TRUE(t.huang->has_absorption());
+        EXPECT_TRUE(round_trip(t));
+    }
+    EXPECT_EQ(read_image(encode(with_distinct_absorption(with_distinct_f(distinct_tables()))))
+                  .spec.get_string_attribute("hairis:parts"),
+              "huang,f,absorption");
+    const TableSet t = with_distinct_absorption(with_distinct_f(distinct_with_multiple()));
+    Image image = read_image(encode(t));
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:parts"), "huang,f,absorption,multiple");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:huang_f"), "row=24");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:huang_absorption"),
+              "row=48;nodes=0.100000001,0.300000012,1.70000005,12.5,1000");
+    EXPECT_EQ(image.spec.get_string_attribute("hairis:multiple"), "row=96;theta_r=3;theta_i=4");
+    ASSERT_EQ(image.spec.width, 5);
+    ASSERT_EQ(image.spec.height, 24 + 24 + 2 * 24 + 3 * 4);
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 5; ++x) {
+            const std::size_t n = std::size_t(y) * 5 + std::size_t(x);
+            EXPECT_EQ(image.at(x, 24 + y, 0), t.huang->f[3 * n]) << x << y;
+            for (int b = 0; b < 2; ++b)
+                for (int c = 0; c < 4; ++c) {
+                    const int k = 4 * b + c;
+                    EXPECT_EQ(image.at(x, 48 + 24 * b + y, c), k < 5 ? t.huang->absorption[5 * n + std::size_t(k)] : 0.0f)
+                        << x << " " << y << " node " << k;
+                }
+        }
+    EXPECT_EQ(image.at(0, 96, 1), t.multiple[0]);
+}
+
+// Damaged absorption parts are refused naming what is wrong (rows 48-71 hold nodes 0-3,
+// rows 72-95 node 4 in R and padding in G, B, A).
+TEST(HuangTableFile, RefusesADamagedAbsorptionPart) {
+    const TableSet t = with_distinct_absorption(with_distinct_f(distinct_with_multiple()));
+    auto with_absorption = [&](const std::string &value) {
+        return tamper(t, [&](Image &im) { im.spec.attribute("hairis:huang_absorption", value); });
+    };
+    expect_refused(with_absorption("row=47;nodes=0.1,0.3,1.7,12.5,1000"),
+                   "hairis:huang_absorption must start at row 48, after the f part");
+    expect_refused(tamper(t, [](Image &im) { im.spec.erase_attribute("hairis:huang_absorption"); }),
+                   "no string attribute hairis:huang_absorption");
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,f,multiple"); }),
+                   "hairis:parts names no absorption part, but the file has hairis:huang_absorption");
+    expect_refused(tamper(t, [](Image &im) { im.spec.attribute("hairis:parts", "huang,absorption,multiple"); }),
+                   "\"huang,f,absorption\", \"huang,multiple\", \"huang,f,multiple\" or \"huang,f,absorption,multiple\"");
+    expect_refused(tamper(t, [](Image &im) { im.at(2, 75, 1) = 0.5f; }),
+                   "the absorption part has 5 nodes, so its last block's channels past the last node (G, B, A) must "
+                   "be 0 at pixel (2, 75)");
+    expect_refused(tamper(t, [](Image &im) { im.at(1, 50, 2) = -1.0f; }),
+                   "the Huang table's absorption part: entry 57 (cell 11, node 2) must be finite and >= 0");
+    expect_refused(tamper(t, [](Image &im) { im.at(1, 73, 0) = std::numeric_limits<float>::infinity(); }),
+                   "pixel (1, 73) holds NaN or infinity");
+    expect_refused(with_absorption("row=48;nodes=0.5"),
+                   "hairis:huang_absorption: nodes must be 2 to 32 numbers strictly increasing in (0, 1000]");
+    expect_refused(with_absorption("row=48;nodes=0.1,0.3,0.3,12.5,1000"), "strictly increasing in (0, 1000]");
+    expect_refused(with_absorption("row=48;nodes=0,0.3,1.7,12.5,1000"), "(got \"0,0.3,1.7,12.5,1000\")");
+    expect_refused(with_absorption("row=48;nodes=0.1,0.3,1.7,12.5,2000"), "strictly increasing in (0, 1000]");
+    expect_refused(with_absorption("row=48;nodes=0.1,0.3,1.7,12.5,x"), "strictly increasing in (0, 1000]");
+    expect_refused(with_absorption("row=48;nodes=0.1,0.3,1.7,12.5,1000;k=5"), "unknown option \"k\"");
+    // Four nodes fill one block: the image has a block of rows more than the attribute places.
+    expect_refused(with_absorption("row=48;nodes=0.1,0.3,1.7,12.5"), "start at row 72, after the absorption part");
+    expect_refused(tamper(with_distinct_absorption(with_distinct_f(distinct_tables())),
+                          [](Image &im) { im.spec.attribute("hairis:huang_absorption", "row=48;nodes=0.1,0.3,1.7,12.5"); }),
+                   "needs 5x72");
+}
+
+// The absorption part extends the f part: a set with the one but not the other is refused by
+// HuangTableSet::validate(), whose message the encoder returns.
+TEST(HuangTableFile, TheEncoderRefusesAnAbsorptionPartWithoutAnFPart) {
+    TableSet t = with_distinct_absorption(with_distinct_f(distinct_tables()));
+    auto h = std::make_shared<HuangTableSet>(*t.huang);
+    h->f.clear();
+    t.huang = h;
+    const Expected<std::vector<unsigned char>> bytes = encode_table_exr(t);
+    ASSERT_FALSE(bytes.ok());
+    EXPECT_EQ(bytes.error().kind, ErrorKind::InvalidTable);
+    EXPECT_NE(bytes.error().message.find("the Huang table's absorption part needs the f part beside it"),
+              std::string::npos)
+        << bytes.error().message;
 }
 
 TEST(HuangTableFile, RefusesADamagedMultiplePart) {

@@ -497,8 +497,8 @@ TEST(TableFileNearPart, RefusesUnknownParts) {
     for (const char *parts : {"", "near", "near,far", "far,near,far", "far,mid", "far, near", "FAR,NEAR", "far,huang"}) {
         SCOPED_TRACE(parts);
         expect_refused(with_attribute(small_tables(), "hairis:parts", parts),
-                       "hairis:parts must be \"far\", \"far,near\", \"huang\", \"huang,f\", "
-                       "\"huang,multiple\" or \"huang,f,multiple\"");
+                       "hairis:parts must be \"far\", \"far,near\", \"huang\", \"huang,f\", \"huang,f,absorption\", "
+                       "\"huang,multiple\", \"huang,f,multiple\" or \"huang,f,absorption,multiple\"");
     }
     // A Huang part claimed on a Chiang file.
     expect_refused(with_attribute(small_tables(), "hairis:parts", "huang"), "is for model huang2022");

@@ -877,7 +877,7 @@ class TestRender(unittest.TestCase):
         self.assertEqual(items(lib().hairis_tables_info(tables).decode()),
                          {"source": "exact", "huang_theta_o": "6", "huang_phi_o": "3",
                           "huang_theta_i": "12", "huang_phi": "16", "huang_f": "1",
-                          "huang_f_refinement": "1"})
+                          "huang_f_refinement": "1", "huang_absorption": "0"})
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "huang.exr")
             self.assertEqual(lib().hairis_tables_write(tables, path.encode()), OK, last_error())

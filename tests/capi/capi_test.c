@@ -1947,14 +1947,15 @@ static void test_huang(void)
     CHECK(huang_tables && strcmp(hairis_tables_model(huang_tables), "huang2022") == 0, "model huang2022");
     CHECK(huang_tables && strcmp(hairis_tables_info(huang_tables),
                                  "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;"
-                                 "huang_f=1;huang_f_refinement=1;theta_r=31;theta_i=64;n_h=1,2,4,8,16") == 0,
+                                 "huang_f=1;huang_f_refinement=1;huang_absorption=0;theta_r=31;theta_i=64;"
+                                 "n_h=1,2,4,8,16") == 0,
           "info \"%s\" (with the multiple part)", huang_tables ? hairis_tables_info(huang_tables) : "");
     char table_only_options[TEXT];
     snprintf(table_only_options, TEXT, "%s;huang_multiple=0", small);
     hairis_tables *table_only = hairis_tables_bake(huang, table_only_options, NULL, NULL);
     CHECK(table_only && strcmp(hairis_tables_info(table_only),
                                "source=exact;huang_theta_o=8;huang_phi_o=3;huang_theta_i=16;huang_phi=24;huang_f=1;"
-                               "huang_f_refinement=1") == 0,
+                               "huang_f_refinement=1;huang_absorption=0") == 0,
           "huang_multiple=0: the Huang table alone, \"%s\"", table_only ? hairis_tables_info(table_only) : "");
     /* A refined f part says so, also after a round trip through a file; 5 is out of range. */
     char refined_options[TEXT];

@@ -136,8 +136,10 @@ HAIRIS_API const char *hairis_tables_model(const hairis_tables *tables);
 HAIRIS_API const char *hairis_tables_parameters(const hairis_tables *tables);
 /** What the tables hold, as options: source, theta_r, theta_i, phi, n_h; for huang2022 tables
  * source, huang_theta_o, huang_phi_o, huang_theta_i, huang_phi, huang_f (1 when they hold the
- * baked f that renders shade with), huang_f_refinement (with the f part) and, when they hold the multiple part that
- * integrator=dual_scattering needs, theta_r, theta_i, n_h. */
+ * baked f that renders shade with), huang_f_refinement (with the f part), huang_absorption (1 when
+ * they hold the absorption part, the f part at several absorptions for strands of other
+ * absorption), huang_absorption_nodes (its number of absorption nodes, with it) and, when they
+ * hold the multiple part that integrator=dual_scattering needs, theta_r, theta_i, n_h. */
 HAIRIS_API const char *hairis_tables_info(const hairis_tables *tables);
 /** 1 when the tables were baked for exactly this fiber's parameters, else 0 (also for NULL
  * arguments, with the last error set). */
