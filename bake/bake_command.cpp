@@ -135,6 +135,9 @@ void add_bake_command(CLI::App &app, int &exit_code) {
                     "Huang fibers: multiplies the orders of the f part's quadrature, which leaves less error "
                     "towards single lights and bakes for longer")
         ->check(CLI::Range(1, kMaxHuangFRefinement))->capture_default_str();
+    cmd->add_flag("--huang-absorption", b.huang_absorption,
+                  "Huang fibers: also bake the absorption part, so that renders shade strands of other "
+                  "absorption (Random Color, Hair Info) with baked values instead of Cycles' eval");
     cmd->add_option("--threads", b.threads, "worker threads, 0 for all cores (the output does not depend on it)")
         ->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--output,-o", flags->output, "the EXR file to write (atomically)")->required();

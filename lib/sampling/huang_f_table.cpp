@@ -17,42 +17,32 @@ std::vector<double> huang_sin_theta_points(int theta_i_count) {
     return points;
 }
 
+HuangFGrid::HuangFGrid(const HuangTableSet &set)
+    : theta_o_count_(set.theta_o_count()), theta_i_count_(set.theta_i_count), phi_count_(set.phi_count),
+      sin_points_(huang_sin_theta_points(set.theta_i_count)), phi_o_nodes_(set.phi_o_nodes) {}
+
 Expected<HuangFTable> HuangFTable::create(const HuangTableSet &set) {
     if (Status s = set.validate()) return *s;
     if (!set.has_f()) return Error{"the Huang table set has no f part (bake it with the f part)"};
     HuangFTable t;
-    t.theta_o_count_ = set.theta_o_count();
-    t.theta_i_count_ = set.theta_i_count;
-    t.phi_count_ = set.phi_count;
-    t.sin_points_ = huang_sin_theta_points(set.theta_i_count);
-    t.phi_o_nodes_ = set.phi_o_nodes;
+    t.grid_ = HuangFGrid(set);
     t.values_ = set.f;
     return t;
 }
 
 Rgb HuangFTable::value(int q, int r, int i, int j) const {
-    const std::size_t n =
-        ((std::size_t(q) * std::size_t(theta_o_count_) + std::size_t(r)) * std::size_t(theta_i_count_) + std::size_t(i)) *
-            std::size_t(phi_count_) +
-        std::size_t(j);
+    const std::size_t n = grid_.cell(q, r, i, j);
     return {values_[3 * n], values_[3 * n + 1], values_[3 * n + 2]};
 }
 
-namespace {
-
-// Cubic Hermite weights of the four values at x[0] < x[1] ≤ x < x[2] < x[3], t = (x − x[1]) /
-// (x[2] − x[1]), with the slopes at x[1] and x[2] taken from their neighbours (Catmull-Rom
-// on uneven nodes). It passes through the values and reproduces quadratics.
-std::array<float, 4> hermite_weights(const double x[4], double t) {
+std::array<float, 4> catmull_rom_weights(const double x[4], double t) {
     const double t2 = t * t, t3 = t2 * t;
     const double h00 = 2 * t3 - 3 * t2 + 1, h10 = t3 - 2 * t2 + t, h01 = -2 * t3 + 3 * t2, h11 = t3 - t2;
     const double d = x[2] - x[1], a = d / (x[2] - x[0]), b = d / (x[3] - x[1]);
     return {float(-h10 * a), float(h00 - h11 * b), float(h01 + h10 * a), float(h11 * b)};
 }
 
-}  // namespace
-
-HuangFTable::Stencil HuangFTable::theta_i_stencil(double sin_theta) const {
+HuangFGrid::Stencil HuangFGrid::theta_i_stencil(double sin_theta) const {
     // Rows −1 and n_i are the poles (s = ∓1), where f·|cos θ_i| is 0. Next to a pole the value
     // behaves like √(1 − s²), which no polynomial follows, so that interval is linear.
     const int n_i = theta_i_count_;
@@ -64,10 +54,10 @@ HuangFTable::Stencil HuangFTable::theta_i_stencil(double sin_theta) const {
     const double t = std::clamp((s - x(lower)) / (x(lower + 1) - x(lower)), 0.0, 1.0);
     if (lower < 0 || lower >= n_i - 1) return {lower - 1, {0.0f, float(1.0 - t), float(t), 0.0f}};
     const double nodes[4] = {x(lower - 1), x(lower), x(lower + 1), x(lower + 2)};
-    return {lower - 1, hermite_weights(nodes, t)};
+    return {lower - 1, catmull_rom_weights(nodes, t)};
 }
 
-HuangFTable::Stencil HuangFTable::phi_stencil(double phi) const {
+HuangFGrid::Stencil HuangFGrid::phi_stencil(double phi) const {
     // Points at the cells' centres, evenly spaced and periodic.
     const int n_j = phi_count_;
     const double x = (phi + kPi) / kTwoPi * n_j - 0.5;
@@ -75,34 +65,26 @@ HuangFTable::Stencil HuangFTable::phi_stencil(double phi) const {
     const double even[4] = {-1.0, 0.0, 1.0, 2.0};
     int first = (int(fx) - 1) % n_j;
     if (first < 0) first += n_j;
-    return {first, hermite_weights(even, x - fx)};
+    return {first, catmull_rom_weights(even, x - fx)};
 }
 
-Rgb HuangFTable::slice(int q, int r, const Stencil &rows, const Stencil &columns) const {
-    std::size_t column[4];
-    for (int b = 0; b < 4; ++b) column[b] = 3 * std::size_t((columns.first + b) % phi_count_);
-    const std::size_t row_size = 3 * std::size_t(phi_count_);
-    const float *slice_values =
-        values_.data() + (std::size_t(q) * std::size_t(theta_o_count_) + std::size_t(r)) * std::size_t(theta_i_count_) * row_size;
-    float sum[3] = {0.0f, 0.0f, 0.0f};
+void HuangFGrid::add_slice(int q, int r, const Stencil &rows, const Stencil &columns, float scale,
+                           HuangGridRead &out) const {
     for (int a = 0; a < 4; ++a) {
         const int i = rows.first + a;
-        const float wa = rows.w[std::size_t(a)];
+        const float wa = rows.w[std::size_t(a)] * scale;
         if (wa == 0.0f || i < 0 || i >= theta_i_count_) continue;  // a pole
-        const float *row = slice_values + std::size_t(i) * row_size;
         for (int b = 0; b < 4; ++b) {
-            const float w = wa * columns.w[std::size_t(b)];
-            const float *v = row + column[b];
-            sum[0] += w * v[0];
-            sum[1] += w * v[1];
-            sum[2] += w * v[2];
+            const std::size_t k = std::size_t(out.count++);
+            out.cell[k] = std::uint32_t(cell(q, r, i, (columns.first + b) % phi_count_));
+            out.weight[k] = wa * columns.w[std::size_t(b)];
         }
     }
-    return {sum[0], sum[1], sum[2]};
 }
 
-Rgb HuangFTable::f_cos(const HuangTableQuery &q, Vec3 wi) const {
-    if (!(wi.x >= -1.0f && wi.x <= 1.0f)) return {};
+HuangGridRead HuangFGrid::read(const HuangTableQuery &q, Vec3 wi) const {
+    HuangGridRead out;
+    if (!(wi.x >= -1.0f && wi.x <= 1.0f)) return out;
     const float y = q.sign_y * wi.y, z = q.sign_z * wi.z;
     const double phi = std::atan2(z * q.cos_phi_o - y * q.sin_phi_o, y * q.cos_phi_o + z * q.sin_phi_o);
     const double theta_i = std::asin(double(wi.x));
@@ -135,21 +117,32 @@ Rgb HuangFTable::f_cos(const HuangTableQuery &q, Vec3 wi) const {
             x[m] = at;
             nodes[m] = {index, mirrored, 0.0f};
         }
-        const std::array<float, 4> w = hermite_weights(x, q.phi.t);
+        const std::array<float, 4> w = catmull_rom_weights(x, q.phi.t);
         for (int m = 0; m < 4; ++m) nodes[m].weight = w[std::size_t(m)];
     }
     const Stencil columns = phi_stencil(phi), mirrored_columns = phi_stencil(-phi);
-    Rgb sum;
     for (int k = 0; k < 2; ++k) {
         const float wk = k ? q.theta.t : 1.0f - q.theta.t;
         if (!(wk > 0.0f)) continue;
         const int r = q.theta.lower + k;
         const Stencil rows = theta_i_stencil(std::sin(q.warp[k].to_node(theta_i)));
         for (const Node &m : nodes)
-            if (m.weight != 0.0f) sum += slice(m.index, r, rows, m.mirrored ? mirrored_columns : columns) * (wk * m.weight);
+            if (m.weight != 0.0f) add_slice(m.index, r, rows, m.mirrored ? mirrored_columns : columns, wk * m.weight, out);
+    }
+    return out;
+}
+
+Rgb HuangFTable::f_cos(const HuangGridRead &read) const {
+    float sum[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = 0; k < read.count; ++k) {
+        const float *v = values_.data() + 3 * std::size_t(read.cell[std::size_t(k)]);
+        const float w = read.weight[std::size_t(k)];
+        sum[0] += w * v[0];
+        sum[1] += w * v[1];
+        sum[2] += w * v[2];
     }
     // The cubic overshoots a little next to sharp features; f is never negative.
-    return {std::max(sum.r, 0.0f), std::max(sum.g, 0.0f), std::max(sum.b, 0.0f)};
+    return {std::max(sum[0], 0.0f), std::max(sum[1], 0.0f), std::max(sum[2], 0.0f)};
 }
 
 }  // namespace hairis

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/frame.h"
+#include "sampling/huang_absorption_table.h"
 #include "sampling/huang_f_table.h"
 #include "sampling/table_set.h"
 
@@ -274,6 +275,11 @@ Expected<HuangSamplingTable> HuangSamplingTable::from(const HuangTableSet &set) 
         Expected<HuangFTable> f = HuangFTable::create(set);
         if (!f) return Error{f.error().message, ErrorKind::InvalidTable};
         out.f = std::make_shared<const HuangFTable>(std::move(f).value());
+    }
+    if (set.has_absorption()) {
+        Expected<HuangAbsorptionTable> a = HuangAbsorptionTable::create(set);
+        if (!a) return Error{a.error().message, ErrorKind::InvalidTable};
+        out.absorption = std::make_shared<const HuangAbsorptionTable>(std::move(a).value());
     }
     return out;
 }

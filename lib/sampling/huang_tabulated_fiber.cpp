@@ -1,5 +1,6 @@
 #include "sampling/huang_tabulated_fiber.h"
 
+#include <algorithm>
 #include <string>
 
 #include "sampling/table_set.h"
@@ -24,15 +25,27 @@ HuangTabulatedPoint::HuangTabulatedPoint(const HuangTabulatedFiber &model, const
     : FiberPoint(hit), point_(strand ? *strand : model.fiber(), hit),
       query_(model.table().locate(point_.to_huang(hit.wo))), f_(&model.f_table()), lcg_(point_.lcg()) {
     if (!strand || strand == &model.fiber()) return;
-    if (model.strand_shading() == StrandShading::ControlVariate && absorption_only(*strand, model.fiber()))
+    const bool absorption_differs = absorption_only(*strand, model.fiber());
+    const HuangAbsorptionTable *part = model.absorption_table();
+    if (absorption_differs && part && part->reads(strand->sigma(), model.fiber().sigma())) {
+        absorption_ = part;
+        node_fiber_ = &model.fiber();
+    } else if (model.strand_shading() == StrandShading::ControlVariate && absorption_differs) {
         node_ = &model.fiber();
-    else
+    } else {
         own_eval_ = true;
+    }
 }
 
 Rgb HuangTabulatedPoint::f(Vec3 wi) const {
     if (point_.near_field() || own_eval_) return point_.f_estimate(wi, lcg_);
-    const Rgb tabulated = f_->f_cos(query_, point_.to_huang(wi));
+    const HuangGridRead read = f_->grid().read(query_, point_.to_huang(wi));
+    const Rgb tabulated = f_->f_cos(read);
+    if (absorption_) {
+        // The node's baked f moved to the strand's absorption; never below 0.
+        const Rgb moved = tabulated + absorption_->difference(read, point_.fiber().sigma(), node_fiber_->sigma());
+        return point_.f_reflection(wi) + Rgb(std::max(moved.r, 0.0f), std::max(moved.g, 0.0f), std::max(moved.b, 0.0f));
+    }
     if (!node_) return point_.f_reflection(wi) + tabulated;
     // The control variate: the strand's eval and the node's along the same chains, in one
     // pass; R cancels in the difference and is the same for both.

@@ -5,11 +5,14 @@
 // keep Cycles' one-sample eval: the table holds the far field only.
 //
 // A strand whose inputs differ from the node's (HuangStrands) is shaded with its own f. When
-// only its absorption differs, the table is a control variate: f = the baked expectation +
-// (the strand's Cycles eval − the node's), both evals following the same microfacet chains in
-// one pass, so the correction has mean (strand − node) and little noise, at about one eval's
-// cost. A strand of another roughness, IOR or offset draws other chains; it is shaded with its
-// own Cycles eval. A renderer can ask for the strand's own eval everywhere
+// only its absorption differs and the table has an absorption part that reads it
+// (huang_absorption_table.h), f = the baked f + the part's difference between the strand's
+// absorption and the node's: no noise, whatever StrandShading says. Without that part the
+// table is a control variate: f = the baked expectation + (the strand's Cycles eval − the
+// node's), both evals following the same microfacet chains in one pass, so the correction has
+// mean (strand − node) and little noise, at about one eval's cost. A strand of another
+// roughness, IOR or offset draws other chains; it is shaded with its own Cycles eval. A
+// renderer can ask for the strand's own eval wherever the absorption part does not serve
 // (StrandShading::OwnEval).
 #pragma once
 
@@ -18,6 +21,7 @@
 #include "core/expected.h"
 #include "fiber/huang.h"
 #include "fiber/huang_strands.h"
+#include "sampling/huang_absorption_table.h"
 #include "sampling/huang_f_table.h"
 #include "sampling/huang_table.h"
 
@@ -25,7 +29,8 @@ namespace hairis {
 
 class HuangTabulatedFiber;
 
-/// How a strand whose inputs differ from the node's is shaded.
+/// How a strand whose inputs differ from the node's is shaded where the table's absorption
+/// part does not serve it.
 enum class StrandShading {
     ControlVariate,  ///< the baked f corrected where only the absorption differs
     OwnEval,         ///< the strand's own Cycles eval (one eval, noisier)
@@ -50,6 +55,10 @@ class HuangTabulatedPoint final : public FiberPoint {
     HuangPoint point_;  // the strand's own fiber at the hit
     HuangTableQuery query_;
     const HuangFTable *f_;
+    // A strand that differs from the node in absorption only, read from the table's
+    // absorption part; and the two absorptions it reads.
+    const HuangAbsorptionTable *absorption_ = nullptr;
+    const HuangFiber *node_fiber_ = nullptr;
     // A strand that differs from the node in absorption only: the node's fiber, whose eval
     // along the strand's chains is the control variate.
     const HuangFiber *node_ = nullptr;
@@ -75,6 +84,8 @@ class HuangTabulatedFiber final : public ShadingModel {
     const HuangFiber &fiber() const { return *fiber_; }
     const HuangTable &table() const { return *table_->table; }
     const HuangFTable &f_table() const { return *table_->f; }
+    /// The table's absorption part, or null.
+    const HuangAbsorptionTable *absorption_table() const { return table_->absorption.get(); }
     StrandShading strand_shading() const { return strand_shading_; }
 
   private:

@@ -16,6 +16,7 @@
 #include "sampling/hair_bsdf.h"
 #include "fiber/hair_inputs.h"
 #include "fiber/huang_strands.h"
+#include "sampling/huang_absorption_table.h"
 #include "sampling/huang_table_sampler.h"
 #include "sampling/strategy.h"
 #include "tables/huang_bake.h"
@@ -265,6 +266,72 @@ TEST(HuangTabulatedFiber, AStrandOfOtherMelaninIsTheBakedFCorrectedWithLittleNoi
         // On the same draws the corrected table is far less noisy than the strand's own eval.
         EXPECT_LT(cv.variance(), 0.5 * plain.variance()) << wi.x << " " << wi.y << " " << wi.z;
     }
+}
+
+// With the absorption part a strand of other melanin is shaded without noise under either
+// StrandShading, and as close to its own expectation as the node's baked f is to the node's:
+// the part moves the baked f to the strand's absorption. A strand below the part's first node
+// keeps Cycles' eval.
+TEST(HuangTabulatedFiber, AStrandOfOtherMelaninReadsTheAbsorptionPartWithoutNoise) {
+    const StrandFixture &fx = strand_fixture();
+    HuangBakeOptions o = testing::small_huang_bake();
+    o.first_order = o.f_first_order = 3;
+    o.second_order = o.f_second_order = 2;
+    o.absorption_nodes = huang_absorption_nodes();
+    const auto table =
+        std::make_shared<const HuangSamplingTable>(HuangSamplingTable::from(bake_huang_table(*fx.fiber, o).value()).value());
+    ASSERT_NE(table->absorption, nullptr);
+    HuangQuadrature rule;
+    rule.first_order = 3;
+    rule.second_order = 2;
+    rule.tt_order = o.f_tt_order;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (StrandShading shading : {StrandShading::ControlVariate, StrandShading::OwnEval}) {
+        const HuangTabulatedFiber model = HuangTabulatedFiber::create(fx.fiber, table, fx.strands, shading).value();
+        for (float melanin : {0.25f, 0.75f}) {
+            const Strand strand(fx.node, HairInput::Melanin, melanin);
+            double strand_error = 0, strand_sum = 0, node_error = 0, node_sum = 0;
+            for (int v = 0; v < 6; ++v) {
+                FiberHit hit = hit_at(-60.0 + 24.0 * v, 0.4 * v);
+                hit.seed = std::uint32_t(v);
+                FiberHit node_hit = hit;
+                hit.inputs = &strand.inputs;
+                ScratchBuffer scratch;
+                const FiberPoint &point = model.prepare(hit, scratch);
+                const FiberPoint &node_point = model.prepare(node_hit, scratch);
+                const HuangPoint own = strand.own->at(hit), node = fx.fiber->at(node_hit);
+                const HuangExpectation own_e = strand.own->expectation(own.huang_hit(), rule);
+                const HuangExpectation node_e = fx.fiber->expectation(node.huang_hit(), rule);
+                for (int n = 0; n < 200; ++n) {
+                    const Vec3 wi = safe_normalize(Vec3{u(rng), u(rng), u(rng)});
+                    const Rgb f = point.f(wi);
+                    ASSERT_EQ(f.g, point.f(wi).g) << "noise at draw " << n;
+                    const Rgb want = own_e.f(own.to_huang(wi)), node_want = node_e.f(node.to_huang(wi));
+                    const Rgb node_f = node_point.f(wi);
+                    for (int c = 0; c < 3; ++c) {
+                        strand_error += std::fabs(f[c] - want[c]);
+                        strand_sum += want[c];
+                        node_error += std::fabs(node_f[c] - node_want[c]);
+                        node_sum += node_want[c];
+                    }
+                }
+            }
+            EXPECT_LT(strand_error / strand_sum, 1.5 * node_error / node_sum + 0.003)
+                << "melanin " << melanin << ": strand " << strand_error / strand_sum << ", node "
+                << node_error / node_sum;
+        }
+    }
+    // Melanin 0 gives no absorption, below the part's first node: Cycles' eval, with its noise.
+    const HuangTabulatedFiber model = HuangTabulatedFiber::create(fx.fiber, table, fx.strands).value();
+    const Strand clear(fx.node, HairInput::Melanin, 0.0f);
+    FiberHit hit = hit_at(25.0, 0.7);
+    hit.inputs = &clear.inputs;
+    ScratchBuffer scratch;
+    const FiberPoint &point = model.prepare(hit, scratch);
+    const Vec3 wi = safe_normalize(Vec3{-0.3f, 0.6f, 0.7f});
+    const Moments m = moments(point, wi, 200);
+    EXPECT_GT(m.variance(), 0.0);
 }
 
 TEST(HuangTabulatedFiber, OwnEvalShadesAStrandOfOtherMelaninWithItsCyclesEval) {

@@ -45,6 +45,7 @@ Status BakeOptions::validate() const {
         if (k > 0 && n_h_values[k] <= n_h_values[k - 1])
             return Error{"n_h values must be strictly increasing"};
     }
+    if (huang_absorption && !huang_f) return Error{"huang_absorption needs huang_f: the absorption part corrects the f part"};
     if (source != "exact" && source != "gaussian")
         return Error{"source must be \"exact\" or \"gaussian\" (got \"" + source + "\")"};
     if (source == "gaussian") {

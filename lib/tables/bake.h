@@ -47,6 +47,9 @@ struct BakeOptions {
     /// Multiplies the Gauss orders of the f part's rule (HuangBakeOptions): the finer rule
     /// leaves less of the f part's error towards single lights and takes longer to bake.
     int huang_f_refinement = 1;
+    /// A huang2022 fiber's absorption part (huang_absorption_table.h), with the f part: renders
+    /// then shade strands of other absorption (Random Color, Hair Info) without Cycles' eval.
+    bool huang_absorption = false;
 
     /// Names the first option out of range.
     Status validate() const;
@@ -65,6 +68,7 @@ void describe(Fields &f, BakeOptions &o) {
     f.field("huang_multiple", o.huang_multiple);
     f.field("huang_f", o.huang_f);
     f.field("huang_f_refinement", o.huang_f_refinement, 1, kMaxHuangFRefinement);
+    f.field("huang_absorption", o.huang_absorption);
     f.field("huang_theta_o", o.huang.theta_o, 1, kMaxThetaRNodes);
     f.field("huang_phi_o", o.huang.phi_o, 1, kMaxPhiONodes);
     f.field("huang_theta_i", o.huang.theta_i, 1, kMaxTableAxisCells);

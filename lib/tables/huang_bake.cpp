@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "sampling/huang_absorption_table.h"
 
 namespace hairis {
 
@@ -35,7 +36,23 @@ struct NodeView {
     std::optional<HuangExpectation> expectation;
     std::optional<HuangPoint> point;  // Huang's frame = this point's frame (normal on y)
     std::optional<HuangExpectation> f;  // the f part's (HuangBakeOptions::f)
+    std::vector<HuangExpectation> absorption;  // one per fiber of three absorption nodes
 };
+
+// The fibers the absorption part is evaluated from: `fiber` with its absorption replaced by
+// three nodes at a time (the last fiber repeats the last node where fewer are left).
+Expected<std::vector<HuangFiber>> absorption_fibers(const HuangFiber &fiber, const std::vector<float> &nodes) {
+    std::vector<HuangFiber> fibers;
+    for (std::size_t k = 0; k < nodes.size(); k += 3) {
+        HuangParams p = fiber.params();
+        const float last = nodes.back();
+        p.sigma_a = {nodes[k], k + 1 < nodes.size() ? nodes[k + 1] : last, k + 2 < nodes.size() ? nodes[k + 2] : last};
+        Expected<HuangFiber> f = HuangFiber::create(p);
+        if (!f) return Error{"the absorption part's fiber: " + f.error().message};
+        fibers.push_back(std::move(f).value());
+    }
+    return fibers;
+}
 
 }  // namespace
 
@@ -57,6 +74,19 @@ Status HuangBakeOptions::validate() const {
     if (const int finest = std::max({f_first_order, f_second_order, f_tt_order}) * f_refinement; finest > 32)
         return Error{"f_refinement " + std::to_string(f_refinement) + " makes the f part's finest order " +
                      std::to_string(finest) + "; at most 32"};
+    if (!absorption_nodes.empty()) {
+        if (!f) return Error{"the absorption part (absorption_nodes) needs the f part (f)"};
+        const int k = int(absorption_nodes.size());
+        if (k < 2 || k > kMaxHuangAbsorptionNodes)
+            return Error{"absorption_nodes must hold 2 to " + std::to_string(kMaxHuangAbsorptionNodes) +
+                         " nodes (got " + std::to_string(k) + ")"};
+        for (int a = 0; a < k; ++a) {
+            const float node = absorption_nodes[std::size_t(a)];
+            if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > absorption_nodes[std::size_t(a - 1)])))
+                return Error{"absorption_nodes[" + std::to_string(a) + "] must be in (0, " +
+                             std::to_string(int(kMaxHuangAbsorption)) + "] and greater than the node before"};
+        }
+    }
     if (evaluator != "expectation" && evaluator != "estimate")
         return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};
     const long long cells = (long long)theta_o_count * phi_o_count * theta_i_count * phi_count;
@@ -105,6 +135,14 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
         t.f.assign(3 * t.values.size(), 0.0f);
         t.f_refinement = o.f_refinement;
     }
+    Expected<std::vector<HuangFiber>> absorption_fibers_or = absorption_fibers(fiber, o.absorption_nodes);
+    if (!absorption_fibers_or) return absorption_fibers_or.error();
+    const std::vector<HuangFiber> &absorption = absorption_fibers_or.value();
+    const std::size_t n_k = o.absorption_nodes.size();
+    if (n_k > 0) {
+        t.absorption_nodes = o.absorption_nodes;
+        t.absorption.assign(n_k * t.values.size(), 0.0f);
+    }
     const int p = o.points;
     std::atomic<bool> bad{false};
 
@@ -118,6 +156,8 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
             const Vec3 wo = direction_of(theta_o, t.phi_o_nodes[std::size_t(q)]);
             NodeView &v = views[std::size_t(q)];
             if (o.f) v.f.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule));
+            v.absorption.clear();
+            for (const HuangFiber &a : absorption) v.absorption.push_back(a.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule));
             if (shared_rule) {
                 v.expectation.reset();
             } else if (expectation) {
@@ -152,6 +192,17 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
                           rest.g >= 0.0f && rest.b >= 0.0f))
                         bad = true;
                     if (shared_rule) sum = luminance(lobes[0] + rest);
+                    // The absorption part: channel c of fiber g is node 3g + c.
+                    float *nodes_out = n_k ? &t.absorption[n_k * (first + std::size_t(j))] : nullptr;
+                    for (std::size_t g = 0; g < v.absorption.size(); ++g) {
+                        const std::array<Rgb, 4> a = v.absorption[g].lobes(direction_of(float(theta_i), float(phi_o + phi)));
+                        const Rgb a_rest = a[1] + a[2] + a[3];
+                        const float channels[3] = {a_rest.r, a_rest.g, a_rest.b};
+                        for (std::size_t c = 0; c < 3 && 3 * g + c < n_k; ++c) {
+                            nodes_out[3 * g + c] = channels[c];
+                            if (!(std::isfinite(channels[c]) && channels[c] >= 0.0f)) bad = true;
+                        }
+                    }
                 }
                 for (int a = 0; a < (shared_rule ? 0 : p); ++a) {
                     const double theta_i = std::asin(std::clamp(s0 + (s1 - s0) * (a + 0.5) / p, -1.0, 1.0));
@@ -225,10 +276,12 @@ Expected<TableSet> bake_huang_tables(const HuangFiber &fiber, const BakeOptions 
     o.threads = options.threads;
     o.f = options.huang_f;
     o.f_refinement = options.huang_f_refinement;
+    if (options.huang_absorption) o.absorption_nodes = huang_absorption_nodes();
     if (Status s = o.validate()) return Error{"the Huang resolution (huang_theta_o, huang_phi_o, huang_theta_i, huang_phi): " + s->message};
     // The file's image: one row per (φ_o node, θ_o node, θ_i cell), refused before the bake.
     const long long rows = (long long)(fiber.aspect_ratio() == 1.0 ? 1 : o.phi_o_count) * o.theta_o_count *
-                           o.theta_i_count * (o.f ? 2 : 1);  // the f part has as many rows
+                           o.theta_i_count *
+                           (1 + (o.f ? 1 : 0) + (int(o.absorption_nodes.size()) + 3) / 4);  // the f and absorption parts
     const long long multiple_rows = options.huang_multiple ? (long long)options.theta_r_count * options.theta_i_count : 0;
     if (Status s = TableImageSize{std::max<long long>(o.phi_count, (long long)options.n_h_values.size()),
                                   rows + multiple_rows}.validate())

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/expected.h"
 #include "fiber/huang.h"
@@ -41,6 +42,9 @@ struct HuangBakeOptions {
     /// Multiplies f_first_order, f_second_order and f_tt_order in the f part (the sampling
     /// part keeps its rule): TRT's two microfacets are the f part's largest error left.
     int f_refinement = 1;
+    /// Also bake the absorption part (huang_absorption_table.h) at these absorption nodes
+    /// (empty: none), with the f part's rule; it needs the f part.
+    std::vector<float> absorption_nodes;
 
     /// Names the first option out of range.
     Status validate() const;

@@ -224,6 +224,23 @@ TEST(HuangBake, RefusesOptionsByName) {
         o.f_refinement = k;
         EXPECT_NE(message(o).find("f_refinement"), std::string::npos) << k;
     }
+    // The absorption nodes a set may hold, refused before the bake, and only beside the f part.
+    o = {};
+    o.absorption_nodes = {0.5f};
+    EXPECT_NE(message(o).find("absorption_nodes must hold 2 to 32 nodes (got 1)"), std::string::npos) << message(o);
+    o.absorption_nodes = {0.5f, 0.5f};
+    EXPECT_NE(message(o).find("absorption_nodes[1]"), std::string::npos) << message(o);
+    o.absorption_nodes = {-1.0f, 0.5f};
+    EXPECT_NE(message(o).find("absorption_nodes[0]"), std::string::npos) << message(o);
+    o.absorption_nodes = {0.5f, 1.0f};
+    o.f = false;
+    EXPECT_NE(message(o).find("needs the f part"), std::string::npos) << message(o);
+    BakeOptions b;
+    b.huang_absorption = true;
+    b.huang_f = false;
+    const Status status = b.validate();
+    ASSERT_TRUE(status.has_value());
+    EXPECT_NE(status->message.find("huang_absorption needs huang_f"), std::string::npos) << status->message;
 }
 
 // bake_tables on a Huang fiber: its Huang table set at BakeOptions::huang's resolution, the
