@@ -655,17 +655,20 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         bakes = []
 
         def bake_later(index, material, fiber, _status):
+            absorption = material.hair.varies_absorption
             cached = tables.cached_tables(
                 library, fiber, need_multiple=settings.integrator == "DUAL_SCATTERING",
-                refinement=settings.huang_f_refinement)
+                refinement=settings.huang_f_refinement, absorption=absorption)
             if cached is not None:
                 return cached
             bakes.append((index, material.hair.as_dict(),
                           tables.bake_options(library, n_h=int(settings.n_h),
                                               threads=settings.threads,
                                               multiple=settings.integrator == "DUAL_SCATTERING",
-                                              refinement=settings.huang_f_refinement),
-                          tables.fiber_cache_path(fiber, settings.huang_f_refinement)))
+                                              refinement=settings.huang_f_refinement,
+                                              absorption=absorption),
+                          tables.fiber_cache_path(fiber, settings.huang_f_refinement,
+                                                  absorption)))
             return None
 
         found = self._resolve_tables(library, data, settings, bake_later)
@@ -716,7 +719,8 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                         status = tables.check_material(
                             library, material.source, fiber,
                             need_multiple=settings.integrator == "DUAL_SCATTERING",
-                            refinement=settings.huang_f_refinement)
+                            refinement=settings.huang_f_refinement,
+                            absorption=material.hair.varies_absorption)
                     else:
                         status = tables.TableStatus("MISSING", "material %r has no sampling "
                                                     "tables" % material.name)
@@ -752,9 +756,11 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         return found
 
     def _auto_bake(self, library, material, fiber, settings, status):
+        absorption = material.hair.varies_absorption
         cached = tables.cached_tables(library, fiber,
                                       need_multiple=settings.integrator == "DUAL_SCATTERING",
-                                      refinement=settings.huang_f_refinement)
+                                      refinement=settings.huang_f_refinement,
+                                      absorption=absorption)
         if cached is not None:
             self.report({"INFO"}, "%s: using tables auto-baked earlier in this session"
                         % status.message)
@@ -762,9 +768,10 @@ class HairisRenderEngine(bpy.types.RenderEngine):
         self.update_stats("", "Baking sampling tables for %s" % material.name)
         options = tables.bake_options(library, n_h=int(settings.n_h), threads=settings.threads,
                                       multiple=settings.integrator == "DUAL_SCATTERING",
-                                      refinement=settings.huang_f_refinement)
+                                      refinement=settings.huang_f_refinement,
+                                      absorption=absorption)
         baked = library.bake_tables(fiber, options, ProgressReporter(self))
-        tables.write_cache(baked, fiber, settings.huang_f_refinement)
+        tables.write_cache(baked, fiber, settings.huang_f_refinement, absorption)
         self.report({"INFO"}, "%s: baked them for this render (Bake Sampling Tables stores them "
                     "with the .blend)" % status.message)
         return baked

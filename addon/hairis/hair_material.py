@@ -35,6 +35,10 @@ HAIR_INPUTS = (
 """Every input of the Principled Hair BSDF node the models read, by socket identifier (the
 lobe multipliers are shown as Reflection, Transmission and Secondary Reflection)."""
 
+ABSORPTION_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption_coefficient",
+                     "random_color")
+"""Inputs that change only a strand's absorption."""
+
 HUANG_LOBES = ("reflection", "transmission", "secondary_reflection")
 
 HUANG_MATERIAL_ONLY = ("aspect_ratio",) + HUANG_LOBES
@@ -102,6 +106,17 @@ class HairParameters:
         """False for a Huang node whose three lobe multipliers are <= 0: Cycles makes no
         closure for it (the strands are black and opaque)."""
         return self.model != "HUANG" or any(getattr(self, name) > 0.0 for name in HUANG_LOBES)
+
+    @property
+    def varies_absorption(self):
+        """True for Huang hair whose absorption varies per strand (Random Color, or a linked
+        colour or melanin input): its tables then need the absorption part."""
+        if self.model != "HUANG":
+            return False
+        if any(name in self.strand_inputs for name in ABSORPTION_INPUTS):
+            return True
+        melanin = self.parametrization == PARAMETRIZATIONS["MELANIN"]
+        return "random" in self.strand_inputs and melanin and self.random_color > 0.0
 
     @property
     def oriented(self):

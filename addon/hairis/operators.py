@@ -26,6 +26,8 @@ class BakeJob:
     path: str
     stored_path: str
     blend_saved: bool
+    absorption: bool = False
+    """The material's Huang absorption varies per strand: bake the absorption part too."""
 
 
 def collect_jobs(library, material_name="", force=False, refinement=1):
@@ -57,7 +59,8 @@ def collect_jobs(library, material_name="", force=False, refinement=1):
             try:
                 with library.fiber_principled(node) as fiber:
                     status = tables.check_material(library, material, fiber,
-                                                   refinement=refinement)
+                                                   refinement=refinement,
+                                                   absorption=params.varies_absorption)
             except native.HairisError as error:
                 messages.append(("ERROR", "material %r: %s" % (material.name, error)))
                 continue
@@ -66,7 +69,7 @@ def collect_jobs(library, material_name="", force=False, refinement=1):
             if status.ok:
                 continue
         path, stored, saved = tables.output_path(material)
-        jobs.append(BakeJob(material.name, node, path, stored, saved))
+        jobs.append(BakeJob(material.name, node, path, stored, saved, params.varies_absorption))
     return jobs, messages
 
 
@@ -75,6 +78,8 @@ def run_job(library, job, options, progress=None):
 
     Returns (parameters, model, Huang f refinement or 0) of the written tables.
     """
+    if job.absorption:
+        options = dict(options, huang_absorption=1)
     with library.fiber_principled(job.node) as fiber:
         with library.bake_tables(fiber, options, progress) as baked:
             folder = os.path.dirname(job.path)

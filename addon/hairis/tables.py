@@ -69,17 +69,20 @@ def hair_materials(materials=None):
     return [m for m in materials if shader_nodes.hair_node(m) is not None]
 
 
-def bake_options(library, n_h=None, threads=0, multiple=True, refinement=1):
+def bake_options(library, n_h=None, threads=0, multiple=True, refinement=1, absorption=False):
     """The default bake options, holding ``N_H_CHOICES`` (and ``n_h``) and ``threads``.
 
     ``multiple``: also bake a Huang fiber's multiple-scattering part, which only Dual
     Scattering reads and which costs several times the rest of the bake. ``refinement``: the
-    Huang f part's quadrature refinement (Huang Bake)."""
+    Huang f part's quadrature refinement (Huang Bake). ``absorption``: also bake the Huang
+    absorption part, which shades strands of their own colour without Cycles' noise."""
     options = library.bake_options_defaults()
     if "huang_multiple" in options:  # a library that bakes Huang tables
         options["huang_multiple"] = 1 if multiple else 0
     if "huang_f_refinement" in options:
         options["huang_f_refinement"] = int(refinement)
+    if "huang_absorption" in options:
+        options["huang_absorption"] = 1 if absorption else 0
     values = {int(v) for v in options["n_h"].split(",")} | set(N_H_CHOICES)
     if n_h is not None:
         values.add(int(n_h))
@@ -111,12 +114,14 @@ def image_tables(library, image):
     return library.load_tables_file(path)
 
 
-def check_material(library, material, fiber, need_multiple=False, refinement=1):
+def check_material(library, material, fiber, need_multiple=False, refinement=1,
+                   absorption=False):
     """Full check (load, validate, match ``fiber``) of a material's tables: a TableStatus.
 
     ``need_multiple``: the tables must hold multiple-scattering tables (Dual Scattering), which
     Huang tables baked before Dual Scattering covered Huang lack. ``refinement``: the Huang f
-    part's quadrature refinement the scene asks for (Huang Bake).
+    part's quadrature refinement the scene asks for (Huang Bake). ``absorption``: the tables
+    must hold the Huang absorption part (HairParameters.varies_absorption).
     """
     image = material.hairis.table_image
     if image is None:
@@ -140,6 +145,11 @@ def check_material(library, material, fiber, need_multiple=False, refinement=1):
         tables.close()
         return TableStatus("STALE", "material %r: its Huang tables' f was baked at another "
                            "Huang Bake than the scene's; bake them again" % material.name)
+    if absorption and tables.info.get("huang_absorption") != "1":
+        tables.close()
+        return TableStatus("STALE", "material %r: its Huang tables have no absorption part, "
+                           "which shades strands of their own colour without Cycles' noise; "
+                           "bake them again" % material.name)
     if need_multiple and not tables.n_h_values:
         tables.close()
         return TableStatus("STALE", "material %r: its tables have no multiple-scattering part, "
@@ -223,25 +233,28 @@ def store_image(material, path, stored_path, pack, parameters, model, refinement
     return image
 
 
-def cache_path(parameters, refinement=1):
+def cache_path(parameters, refinement=1, absorption=False):
     """The per-session cache file for tables auto-baked during a render (one per Huang f
-    refinement)."""
+    refinement, and apart for tables with the absorption part)."""
     folder = bpy.app.tempdir or tempfile.gettempdir()
     key = parameters if refinement == 1 else "%s;huang_f_refinement=%d" % (parameters, refinement)
+    if absorption:
+        key += ";huang_absorption=1"
     digest = hashlib.sha1(key.encode("utf-8")).hexdigest()[:16]
     return os.path.join(folder, "hairis_autobake_%s.exr" % digest)
 
 
-def fiber_cache_path(fiber, refinement=1):
-    """``cache_path`` of ``fiber``'s tables: Huang Bake changes only Huang tables, so other
-    models keep one cache file whatever the setting."""
-    return cache_path(fiber.parameters, refinement if fiber.model == "huang2022" else 1)
+def fiber_cache_path(fiber, refinement=1, absorption=False):
+    """``cache_path`` of ``fiber``'s tables: Huang Bake and the absorption part change only
+    Huang tables, so other models keep one cache file whatever the setting."""
+    huang = fiber.model == "huang2022"
+    return cache_path(fiber.parameters, refinement if huang else 1, absorption and huang)
 
 
-def cached_tables(library, fiber, need_multiple=False, refinement=1):
+def cached_tables(library, fiber, need_multiple=False, refinement=1, absorption=False):
     """Tables from the auto-bake cache when present and matching ``fiber`` (and holding
     multiple-scattering tables if ``need_multiple``), else None."""
-    path = fiber_cache_path(fiber, refinement)
+    path = fiber_cache_path(fiber, refinement, absorption)
     if not os.path.isfile(path):
         return None
     try:
@@ -254,9 +267,9 @@ def cached_tables(library, fiber, need_multiple=False, refinement=1):
     return None
 
 
-def write_cache(tables, fiber, refinement=1):
+def write_cache(tables, fiber, refinement=1, absorption=False):
     """Writes auto-baked tables to the cache; returns the path, or None if writing failed."""
-    path = fiber_cache_path(fiber, refinement)
+    path = fiber_cache_path(fiber, refinement, absorption)
     try:
         tables.write(path)
     except native.HairisError:

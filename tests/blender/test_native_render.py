@@ -429,6 +429,64 @@ def test_huang_tables_without_their_f_are_stale():
         assert tables.fiber_cache_path(fiber, 2) == tables.fiber_cache_path(fiber)
 
 
+def test_huang_random_color_bakes_the_absorption_part():
+    """Blender 4.0+: Huang hair with Random Color needs tables with the absorption part (which
+    shades each strand's colour without Cycles' noise): the Bake operator's job and auto-bake
+    ask for it, tables without it are stale for that material only, and its auto-bake cache
+    file is its own."""
+    helpers.skip_without_huang()
+    material = bpy.data.materials["Hair"]
+    node = next(n for n in material.node_tree.nodes
+                if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
+    saved_state = (node.model, node.parametrization, node.inputs["Random Color"].default_value)
+    saved = material.hairis.table_image
+    saved_record = (material.hairis.baked_parameters, material.hairis.baked_model)
+    lib = library()
+    small = {"huang_theta_o": 4, "huang_phi_o": 2, "huang_theta_i": 8, "huang_phi": 8,
+             "huang_multiple": 0}
+    try:
+        node.model = "HUANG"
+        node.parametrization = "MELANIN"
+        node.inputs["Random Color"].default_value = 0.0
+        assert not tables.material_parameters(material).varies_absorption
+        node.inputs["Random Color"].default_value = 0.5
+        params = tables.material_parameters(material)
+        assert params.varies_absorption
+        material.hairis.table_image = None  # store_image below then leaves the saved image be
+        states = {}
+        with lib.fiber_principled(tables.principled_struct(lib, params)) as fiber:
+            for absorption in (False, True):
+                path = os.path.join(ARGS.workdir, "huang_absorption%d.exr" % absorption)
+                job = operators.BakeJob(material.name, tables.principled_struct(lib, params),
+                                        path, path, True, absorption)
+                parameters, model, refinement = operators.run_job(lib, job, dict(small))
+                tables.store_image(material, path, path, False, parameters, model, refinement)
+                for needed in (False, True):
+                    status = tables.check_material(lib, material, fiber, absorption=needed)
+                    states[(absorption, needed)] = (status.state, status.message)
+                    if status.tables is not None:
+                        assert status.tables.info["huang_absorption"] == str(int(absorption))
+                        status.tables.close()
+            cache = tables.fiber_cache_path(fiber, 1, True)
+            assert cache != tables.fiber_cache_path(fiber), cache
+        assert states[(False, False)][0] == "OK", states
+        assert states[(False, True)][0] == "STALE", states
+        assert "absorption part" in states[(False, True)][1], states
+        assert states[(True, False)][0] == "OK" and states[(True, True)][0] == "OK", states
+        assert tables.bake_options(lib, absorption=True)["huang_absorption"] == 1
+        assert tables.bake_options(lib)["huang_absorption"] == 0
+    finally:
+        node.model, node.parametrization, node.inputs["Random Color"].default_value = saved_state
+        material.hairis.table_image = saved
+        material.hairis.baked_parameters, material.hairis.baked_model = saved_record
+        material.hairis.baked_huang_f_refinement = 0
+    # Chiang strands take their colour exactly: no absorption part, one cache file.
+    params = tables.material_parameters(material)
+    assert not params.varies_absorption
+    with lib.fiber_principled(tables.principled_struct(lib, params)) as fiber:
+        assert tables.fiber_cache_path(fiber, 1, True) == tables.fiber_cache_path(fiber)
+
+
 TESTS = [
     test_library_loads,
     test_bake_operator,
@@ -440,6 +498,7 @@ TESTS = [
     test_cancel_within_one_second,
     test_packed_tables_render_without_their_file,
     test_huang_tables_without_their_f_are_stale,
+    test_huang_random_color_bakes_the_absorption_part,
 ]
 if helpers.VERSION >= (5, 0, 0):
     # 5.0 shades hair with 4.5's closures: the two slowest library-level checks run once per
