@@ -79,12 +79,12 @@ bool visible(Vec3d p, Vec3d m, Vec3d h) { return dot(p, h) > 0.0 && dot(p, m) > 
 double fresnel(double c, double eta) { return fresnel_dielectric(std::fabs(c), eta); }
 
 // TRRT+'s geometric series of §6.2: T R² T̄ A³ / (1 − A(1 − T̄)), T̄ = max(1 − R, 1e-5).
-Colour residual_series(double t, double r, const Colour &a) {
+double residual_term(double t, double r, double a) {
     const double t_avg = std::max(1.0 - r, 1e-5);
-    Colour out;
-    for (int c = 0; c < 3; ++c)
-        out[c] = t * r * r * t_avg * a[c] * a[c] * a[c] / (1.0 - a[c] * (1.0 - t_avg));
-    return out;
+    return t * r * r * t_avg * a * a * a / (1.0 - a * (1.0 - t_avg));
+}
+Colour residual_series(double t, double r, const Colour &a) {
+    return {residual_term(t, r, a[0]), residual_term(t, r, a[1]), residual_term(t, r, a[2])};
 }
 
 }  // namespace
@@ -492,8 +492,14 @@ huang::View HuangFiber::make_view(const HuangHit &hit, int simpson_refinement) c
     return p;
 }
 
-HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrature &q) const {
+HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrature &q,
+                                         const std::vector<double> &absorptions) const {
     HuangExpectation out(*this);
+    out.absorptions_ = absorptions;
+    const std::size_t n_extra = absorptions.size();
+    out.tir_only_.count = n_extra;
+    out.trrt_always_extra_.assign(n_extra, 0.0);
+    std::vector<double> at_extra(n_extra), trrt_extra(n_extra);
     out.view_ = make_view(hit, q.simpson_refinement);
     const huang::View &p = out.view_;
     if (p.empty || p.res_intervals == 0) return out;
@@ -517,6 +523,7 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
             path.coefficient = base * m_tt_ * c.ellipse.arc(e.gamma2) * e.t1 * e.s1 * e.s2 * e.g1o * e.cos_m1 / e.cos_o1;
             path.colour = e.at;
             out.tt_.push_back(path);
+            for (std::size_t a = 0; a < n_extra; ++a) out.tt_extra_.push_back(std::exp(absorptions[a] / e.ct * e.path));
         };
         const int tt_order = q.tt_order > 0 ? q.tt_order : q.first_order;
         if (m_tt_ > 0.0 && tt_order != q.first_order)
@@ -547,11 +554,16 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
                 const double weight = base * second.weight;
                 Colour trrt = residual_series(e.t1, b.r2, e.at);
                 for (double &x : trrt) x *= weight;
+                for (std::size_t a = 0; a < n_extra; ++a) {
+                    at_extra[a] = std::exp(absorptions[a] / e.ct * e.path);
+                    trrt_extra[a] = weight * residual_term(e.t1, b.r2, at_extra[a]);
+                }
                 if (!b.vis) {
-                    out.tir_only_.push_back(-b.wtr, trrt);
+                    out.tir_only_.push_back(-b.wtr, trrt, trrt_extra.data());
                     continue;
                 }
                 for (int i = 0; i < 3; ++i) out.trrt_always_[i] += trrt[i];
+                for (std::size_t a = 0; a < n_extra; ++a) out.trrt_always_extra_[a] += trrt_extra[a];
                 // trt_exit is 0 for every ω_i unless w_tr faces both exit normals.
                 if (!(b.cos_m3 > 0.0) || !(dot(b.wtr, b.m3) > 0.0)) continue;
                 HuangExpectation::TrtPath path;
@@ -563,6 +575,8 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
                                    e.s2 * e.g1o * b.g2o * e.cos_m1 * e.cos_m2 / (e.cos_o1 * b.cos_mo2) * b.s3;
                 for (int i = 0; i < 3; ++i) path.colour[i] = e.at[i] * b.atr[i];
                 out.trt_.push_back(path);
+                for (std::size_t a = 0; a < n_extra; ++a)
+                    out.trt_extra_.push_back(at_extra[a] * std::exp(-absorptions[a] / b.ct * b.path));
             }
         }
     }
@@ -591,8 +605,20 @@ Rgb HuangFiber::f_cos(Vec3 wi, Vec3 wo) const { return expectation({wo, 0.0f, 1.
 // ---------------------------------------------------------------------------------------
 // HuangExpectation
 
-std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
+std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi, double *rest) const {
     std::array<Rgb, 4> out{};
+    const std::size_t n_extra = rest ? absorptions_.size() : 0;
+    // Sums per extra absorption: TT, TRT and TRRT+ (each n_extra).
+    double extra_sums[3 * 32];
+    std::vector<double> extra_heap;
+    double *extra = extra_sums;
+    if (n_extra > 32) {
+        extra_heap.assign(3 * n_extra, 0.0);
+        extra = extra_heap.data();
+    }
+    std::fill(extra, extra + 3 * n_extra, 0.0);
+    double *tt_e = extra, *trt_e = extra + n_extra, *trrt_e = extra + 2 * n_extra;
+    if (rest) std::fill(rest, rest + absorptions_.size(), 0.0);
     const huang::View &p = view_;
     if (p.empty) return out;
     const HuangFiber &fiber = *fiber_;
@@ -605,10 +631,13 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
     const double inv_eta2 = 1.0 / (c.eta * c.eta);
     Colour tt{}, trt{}, trrt = trrt_always_;
     const ExitTerms exits{c.alpha, c.alpha * c.alpha, 1.0 / c.eta};
-    for (const TtPath &path : tt_) {
+    for (std::size_t j = 0; j < tt_.size(); ++j) {
+        const TtPath &path = tt_[j];
         const double x = path.coefficient * exits.tt(path.wt, path.n2, path.lambda2, l);
         if (!std::isfinite(x)) continue;
         for (int k = 0; k < 3; ++k) tt[k] += x * path.colour[k];
+        const double *colour = tt_extra_.data() + j * n_extra;
+        for (std::size_t k = 0; k < n_extra; ++k) tt_e[k] += x * colour[k];
     }
     // A TRT exit below cos_min from −w_tr is totally reflected (exit_tir).
     const double cos_min = 1.0 / c.eta - kTirSlack;
@@ -622,10 +651,13 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
             const double x = path.coefficient * exits.trt(path.wtr, path.n3, path.m3, path.lambda3, l);
             if (!std::isfinite(x)) continue;
             for (int k = 0; k < 3; ++k) trt[k] += x * path.colour[k];
+            const double *colour = trt_extra_.data() + std::size_t(j) * n_extra;
+            for (std::size_t k = 0; k < n_extra; ++k) trt_e[k] += x * colour[k];
         }
     }
-    const std::array<double, 3> reflecting = tir_only_.sum_reflecting(l, cos_min);
+    const std::array<double, 3> reflecting = tir_only_.sum_reflecting(l, cos_min, n_extra ? trrt_e : nullptr);
     for (int k = 0; k < 3; ++k) trrt[k] += reflecting[k];
+    for (std::size_t k = 0; k < n_extra; ++k) trrt_e[k] += trrt_always_extra_[k];
     const double m = chiang::longitudinal_scattering(p.v.y, cos_theta(p.v), l.y, cos_theta(l), 4.0 * c.alpha);
     const double trrt_factor = m * kInvTwoPi * (2.0 / kPi);
     // A chain that leaves at the edge of total internal reflection can come out a rounding
@@ -635,13 +667,18 @@ std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi) const {
         trt[k] = std::max(0.0, trt[k] * factor * inv_eta2);
         trrt[k] = std::max(0.0, trrt[k] * factor * trrt_factor);
     }
+    for (std::size_t k = 0; k < n_extra; ++k)
+        rest[k] = std::max(0.0, tt_e[k] * factor * inv_eta2) + std::max(0.0, trt_e[k] * factor * inv_eta2) +
+                  std::max(0.0, trrt_e[k] * factor * trrt_factor);
     out[1] = rgb_of(tt);
     out[2] = rgb_of(trt);
     out[3] = rgb_of(trrt);
     return out;
 }
 
-void HuangExpectation::TirPaths::push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt) {
+void HuangExpectation::TirPaths::push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt,
+                                           const double *trrt_extra) {
+    extra.insert(extra.end(), trrt_extra, trrt_extra + count);
     x.push_back(minus_wtr.x);
     y.push_back(minus_wtr.y);
     z.push_back(minus_wtr.z);
@@ -660,17 +697,24 @@ void HuangExpectation::TirPaths::group() {
         column.swap(out);
     };
     for (std::vector<double> *column : {&x, &y, &z, &r, &g, &b}) permute(*column);
+    std::vector<double> ordered(extra.size());
+    for (std::size_t k = 0; k < x.size(); ++k)
+        std::copy_n(extra.begin() + std::ptrdiff_t(cones.order()[k] * count), count, ordered.begin() + std::ptrdiff_t(k * count));
+    extra.swap(ordered);
     cone_sums.assign(cones.cones().size(), {0.0, 0.0, 0.0});
+    cone_extra.assign(cones.cones().size() * count, 0.0);
     for (std::size_t c = 0; c < cone_sums.size(); ++c)
         for (std::uint32_t k = cones.cones()[c].begin; k < cones.cones()[c].end; ++k) {
             cone_sums[c][0] += r[k];
             cone_sums[c][1] += g[k];
             cone_sums[c][2] += b[k];
+            for (std::size_t e = 0; e < count; ++e) cone_extra[c * count + e] += extra[k * count + e];
         }
 }
 
-std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double cos_min) const {
+std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double cos_min, double *sums) const {
     double sr = 0.0, sg = 0.0, sb = 0.0;
+    const std::size_t n = sums ? count : 0;
     const DirectionCones::Threshold threshold(l, cos_min);
     for (std::size_t c = 0; c < cone_sums.size(); ++c) {
         const DirectionCones::Cone &cone = cones.cones()[c];
@@ -679,6 +723,7 @@ std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double
             sr += cone_sums[c][0];
             sg += cone_sums[c][1];
             sb += cone_sums[c][2];
+            for (std::size_t e = 0; e < n; ++e) sums[e] += cone_extra[c * count + e];
             break;
         case DirectionCones::Side::AtOrAbove:
             break;
@@ -688,6 +733,7 @@ std::array<double, 3> HuangExpectation::TirPaths::sum_reflecting(Vec3d l, double
                 sr += keep * r[k];
                 sg += keep * g[k];
                 sb += keep * b[k];
+                for (std::size_t e = 0; e < n; ++e) sums[e] += keep * extra[k * count + e];
             }
             break;
         }
@@ -702,6 +748,11 @@ void HuangExpectation::group_paths() {
     std::vector<TrtPath> ordered(trt_.size());
     for (std::size_t k = 0; k < ordered.size(); ++k) ordered[k] = trt_[trt_cones_.order()[k]];
     trt_.swap(ordered);
+    const std::size_t n = absorptions_.size();
+    std::vector<double> extra(trt_extra_.size());
+    for (std::size_t k = 0; k < trt_.size(); ++k)
+        std::copy_n(trt_extra_.begin() + std::ptrdiff_t(trt_cones_.order()[k] * n), n, extra.begin() + std::ptrdiff_t(k * n));
+    trt_extra_.swap(extra);
     tir_only_.group();
 }
 

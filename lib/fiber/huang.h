@@ -130,8 +130,12 @@ class HuangExpectation {
   public:
     /// f·|cos θ_i| (ω_i in Huang's frame), all lobes.
     Rgb f(Vec3 wi) const;
-    /// R, TT, TRT, TRRT+.
-    std::array<Rgb, 4> lobes(Vec3 wi) const;
+    /// R, TT, TRT, TRRT+. With `rest` (an expectation built with absorptions, HuangFiber::
+    /// expectation): rest[k] = TT + TRT + TRRT+ of one channel of the fiber with absorption
+    /// absorptions[k] instead of its own, from the same chains.
+    std::array<Rgb, 4> lobes(Vec3 wi, double *rest = nullptr) const;
+    /// The absorptions `rest` is computed at.
+    const std::vector<double> &absorptions() const { return absorptions_; }
     const huang::View &view() const { return view_; }
     /// Precomputed paths (TT exits, TRT exits, TRRT+ terms counted only under total internal
     /// reflection), for cost studies.
@@ -161,12 +165,16 @@ class HuangExpectation {
     struct TirPaths {
         std::vector<double> x, y, z;  ///< −w_tr
         std::vector<double> r, g, b;  ///< the TRRT+ term
+        std::vector<double> extra;    ///< the term at each extra absorption (`count` per term)
+        std::size_t count = 0;
         DirectionCones cones;
         std::vector<std::array<double, 3>> cone_sums;
-        void push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt);
+        std::vector<double> cone_extra;  ///< `count` per cone
+        void push_back(Vec3d minus_wtr, const std::array<double, 3> &trrt, const double *trrt_extra);
         void group();
-        /// Σ of the terms whose exit towards l is totally reflecting (dot(−w_tr, l) < cos_min).
-        std::array<double, 3> sum_reflecting(Vec3d l, double cos_min) const;
+        /// Σ of the terms whose exit towards l is totally reflecting (dot(−w_tr, l) < cos_min);
+        /// with `extra`, their extra terms' sums too (added to extra[0..count)).
+        std::array<double, 3> sum_reflecting(Vec3d l, double cos_min, double *extra = nullptr) const;
     };
     /// Orders the TRT paths by cone of −w_tr and groups the TRRT+ terms; called once built.
     void group_paths();
@@ -179,6 +187,9 @@ class HuangExpectation {
     DirectionCones trt_cones_;  ///< of −w_tr, over trt_ as ordered
     TirPaths tir_only_;
     std::array<double, 3> trrt_always_{};
+    // Extra absorptions: the colour of each TT and TRT path and the TRRT+ sums at each of
+    // them (absorptions_.size() per path, in the paths' order).
+    std::vector<double> absorptions_, tt_extra_, trt_extra_, trrt_always_extra_;
 };
 
 /// The Huang fiber at one renderer hit. f is an unbiased estimate of HuangExpectation's f
@@ -274,8 +285,11 @@ class HuangFiber final : public FiberModel, public ShadingModel {
         return scratch.make<HuangPoint>(*this, hit);
     }
     HuangPoint at(const FiberHit &hit) const { return HuangPoint(*this, hit); }
-    /// The expectation of Cycles' eval at a hit in Huang's frame.
-    HuangExpectation expectation(const HuangHit &hit, const HuangQuadrature &quadrature = {}) const;
+    /// The expectation of Cycles' eval at a hit in Huang's frame; with `absorptions`, also the
+    /// colour of every chain at each of them (HuangExpectation::lobes' `rest`): the chains do
+    /// not depend on the absorption, so one build serves fibers of any absorption.
+    HuangExpectation expectation(const HuangHit &hit, const HuangQuadrature &quadrature = {},
+                                 const std::vector<double> &absorptions = {}) const;
     /// Cycles' set-up of §2 and §6 steps 1–5 for a hit in Huang's frame.
     huang::View make_view(const HuangHit &hit, int simpson_refinement = 1) const;
 

@@ -36,23 +36,7 @@ struct NodeView {
     std::optional<HuangExpectation> expectation;
     std::optional<HuangPoint> point;  // Huang's frame = this point's frame (normal on y)
     std::optional<HuangExpectation> f;  // the f part's (HuangBakeOptions::f)
-    std::vector<HuangExpectation> absorption;  // one per fiber of three absorption nodes
 };
-
-// The fibers the absorption part is evaluated from: `fiber` with its absorption replaced by
-// three nodes at a time (the last fiber repeats the last node where fewer are left).
-Expected<std::vector<HuangFiber>> absorption_fibers(const HuangFiber &fiber, const std::vector<float> &nodes) {
-    std::vector<HuangFiber> fibers;
-    for (std::size_t k = 0; k < nodes.size(); k += 3) {
-        HuangParams p = fiber.params();
-        const float last = nodes.back();
-        p.sigma_a = {nodes[k], k + 1 < nodes.size() ? nodes[k + 1] : last, k + 2 < nodes.size() ? nodes[k + 2] : last};
-        Expected<HuangFiber> f = HuangFiber::create(p);
-        if (!f) return Error{"the absorption part's fiber: " + f.error().message};
-        fibers.push_back(std::move(f).value());
-    }
-    return fibers;
-}
 
 }  // namespace
 
@@ -135,10 +119,9 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
         t.f.assign(3 * t.values.size(), 0.0f);
         t.f_refinement = o.f_refinement;
     }
-    Expected<std::vector<HuangFiber>> absorption_fibers_or = absorption_fibers(fiber, o.absorption_nodes);
-    if (!absorption_fibers_or) return absorption_fibers_or.error();
-    const std::vector<HuangFiber> &absorption = absorption_fibers_or.value();
-    const std::size_t n_k = o.absorption_nodes.size();
+    // The absorption part's values come from the f part's chains, coloured at each node.
+    const std::vector<double> absorptions(o.absorption_nodes.begin(), o.absorption_nodes.end());
+    const std::size_t n_k = absorptions.size();
     if (n_k > 0) {
         t.absorption_nodes = o.absorption_nodes;
         t.absorption.assign(n_k * t.values.size(), 0.0f);
@@ -155,9 +138,7 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
         tbb::parallel_for(0, n_q, [&](int q) {
             const Vec3 wo = direction_of(theta_o, t.phi_o_nodes[std::size_t(q)]);
             NodeView &v = views[std::size_t(q)];
-            if (o.f) v.f.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule));
-            v.absorption.clear();
-            for (const HuangFiber &a : absorption) v.absorption.push_back(a.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule));
+            if (o.f) v.f.emplace(fiber.expectation(HuangHit{wo, 0.0f, 1.0f}, f_rule, absorptions));
             if (shared_rule) {
                 v.expectation.reset();
             } else if (expectation) {
@@ -182,7 +163,9 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
                     // The cell's midpoint in sin θ_i and φ (the p = 1 point).
                     const double theta_i = std::asin(std::clamp(0.5 * (s0 + s1), -1.0, 1.0));
                     const double phi = -kPi + kTwoPi * (j + 0.5) / n_j;
-                    const std::array<Rgb, 4> lobes = v.f->lobes(direction_of(float(theta_i), float(phi_o + phi)));
+                    double rest_at[kMaxHuangAbsorptionNodes];
+                    const std::array<Rgb, 4> lobes =
+                        v.f->lobes(direction_of(float(theta_i), float(phi_o + phi)), n_k ? rest_at : nullptr);
                     const Rgb rest = lobes[1] + lobes[2] + lobes[3];
                     float *out = &t.f[3 * (first + std::size_t(j))];
                     out[0] = rest.r;
@@ -192,16 +175,10 @@ Expected<HuangTableSet> bake_in_arena(const HuangFiber &fiber, const HuangBakeOp
                           rest.g >= 0.0f && rest.b >= 0.0f))
                         bad = true;
                     if (shared_rule) sum = luminance(lobes[0] + rest);
-                    // The absorption part: channel c of fiber g is node 3g + c.
-                    float *nodes_out = n_k ? &t.absorption[n_k * (first + std::size_t(j))] : nullptr;
-                    for (std::size_t g = 0; g < v.absorption.size(); ++g) {
-                        const std::array<Rgb, 4> a = v.absorption[g].lobes(direction_of(float(theta_i), float(phi_o + phi)));
-                        const Rgb a_rest = a[1] + a[2] + a[3];
-                        const float channels[3] = {a_rest.r, a_rest.g, a_rest.b};
-                        for (std::size_t c = 0; c < 3 && 3 * g + c < n_k; ++c) {
-                            nodes_out[3 * g + c] = channels[c];
-                            if (!(std::isfinite(channels[c]) && channels[c] >= 0.0f)) bad = true;
-                        }
+                    for (std::size_t k = 0; k < n_k; ++k) {
+                        const float value = float(rest_at[k]);
+                        t.absorption[n_k * (first + std::size_t(j)) + k] = value;
+                        if (!(std::isfinite(value) && value >= 0.0f)) bad = true;
                     }
                 }
                 for (int a = 0; a < (shared_rule ? 0 : p); ++a) {
