@@ -198,6 +198,18 @@ TableSet huang_set(bool multiple) {
     return t;
 }
 
+// huang_set with an f part (rows 24..47) and an absorption part of 5 nodes (rows 48..95, the
+// last block padded), with the multiple part after them when `multiple`.
+TableSet huang_absorption_set(bool multiple) {
+    TableSet t = huang_set(multiple);
+    auto h = std::make_shared<HuangTableSet>(*t.huang);
+    for (std::size_t n = 0; n < 3 * h->values.size(); ++n) h->f.push_back(0.01f * float(n % 17));
+    h->absorption_nodes = {0.015625f, 0.2f, 1.0f, 4.0f, 12.0f};
+    for (std::size_t n = 0; n < 5 * h->values.size(); ++n) h->absorption.push_back(0.5f / float(1 + n % 5));
+    t.huang = std::move(h);
+    return t;
+}
+
 struct Chiang {
     std::shared_ptr<const ChiangFiber> fiber;
     std::vector<std::pair<std::string, double>> parameters;
@@ -449,6 +461,15 @@ int main(int argc, char **argv) {
     add("huang_multiple_n_h_missing.exr", tamper(huang_multiple_file, [](Image &i) { i.spec.erase_attribute("hairis:n_h_values"); }));
     add("huang_parts_without_multiple.exr", with_attribute(huang_multiple_file, "hairis:parts", "huang"));
     add("huang_parts_multiple_missing.exr", with_attribute(huang_file, "hairis:parts", "huang,multiple"));
+
+    // ---- Huang files with the f and absorption parts ----
+    const Bytes absorption_file = encode(huang_absorption_set(false));
+    add("huang_absorption_5_nodes.exr", absorption_file);
+    add("huang_absorption_multiple.exr", encode(huang_absorption_set(true)));
+    add("huang_absorption_padding_nonzero.exr", tamper(absorption_file, [](Image &i) { i.at(2, 90, 3) = 0.5f; }));
+    add("huang_absorption_nodes_absurd.exr",
+        with_attribute(absorption_file, "hairis:huang_absorption", "row=48;nodes=1e30,2e30"));
+    add("huang_absorption_parts_without_f.exr", with_attribute(absorption_file, "hairis:parts", "huang,absorption"));
 
     return hairis::fuzz::write_seeds(folder, seeds);
 }

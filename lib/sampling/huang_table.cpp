@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/frame.h"
+#include "core/options.h"
 #include "sampling/huang_absorption_table.h"
 #include "sampling/huang_f_table.h"
 #include "sampling/table_set.h"
@@ -246,7 +247,7 @@ Status HuangTableSet::validate() const {
     for (int a = 0; a < k; ++a) {
         const float node = absorption_nodes[std::size_t(a)];
         if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > absorption_nodes[std::size_t(a - 1)])))
-            return Error{"the Huang table's absorption node " + std::to_string(a) + " (" + std::to_string(node) +
+            return Error{"the Huang table's absorption node " + std::to_string(a) + " (" + format_number(node) +
                          ") must be in (0, " + std::to_string(int(kMaxHuangAbsorption)) +
                          "] and greater than the one before"};
     }
@@ -259,7 +260,7 @@ Status HuangTableSet::validate() const {
         if (!(std::isfinite(absorption[n]) && absorption[n] >= 0.0f))
             return Error{"the Huang table's absorption part: entry " + std::to_string(n) + " (cell " +
                          std::to_string(n / std::size_t(k)) + ", node " + std::to_string(n % std::size_t(k)) +
-                         ") must be finite and >= 0 (got " + std::to_string(absorption[n]) + ")"};
+                         ") must be finite and >= 0 (got " + format_number(absorption[n]) + ")"};
     return std::nullopt;
 }
 
