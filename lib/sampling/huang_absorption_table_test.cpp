@@ -102,8 +102,16 @@ TEST(HuangAbsorptionTable, AtItsNodesAndPointsItIsTheExpectationOfThatAbsorption
 // default nodes against the expectation of fibers of random absorption. The error is measured
 // against each direction's whole f (R included), the quantity a render sees. Reading G, or
 // log G, linearly between the same nodes fails both bounds.
-TEST(HuangAbsorptionTable, BetweenNodesTheErrorStaysWithinItsBudget) {
-    const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});
+struct BudgetCase {
+    float aspect, roughness;
+    double l1, worst;  // the bounds
+};
+
+class HuangAbsorptionBudget : public ::testing::TestWithParam<BudgetCase> {};
+
+TEST_P(HuangAbsorptionBudget, BetweenNodesTheErrorStaysWithinItsBudget) {
+    const BudgetCase k = GetParam();
+    const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f}, k.aspect, k.roughness);
     const HuangBakeOptions o = options(huang_absorption_nodes());
     const Baked b = bake(fiber, o);
     std::mt19937 rng(11);
@@ -114,7 +122,7 @@ TEST(HuangAbsorptionTable, BetweenNodesTheErrorStaysWithinItsBudget) {
         std::array<float, 3> sigma;
         for (float &s : sigma)
             s = float(std::exp(std::log(1.0 / 64 + 0.25) + u(rng) * (std::log(8.25) - std::log(1.0 / 64 + 0.25))) - 0.25);
-        const HuangFiber strand = fiber_of(sigma);
+        const HuangFiber strand = fiber_of(sigma, k.aspect, k.roughness);
         for (int q : {0, 1})
             for (int r : {1, 2}) {
                 const Vec3 wo = direction_of(b.set.theta_o_nodes[size_t(r)], b.set.phi_o_nodes[size_t(q)]);
@@ -134,11 +142,16 @@ TEST(HuangAbsorptionTable, BetweenNodesTheErrorStaysWithinItsBudget) {
                     }
             }
     }
-    std::printf("absorption part between nodes: L1 %.5f of f, largest %.4f of a direction's f\n", abs_sum / ref_sum,
-                worst);
-    EXPECT_LT(abs_sum / ref_sum, 1e-3);
-    EXPECT_LT(worst, 0.02);
+    std::printf("absorption part between nodes (aspect %.2f, roughness %.2f): L1 %.5f of f, largest %.4f of a "
+                "direction's f\n",
+                k.aspect, k.roughness, abs_sum / ref_sum, worst);
+    EXPECT_LT(abs_sum / ref_sum, k.l1);
+    EXPECT_LT(worst, k.worst);
 }
+
+INSTANTIATE_TEST_SUITE_P(Fibers, HuangAbsorptionBudget,
+                         ::testing::Values(BudgetCase{0.5f, 0.3f, 1e-3, 0.02}, BudgetCase{1.0f, 0.1f, 1e-3, 0.01},
+                                           BudgetCase{0.85f, 0.8f, 1e-3, 0.03}));
 
 TEST(HuangAbsorptionTable, AStrandOfTheFibersAbsorptionDiffersByExactlyZero) {
     const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});
