@@ -220,6 +220,20 @@ std::vector<std::pair<std::string, double>> huang_parameters(const HuangParams &
             {"secondary_reflection", p.secondary_reflection}};
 }
 
+Status check_huang_absorption_nodes(const std::vector<float> &nodes, const std::string &name) {
+    const int k = int(nodes.size());
+    if (k < 2 || k > kMaxHuangAbsorptionNodes)
+        return Error{name + " must hold 2 to " + std::to_string(kMaxHuangAbsorptionNodes) + " absorption nodes (got " +
+                     std::to_string(k) + ")"};
+    for (int a = 0; a < k; ++a) {
+        const float node = nodes[std::size_t(a)];
+        if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > nodes[std::size_t(a - 1)])))
+            return Error{name + "[" + std::to_string(a) + "] (" + format_number(node) + ") must be in (0, " +
+                         std::to_string(int(kMaxHuangAbsorption)) + "] and greater than the node before"};
+    }
+    return std::nullopt;
+}
+
 Status HuangTableSet::validate() const {
     if (model != "huang2022") return Error{"a Huang table must have model \"huang2022\" (got \"" + model + "\")"};
     for (const auto &[name, value] : parameters)
@@ -240,17 +254,8 @@ Status HuangTableSet::validate() const {
         if (!absorption.empty()) return Error{"the Huang table's absorption part has values but no absorption nodes"};
         return std::nullopt;
     }
+    if (Status s = check_huang_absorption_nodes(absorption_nodes, "the Huang table's absorption_nodes")) return s;
     const int k = absorption_count();
-    if (k < 2 || k > kMaxHuangAbsorptionNodes)
-        return Error{"the Huang table's absorption part must have 2 to " + std::to_string(kMaxHuangAbsorptionNodes) +
-                     " absorption nodes (got " + std::to_string(k) + ")"};
-    for (int a = 0; a < k; ++a) {
-        const float node = absorption_nodes[std::size_t(a)];
-        if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > absorption_nodes[std::size_t(a - 1)])))
-            return Error{"the Huang table's absorption node " + std::to_string(a) + " (" + format_number(node) +
-                         ") must be in (0, " + std::to_string(int(kMaxHuangAbsorption)) +
-                         "] and greater than the one before"};
-    }
     if (f.empty()) return Error{"the Huang table's absorption part needs the f part beside it"};
     if (absorption.size() != std::size_t(k) * values.size())
         return Error{"the Huang table's absorption part must hold " + std::to_string(k) + " values per cell, " +

@@ -145,6 +145,10 @@ inline constexpr int kMaxHuangAbsorptionNodes = 32;
 /// The largest absorption node: beyond it a strand's TT, TRT and TRRT+ are far below its R.
 inline constexpr float kMaxHuangAbsorption = 1000.0f;
 
+/// What a set's and a bake's absorption nodes must be: 2 to kMaxHuangAbsorptionNodes, strictly
+/// increasing in (0, kMaxHuangAbsorption]; errors name them as `name`.
+Status check_huang_absorption_nodes(const std::vector<float> &nodes, const std::string &name);
+
 /// A baked Huang table as plain data: what a table file holds.
 struct HuangTableSet {
     std::string model = "huang2022";

@@ -285,7 +285,8 @@ TEST(HuangTable, RefusesInvalidInputByName) {
     EXPECT_NE(huge.find("at most"), std::string::npos) << huge;
 }
 
-TEST(HuangSamplingTable, RefusesAnotherModelAndKeepsTheParameters) {
+// A set of the synthetic values (no f part).
+HuangTableSet synthetic_set() {
     HuangTableSet set;
     set.parameters = huang_parameters(HuangParams{});
     set.theta_o_nodes = theta_o_nodes();
@@ -293,6 +294,11 @@ TEST(HuangSamplingTable, RefusesAnotherModelAndKeepsTheParameters) {
     set.theta_i_count = kThetaI;
     set.phi_count = kPhi;
     set.values = synthetic_values(kPhiO);
+    return set;
+}
+
+TEST(HuangSamplingTable, RefusesAnotherModelAndKeepsTheParameters) {
+    HuangTableSet set = synthetic_set();
     const Expected<HuangSamplingTable> ok = HuangSamplingTable::from(set);
     ASSERT_TRUE(ok.ok()) << ok.error().message;
     EXPECT_EQ(ok.value().parameters, canonical_parameters(huang_parameters(HuangParams{})));
@@ -311,13 +317,7 @@ TEST(HuangSamplingTable, RefusesAnotherModelAndKeepsTheParameters) {
 // The absorption part: 2 to kMaxHuangAbsorptionNodes increasing nodes in (0, kMaxHuangAbsorption],
 // K finite non-negative values per cell, only beside an f part; each refusal names what is wrong.
 TEST(HuangTableSet, ValidatesTheAbsorptionPartByName) {
-    HuangTableSet set;
-    set.parameters = huang_parameters(HuangParams{});
-    set.theta_o_nodes = theta_o_nodes();
-    set.phi_o_nodes = phi_o_nodes(kPhiO);
-    set.theta_i_count = kThetaI;
-    set.phi_count = kPhi;
-    set.values = synthetic_values(kPhiO);
+    HuangTableSet set = synthetic_set();
     set.f.assign(3 * set.values.size(), 0.5f);
     set.absorption_nodes = {0.1f, 0.5f, 2.0f};
     set.absorption.assign(3 * set.values.size(), 0.25f);
@@ -330,14 +330,14 @@ TEST(HuangTableSet, ValidatesTheAbsorptionPartByName) {
     HuangTableSet bad = set;
     bad.absorption_nodes = {0.1f};
     bad.absorption.assign(bad.values.size(), 0.25f);
-    EXPECT_NE(refusal(bad).find("2 to 32 absorption nodes (got 1)"), std::string::npos) << refusal(bad);
+    EXPECT_NE(refusal(bad).find("absorption_nodes must hold 2 to 32 absorption nodes (got 1)"), std::string::npos) << refusal(bad);
     bad = set;
     bad.absorption_nodes = {0.1f, 0.1f, 2.0f};
-    EXPECT_NE(refusal(bad).find("absorption node 1"), std::string::npos) << refusal(bad);
+    EXPECT_NE(refusal(bad).find("absorption_nodes[1] (0.100000001) must be in (0, 1000]"), std::string::npos) << refusal(bad);
     bad.absorption_nodes = {0.0f, 0.5f, 2.0f};
-    EXPECT_NE(refusal(bad).find("absorption node 0"), std::string::npos) << refusal(bad);
+    EXPECT_NE(refusal(bad).find("absorption_nodes[0]"), std::string::npos) << refusal(bad);
     bad.absorption_nodes = {0.1f, 0.5f, 2000.0f};
-    EXPECT_NE(refusal(bad).find("absorption node 2"), std::string::npos) << refusal(bad);
+    EXPECT_NE(refusal(bad).find("absorption_nodes[2] (2000)"), std::string::npos) << refusal(bad);
     bad = set;
     bad.absorption.pop_back();
     EXPECT_NE(refusal(bad).find("3 values per cell"), std::string::npos) << refusal(bad);

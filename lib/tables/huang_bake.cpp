@@ -60,16 +60,7 @@ Status HuangBakeOptions::validate() const {
                      std::to_string(finest) + "; at most 32"};
     if (!absorption_nodes.empty()) {
         if (!f) return Error{"the absorption part (absorption_nodes) needs the f part (f)"};
-        const int k = int(absorption_nodes.size());
-        if (k < 2 || k > kMaxHuangAbsorptionNodes)
-            return Error{"absorption_nodes must hold 2 to " + std::to_string(kMaxHuangAbsorptionNodes) +
-                         " nodes (got " + std::to_string(k) + ")"};
-        for (int a = 0; a < k; ++a) {
-            const float node = absorption_nodes[std::size_t(a)];
-            if (!(node > 0.0f && node <= kMaxHuangAbsorption) || (a > 0 && !(node > absorption_nodes[std::size_t(a - 1)])))
-                return Error{"absorption_nodes[" + std::to_string(a) + "] must be in (0, " +
-                             std::to_string(int(kMaxHuangAbsorption)) + "] and greater than the node before"};
-        }
+        if (Status s = check_huang_absorption_nodes(absorption_nodes, "absorption_nodes")) return s;
     }
     if (evaluator != "expectation" && evaluator != "estimate")
         return Error{"evaluator must be \"expectation\" or \"estimate\" (got \"" + evaluator + "\")"};

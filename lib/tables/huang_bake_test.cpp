@@ -227,7 +227,8 @@ TEST(HuangBake, RefusesOptionsByName) {
     // The absorption nodes a set may hold, refused before the bake, and only beside the f part.
     o = {};
     o.absorption_nodes = {0.5f};
-    EXPECT_NE(message(o).find("absorption_nodes must hold 2 to 32 nodes (got 1)"), std::string::npos) << message(o);
+    EXPECT_NE(message(o).find("absorption_nodes must hold 2 to 32 absorption nodes (got 1)"), std::string::npos)
+        << message(o);
     o.absorption_nodes = {0.5f, 0.5f};
     EXPECT_NE(message(o).find("absorption_nodes[1]"), std::string::npos) << message(o);
     o.absorption_nodes = {-1.0f, 0.5f};
