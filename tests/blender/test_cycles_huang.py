@@ -147,20 +147,27 @@ def vary_per_strand(scene):
 
 
 def test_per_strand_inputs_match_cycles():
-    """Huang hair whose Melanin (Hair Info) and roughness (Random Roughness) vary per strand:
-    Hairis (Huang Sampling: Cycles, the default) has Cycles' image means within 2%. The
-    strands' random numbers are not Cycles' own, so blocks are not compared. With the node's
-    own Melanin on every strand the red mean is about 9% lower. (Table's per-strand shading is
-    checked against independent references in huang_tabulated_fiber_test.)"""
+    """Huang hair whose Melanin (Hair Info) and roughness (Random Roughness) vary per strand,
+    rendered with the add-on's defaults (Table with Auto Bake, Huang Sampling: Cycles): the
+    melanin strands' light samples read the tables' absorption part, the rough strands take
+    their own Cycles eval. Image means within 2% of Cycles' (blocks are not asserted: see
+    docs/cycles-parity.md), and within 0.5% of the same renders with every strand's own Cycles
+    eval (no tables), which have the same seeds, so that their difference is the absorption
+    part's error plus a little eval noise. With the node's own Melanin on every strand the red
+    mean is about 9% lower."""
     scene = make_scene("CYCLES")
     vary_per_strand(scene)
     cycles, cycles_time = render_stack(scene, "CYCLES")
-    hairis, hairis_time = render_stack(scene, "HAIRIS")
-    print("render time: cycles %.1f s, hairis %.1f s" % (cycles_time, hairis_time))
-    means = [image.reshape(SEEDS, -1, 3).mean(axis=1) for image in (cycles, hairis)]
-    ratio = means[1].mean(axis=0) / means[0].mean(axis=0)
-    print("hairis / cycles: channel means %s" % ratio)
+    own_evals, own_time = render_stack(scene, "HAIRIS")
+    hairis, hairis_time = render_table(scene)
+    print("render time: cycles %.1f s, hairis with own evals %.1f s, with tables %.1f s (bakes "
+          "included)" % (cycles_time, own_time, hairis_time))
+    means = [image.reshape(SEEDS, -1, 3).mean(axis=(0, 1)) for image in (cycles, own_evals, hairis)]
+    ratio = means[2] / means[0]
+    part = means[2] / means[1]
+    print("hairis / cycles: channel means %s; with tables / with own evals: %s" % (ratio, part))
     assert np.all(np.abs(ratio - 1.0) <= 0.02), ratio
+    assert np.all(np.abs(part - 1.0) <= 0.005), part
 
 
 TESTS = [test_hairis_table_auto_bakes_huang_tables, test_hairis_matches_cycles_on_huang_hair,
