@@ -724,6 +724,13 @@ class HairisRenderEngine(bpy.types.RenderEngine):
                     else:
                         status = tables.TableStatus("MISSING", "material %r has no sampling "
                                                     "tables" % material.name)
+                    if status.state == "PARTIAL" and settings.auto_bake:
+                        status.tables.close()  # a bake below adds the absorption part
+                    elif status.state == "PARTIAL":
+                        # Usable: strands of their own colour fall back to Cycles' eval.
+                        self.report({"WARNING"}, status.message)
+                        found[index] = status.tables
+                        continue
                     if status.ok:
                         found[index] = status.tables
                     elif settings.auto_bake and bake is not None:

@@ -39,6 +39,9 @@ ABSORPTION_INPUTS = ("color", "melanin", "melanin_redness", "tint", "absorption_
                      "random_color")
 """Inputs that change only a strand's absorption."""
 
+GEOMETRY_INPUTS = ("roughness", "ior", "offset", "random_roughness")
+"""Inputs that change a Huang strand's microfacet chains (its absorption part cannot serve)."""
+
 HUANG_LOBES = ("reflection", "transmission", "secondary_reflection")
 
 HUANG_MATERIAL_ONLY = ("aspect_ratio",) + HUANG_LOBES
@@ -109,9 +112,14 @@ class HairParameters:
 
     @property
     def varies_absorption(self):
-        """True for Huang hair whose absorption varies per strand (Random Color, or a linked
-        colour or melanin input): its tables then need the absorption part."""
+        """True for Huang hair whose absorption alone varies per strand (Random Color, or a
+        linked colour or melanin input): its tables then need the absorption part, which
+        strands of their own roughness, IOR or offset cannot read."""
         if self.model != "HUANG":
+            return False
+        if any(name in self.strand_inputs for name in GEOMETRY_INPUTS):
+            return False
+        if "random" in self.strand_inputs and self.random_roughness > 0.0:
             return False
         if any(name in self.strand_inputs for name in ABSORPTION_INPUTS):
             return True

@@ -78,7 +78,7 @@ def run_job(library, job, options, progress=None):
 
     Returns (parameters, model, Huang f refinement or 0) of the written tables.
     """
-    if job.absorption:
+    if job.absorption and "huang_absorption" in library.bake_options_defaults():
         options = dict(options, huang_absorption=1)
     with library.fiber_principled(job.node) as fiber:
         with library.bake_tables(fiber, options, progress) as baked:
@@ -96,7 +96,7 @@ def finish_job(operator, job, parameters, model, refinement=0):
         operator.report({"WARNING"}, "material %r was removed during the bake" % job.material_name)
         return
     tables.store_image(material, job.path, job.stored_path, not job.blend_saved, parameters,
-                       model, refinement)
+                       model, refinement, job.absorption)
     if not job.blend_saved:
         operator.report({"WARNING"}, "the .blend is not saved: tables of %r were written to %s and "
                         "packed into the file; save the .blend and bake again to keep them next "

@@ -194,6 +194,10 @@ class HairisMaterialSettings(bpy.types.PropertyGroup):
         name="Baked Huang Bake", min=0, default=0,
         description="The Huang f refinement the tables were baked with (0: not a Huang bake, "
         "or not recorded)")
+    baked_huang_absorption: BoolProperty(
+        name="Baked Absorption Part", default=False,
+        description="Whether the tables hold the Huang absorption part, which shades strands "
+        "of their own colour without noise")
 
     @classmethod
     def register(cls):

@@ -27,7 +27,9 @@ class TableError(Exception):
 
 @dataclass
 class TableStatus:
-    """The state of a material's tables: 'OK', 'MISSING', 'INVALID' or 'STALE'."""
+    """The state of a material's tables: 'OK', 'MISSING', 'INVALID', 'STALE' or 'PARTIAL'
+    (usable, with ``tables`` open, but without the Huang absorption part the material's
+    per-strand colour asks for: a bake adds it)."""
 
     state: str
     message: str
@@ -145,22 +147,22 @@ def check_material(library, material, fiber, need_multiple=False, refinement=1,
         tables.close()
         return TableStatus("STALE", "material %r: its Huang tables' f was baked at another "
                            "Huang Bake than the scene's; bake them again" % material.name)
-    if absorption and tables.info.get("huang_absorption") != "1":
-        tables.close()
-        return TableStatus("STALE", "material %r: its Huang tables have no absorption part, "
-                           "which shades strands of their own colour without Cycles' noise; "
-                           "bake them again" % material.name)
     if need_multiple and not tables.n_h_values:
         tables.close()
         return TableStatus("STALE", "material %r: its tables have no multiple-scattering part, "
                            "which Dual Scattering samples (baked by an earlier hairis); bake "
                            "them again" % material.name)
+    if absorption and tables.info.get("huang_absorption") != "1":
+        return TableStatus("PARTIAL", "material %r: its Huang tables have no absorption part, "
+                           "so strands of their own colour are shaded with Cycles' noisy eval; "
+                           "bake them again to add it" % material.name, tables)
     return TableStatus("OK", "material %r: tables are current" % material.name, tables)
 
 
 def quick_state(library, material, refinement=1):
     """A cheap check for the UI (no table load): 'OK', 'MISSING', 'STALE', 'OTHER_BAKE' (a
-    Huang f baked at another Huang Bake than ``refinement``) or 'ERROR'."""
+    Huang f baked at another Huang Bake than ``refinement``), 'NO_ABSORPTION' (Huang tables
+    without the absorption part the material's per-strand colour asks for) or 'ERROR'."""
     settings = material.hairis
     image = settings.table_image
     if image is None:
@@ -176,7 +178,11 @@ def quick_state(library, material, refinement=1):
     if current != settings.baked_parameters:
         return "STALE"
     baked = settings.baked_huang_f_refinement
-    return "OTHER_BAKE" if baked and baked != refinement else "OK"
+    if baked and baked != refinement:
+        return "OTHER_BAKE"
+    if baked and params.varies_absorption and not settings.baked_huang_absorption:
+        return "NO_ABSORPTION"
+    return "OK"
 
 
 def table_filename(material):
@@ -200,9 +206,11 @@ def output_path(material):
     return path, path, False
 
 
-def store_image(material, path, stored_path, pack, parameters, model, refinement=0):
+def store_image(material, path, stored_path, pack, parameters, model, refinement=0,
+                absorption=False):
     """Loads ``path`` as the material's table image (float, Non-Color) and records the bake
-    (``refinement``: its Huang f refinement, 0 for other models).
+    (``refinement``: its Huang f refinement, 0 for other models; ``absorption``: whether it
+    holds the Huang absorption part).
 
     Main thread only (writes ``bpy.data``). An image already pointing at ``path`` is
     reloaded; otherwise a new datablock replaces the old one (removed if nothing else uses it).
@@ -228,6 +236,7 @@ def store_image(material, path, stored_path, pack, parameters, model, refinement
     settings.baked_parameters = parameters
     settings.baked_model = model
     settings.baked_huang_f_refinement = int(refinement)
+    settings.baked_huang_absorption = bool(absorption)
     if old is not None and old != image and old.users == 0:
         bpy.data.images.remove(old)
     return image

@@ -333,6 +333,8 @@ class HAIRIS_MATERIAL_PT_tables(HairisPanel, bpy.types.Panel):
                 "MISSING": ("No tables baked", "ERROR"),
                 "STALE": ("Tables are stale: the hair parameters changed", "ERROR"),
                 "OTHER_BAKE": ("Tables are stale: baked at the other Huang Bake", "ERROR"),
+                "NO_ABSORPTION": ("Tables lack the per-strand colour part: bake again",
+                                  "ERROR"),
                 "ERROR": ("The hair node cannot be read", "ERROR"),
             }[state]
             column.label(text=text, icon=icon)

@@ -539,6 +539,8 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
             const double base = node.weight * first.weight;
             if (m_tt_ > 0.0 && tt_order == q.first_order) add_tt(e, base);
             if (m_trt_ <= 0.0) continue;
+            // The entry's colour at each extra absorption, shared by its internal reflections.
+            for (std::size_t a = 0; a < n_extra; ++a) at_extra[a] = std::exp(absorptions[a] / e.ct * e.path);
             // The internal reflection: Fresnel's kink at the critical angle and the visibility
             // tests of the reflected direction against the inner meso- and macronormal.
             const double critical = 1.0 - 1.0 / (eta_ * eta_);
@@ -554,10 +556,7 @@ HuangExpectation HuangFiber::expectation(const HuangHit &hit, const HuangQuadrat
                 const double weight = base * second.weight;
                 Colour trrt = residual_series(e.t1, b.r2, e.at);
                 for (double &x : trrt) x *= weight;
-                for (std::size_t a = 0; a < n_extra; ++a) {
-                    at_extra[a] = std::exp(absorptions[a] / e.ct * e.path);
-                    trrt_extra[a] = weight * residual_term(e.t1, b.r2, at_extra[a]);
-                }
+                for (std::size_t a = 0; a < n_extra; ++a) trrt_extra[a] = weight * residual_term(e.t1, b.r2, at_extra[a]);
                 if (!b.vis) {
                     out.tir_only_.push_back(-b.wtr, trrt, trrt_extra.data());
                     continue;
@@ -608,11 +607,13 @@ Rgb HuangFiber::f_cos(Vec3 wi, Vec3 wo) const { return expectation({wo, 0.0f, 1.
 std::array<Rgb, 4> HuangExpectation::lobes(Vec3 wi, double *rest) const {
     std::array<Rgb, 4> out{};
     const std::size_t n_extra = rest ? absorptions_.size() : 0;
-    // Sums per extra absorption: TT, TRT and TRRT+ (each n_extra).
-    double extra_sums[3 * 32];
+    // Sums per extra absorption: TT, TRT and TRRT+ (each n_extra), on the stack for the
+    // absorption parts a table may hold.
+    constexpr std::size_t kOnStack = 32;
+    double extra_sums[3 * kOnStack];
     std::vector<double> extra_heap;
     double *extra = extra_sums;
-    if (n_extra > 32) {
+    if (n_extra > kOnStack) {
         extra_heap.assign(3 * n_extra, 0.0);
         extra = extra_heap.data();
     }

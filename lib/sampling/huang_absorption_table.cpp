@@ -27,8 +27,10 @@ Expected<HuangAbsorptionTable> HuangAbsorptionTable::create(const HuangTableSet 
 
 bool HuangAbsorptionTable::reads(const std::array<double, 3> &strand, const std::array<double, 3> &fiber) const {
     const double first = nodes_.front();
-    for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t c = 0; c < 3; ++c) {
+        if (!(std::isfinite(strand[c]) && std::isfinite(fiber[c]))) return false;
         if (strand[c] != fiber[c] && !(strand[c] >= first && fiber[c] >= first)) return false;
+    }
     return true;
 }
 
@@ -51,9 +53,10 @@ double HuangAbsorptionTable::interpolate(const float *g, double sigma) const {
     while (j + 2 < n && x >= axis_[std::size_t(j + 1)]) ++j;
     const double x0 = axis_[std::size_t(j)], x1 = axis_[std::size_t(j + 1)];
     const double g0 = g[j], g1 = g[j + 1];
-    if (x > x1) {  // beyond the last node: log-linear
+    if (x > x1) {  // beyond the last node: log-linear, never rising (more absorption, less light)
         if (!(g0 > 0.0 && g1 > 0.0)) return 0.0;
-        return g1 * std::exp((x - x1) / (x1 - x0) * std::log(g1 / g0));
+        const double slope = std::min(std::log(g1 / g0), 0.0);
+        return slope == 0.0 ? g1 : g1 * std::exp((x - x1) / (x1 - x0) * slope);
     }
     const double t = (x - x0) / (x1 - x0);
     // The outer neighbours; at the ends a reflected node with a linearly continued value.

@@ -6,15 +6,15 @@
 // One function serves every channel. Cycles' Huang eval colours each microfacet chain by
 // exp(−σ·length) (TRRT+ by a series in it) and nothing else on a chain depends on σ, so one
 // channel of f·|cos θ_i| is a function G(σ) of that channel's absorption alone, the same for
-// R, G and B. The bake evaluates G at K nodes σ_k (three at a time: a fiber whose absorption
-// is three nodes), at the f part's points.
+// R, G and B. The bake evaluates G at K nodes σ_k at the f part's points, colouring the f
+// part's own chains at each node (HuangFiber::expectation with absorptions).
 //
 // Interpolation in σ. G is a mixture of exp(−σ·ℓ) over chain lengths ℓ, so log G is smooth
 // and convex. The nodes are even in log(σ + 1/4), and log G is read with Catmull-Rom weights in
-// that variable (linearly in G where a neighbour is 0), log-linearly beyond the last node.
-// Below the first node Cycles' TRRT+ series has a pole at σ = 0 (a lossless fiber under total
-// internal reflection) that no grid of nodes follows: reads() says so, and such strands keep
-// Cycles' eval.
+// that variable (linearly in G where a neighbour is 0), log-linearly and never rising beyond
+// the last node. Just above σ = 0 Cycles' TRRT+ series drops steeply (its pole lies just below
+// 0 for a lossless fiber under total internal reflection) over a range no grid of nodes
+// follows: below the first node reads() says no, and such strands keep Cycles' eval.
 //
 // A strand reads the fiber's f part plus G(σ_strand) − G(σ_fiber) per channel: the errors of
 // the two reads cancel for strands near the fiber's absorption, and a strand of the fiber's
@@ -41,7 +41,8 @@ class HuangAbsorptionTable {
     /// both at or above the first node.
     bool reads(const std::array<double, 3> &strand, const std::array<double, 3> &fiber) const;
     /// G(σ) per channel: f·|cos θ_i| of TT, TRT and TRRT+ of a fiber of absorption `sigma` (and
-    /// the set's other parameters) at ω_i for the view `q` was located for.
+    /// the set's other parameters) at ω_i for the view `q` was located for; a σ below the first
+    /// node reads as the first node.
     Rgb f_cos(const HuangTableQuery &q, Vec3 wi, const std::array<double, 3> &sigma) const;
     /// G(strand) − G(fiber) per channel, 0 where the two are equal.
     Rgb difference(const HuangTableQuery &q, Vec3 wi, const std::array<double, 3> &strand,

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -72,7 +73,7 @@ Vec3 point(const Baked &b, int q, int i, int j) {
 
 TEST(HuangAbsorptionTable, AtItsNodesAndPointsItIsTheExpectationOfThatAbsorption) {
     const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});
-    const HuangBakeOptions o = options(huang_absorption_nodes(5));  // two fibers, the last one padded
+    const HuangBakeOptions o = options(huang_absorption_nodes(5));
     const Baked b = bake(fiber, o);
     ASSERT_EQ(b.set.absorption_count(), 5);
     int checked = 0;
@@ -152,6 +153,40 @@ TEST_P(HuangAbsorptionBudget, BetweenNodesTheErrorStaysWithinItsBudget) {
 INSTANTIATE_TEST_SUITE_P(Fibers, HuangAbsorptionBudget,
                          ::testing::Values(BudgetCase{0.5f, 0.3f, 1e-3, 0.02}, BudgetCase{1.0f, 0.1f, 1e-3, 0.01},
                                            BudgetCase{0.85f, 0.8f, 1e-3, 0.03}));
+
+// Beyond the last node (black hair, σ up to tens): G never rises, stays finite, and stays
+// within a small share of each direction's f; an infinite absorption is not read.
+TEST(HuangAbsorptionTable, BeyondTheLastNodeItDecaysAndStaysWithinItsBudget) {
+    const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});
+    const HuangBakeOptions o = options(huang_absorption_nodes());
+    const Baked b = bake(fiber, o);
+    const std::array<float, 3> sigma{14.0f, 22.0f, 40.0f};
+    const HuangFiber strand = fiber_of(sigma);
+    double worst = 0;
+    for (int q : {0, 1})
+        for (int r : {1, 2}) {
+            const Vec3 wo = direction_of(b.set.theta_o_nodes[size_t(r)], b.set.phi_o_nodes[size_t(q)]);
+            const HuangTableQuery query = b.table.locate(wo);
+            const HuangExpectation e = strand.expectation({wo, 0.0f, 1.0f}, rule_of(o));
+            for (int i = 0; i < o.theta_i_count; ++i)
+                for (int j = 0; j < o.phi_count; ++j) {
+                    const Vec3 wi = point(b, q, i, j);
+                    const std::array<Rgb, 4> lobes = e.lobes(wi);
+                    const Rgb want = rest_of(lobes), all = lobes[0] + want;
+                    const Rgb got = b.absorption.f_cos(query, wi, {sigma[0], sigma[1], sigma[2]});
+                    const Rgb last = b.absorption.f_cos(query, wi, {12.0, 12.0, 12.0});
+                    for (int c = 0; c < 3; ++c) {
+                        ASSERT_TRUE(std::isfinite(got[c]) && got[c] >= 0.0f);
+                        EXPECT_LE(got[c], last[c] * (1.0f + 1e-6f));
+                        if (all[c] > 1e-3f) worst = std::max(worst, double(std::fabs(got[c] - want[c]) / all[c]));
+                    }
+                }
+        }
+    std::printf("absorption part beyond the last node: largest %.4f of a direction's f\n", worst);
+    EXPECT_LT(worst, 0.03);
+    const double inf = std::numeric_limits<double>::infinity();
+    EXPECT_FALSE(b.absorption.reads({inf, 0.6, 1.2}, {0.3, 0.6, 1.2}));
+}
 
 TEST(HuangAbsorptionTable, AStrandOfTheFibersAbsorptionDiffersByExactlyZero) {
     const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});

@@ -432,13 +432,15 @@ def test_huang_tables_without_their_f_are_stale():
 def test_huang_random_color_bakes_the_absorption_part():
     """Blender 4.0+: Huang hair with Random Color needs tables with the absorption part (which
     shades each strand's colour without Cycles' noise): the Bake operator's job and auto-bake
-    ask for it, tables without it are stale for that material only, and its auto-bake cache
-    file is its own."""
+    ask for it, tables without it are usable but partial for that material only (the panel
+    says so), its auto-bake cache file is its own, and Random Roughness per strand, which no
+    strand could read the part with, does not ask for it."""
     helpers.skip_without_huang()
     material = bpy.data.materials["Hair"]
     node = next(n for n in material.node_tree.nodes
                 if n.bl_idname == "ShaderNodeBsdfHairPrincipled")
-    saved_state = (node.model, node.parametrization, node.inputs["Random Color"].default_value)
+    saved_state = (node.model, node.parametrization, node.inputs["Random Color"].default_value,
+                   node.inputs["Random Roughness"].default_value)
     saved = material.hairis.table_image
     saved_record = (material.hairis.baked_parameters, material.hairis.baked_model)
     lib = library()
@@ -450,6 +452,9 @@ def test_huang_random_color_bakes_the_absorption_part():
         node.inputs["Random Color"].default_value = 0.0
         assert not tables.material_parameters(material).varies_absorption
         node.inputs["Random Color"].default_value = 0.5
+        node.inputs["Random Roughness"].default_value = 0.3
+        assert not tables.material_parameters(material).varies_absorption
+        node.inputs["Random Roughness"].default_value = 0.0
         params = tables.material_parameters(material)
         assert params.varies_absorption
         material.hairis.table_image = None  # store_image below then leaves the saved image be
@@ -460,7 +465,9 @@ def test_huang_random_color_bakes_the_absorption_part():
                 job = operators.BakeJob(material.name, tables.principled_struct(lib, params),
                                         path, path, True, absorption)
                 parameters, model, refinement = operators.run_job(lib, job, dict(small))
-                tables.store_image(material, path, path, False, parameters, model, refinement)
+                tables.store_image(material, path, path, False, parameters, model, refinement,
+                                   absorption)
+                states[(absorption, "quick")] = tables.quick_state(lib, material, 1)
                 for needed in (False, True):
                     status = tables.check_material(lib, material, fiber, absorption=needed)
                     states[(absorption, needed)] = (status.state, status.message)
@@ -470,16 +477,22 @@ def test_huang_random_color_bakes_the_absorption_part():
             cache = tables.fiber_cache_path(fiber, 1, True)
             assert cache != tables.fiber_cache_path(fiber), cache
         assert states[(False, False)][0] == "OK", states
-        assert states[(False, True)][0] == "STALE", states
+        # Without the part the tables still render (the strands fall back to Cycles' eval);
+        # a bake adds it.
+        assert states[(False, True)][0] == "PARTIAL", states
         assert "absorption part" in states[(False, True)][1], states
+        assert (states[(False, "quick")], states[(True, "quick")]) == ("NO_ABSORPTION", "OK"), \
+            states
         assert states[(True, False)][0] == "OK" and states[(True, True)][0] == "OK", states
         assert tables.bake_options(lib, absorption=True)["huang_absorption"] == 1
         assert tables.bake_options(lib)["huang_absorption"] == 0
     finally:
-        node.model, node.parametrization, node.inputs["Random Color"].default_value = saved_state
+        (node.model, node.parametrization, node.inputs["Random Color"].default_value,
+         node.inputs["Random Roughness"].default_value) = saved_state
         material.hairis.table_image = saved
         material.hairis.baked_parameters, material.hairis.baked_model = saved_record
         material.hairis.baked_huang_f_refinement = 0
+        material.hairis.baked_huang_absorption = False
     # Chiang strands take their colour exactly: no absorption part, one cache file.
     params = tables.material_parameters(material)
     assert not params.varies_absorption
