@@ -100,7 +100,7 @@ TEST(HuangAbsorptionTable, AtItsNodesAndPointsItIsTheExpectationOfThatAbsorption
 }
 
 // The part's error at absorption `sigma` against the expectation of a fiber of that absorption,
-// at the points of two φ_o and two θ_o nodes: Σ|error| and Σ f (R included), and the largest
+// at the points of two φ_o (or the one) and two θ_o nodes: Σ|error| and Σ f (R included), and the largest
 // error as a share of one direction's f. `check` sees each read and the same direction's read
 // at the last node.
 struct PartError {
@@ -110,7 +110,7 @@ struct PartError {
 template <typename Check>
 void add_part_error(const Baked &b, const HuangBakeOptions &o, const HuangFiber &strand,
                     const std::array<float, 3> &sigma, PartError &out, Check check) {
-    for (int q : {0, 1})
+    for (int q = 0; q < std::min(2, b.set.phi_o_count()); ++q)  // a round fiber has one φ_o node
         for (int r : {1, 2}) {
             const Vec3 wo = direction_of(b.set.theta_o_nodes[size_t(r)], b.set.phi_o_nodes[size_t(q)]);
             const HuangTableQuery query = b.table.locate(wo);
