@@ -33,8 +33,9 @@ namespace hairis {
 struct HuangGridRead {
     static constexpr int kMaxPoints = 128;
     int count = 0;
-    std::array<std::uint32_t, kMaxPoints> cell{};
-    std::array<float, kMaxPoints> weight{};
+    // Only the first `count` entries are set: a read is on every shading call's path.
+    std::array<std::uint32_t, kMaxPoints> cell;
+    std::array<float, kMaxPoints> weight;
 };
 
 /// The grid of points a Huang table's f and absorption parts are baked on, and how a read
