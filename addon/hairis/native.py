@@ -473,9 +473,8 @@ class Library:
 
     def load_tables_memory(self, data):
         """Loads and validates tables from EXR bytes (e.g. a packed image's data)."""
-        data = bytes(data)
-        buffer = ctypes.create_string_buffer(data, len(data))
-        pointer = self.raw.hairis_tables_load_memory(buffer, len(data))
+        data = bytes(data)  # no copy of bytes; the library reads them during the call only
+        pointer = self.raw.hairis_tables_load_memory(data, len(data))
         return Tables(self, self._handle("hairis_tables_load_memory", pointer))
 
     def sampler(self, strategy, fiber=None, tables=None, multiple_weight=0.0, n_h=2):

@@ -1,12 +1,15 @@
 // C API: sampling tables — bake, write, load (file or memory), metadata and fiber matching.
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
+#include <filesystem>
 #include <list>
 #include <memory>
 #include <mutex>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "capi_internal.h"
@@ -54,13 +57,13 @@ hairis_tables *make_tables(TableSet set) {
     return tables.release();
 }
 
-// Decoded table files by the SHA-1 of their bytes: a renderer that loads the same file for every
+// Decoded table files by a fingerprint of their bytes: a renderer that loads the same file for every
 // render (the add-on does) decodes and validates it once. A changed byte is a new key, so a
 // damaged file is decoded, and refused, like any other.
 class DecodedCache {
   public:
     hairis_tables *load(const void *data, size_t size, const std::string &where) {
-        const std::string key = std::to_string(size) + ":" + table_file_digest(data, size);
+        const std::string key = std::to_string(size) + ":" + table_file_fingerprint(data, size);
         {
             std::lock_guard<std::mutex> lock(mutex_);
             for (auto it = entries_.begin(); it != entries_.end(); ++it)
@@ -99,6 +102,11 @@ std::vector<unsigned char> read_file(const std::string &path) {
     unsigned char chunk[1 << 16];
     size_t got = 0;
     try {
+        // Reserving the file's size saves the copies of a growing buffer; the loop still reads
+        // to the end, so a file that changes size meanwhile is read whole.
+        std::error_code ignored;
+        const std::uintmax_t expected = std::filesystem::file_size(path, ignored);
+        if (!ignored && expected < (std::uintmax_t(1) << 32)) bytes.reserve(size_t(expected));
         while ((got = std::fread(chunk, 1, sizeof chunk, file)) > 0)
             bytes.insert(bytes.end(), chunk, chunk + got);
     } catch (...) {

@@ -648,9 +648,12 @@ Expected<TableSet> decode_huang(OIIO::ImageInput &in, TableSet t, HuangParts par
 
 }  // namespace
 
-std::string table_file_digest(const void *data, size_t size) {
-    OIIO::SHA1 sha(data, size);
-    return sha.digest();
+std::string table_file_fingerprint(const void *data, size_t size) {
+    const OIIO::farmhash::uint128_t h = OIIO::farmhash::Fingerprint128(static_cast<const char *>(data), size);
+    char hex[33];
+    std::snprintf(hex, sizeof hex, "%016llx%016llx", (unsigned long long)OIIO::farmhash::Uint128High64(h),
+                  (unsigned long long)OIIO::farmhash::Uint128Low64(h));
+    return hex;
 }
 
 Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &t) {

@@ -70,8 +70,9 @@ Expected<std::vector<unsigned char>> encode_table_exr(const TableSet &tables);
 /// Decodes and validates EXR bytes (a file's contents or a packed Blender image).
 Expected<TableSet> decode_table_exr(const void *data, size_t size);
 
-/// The SHA-1 (hex) of a table file's bytes: the key under which a decoded file may be reused.
-std::string table_file_digest(const void *data, size_t size);
+/// A 128-bit fingerprint (hex) of a table file's bytes: the key under which a decoded file may be
+/// reused. Not cryptographic: it is fast enough to take on every load of a large file.
+std::string table_file_fingerprint(const void *data, size_t size);
 
 /// Reads and validates a table file.
 Expected<TableSet> read_table_file(const std::string &path);
