@@ -1,13 +1,22 @@
 // Google Benchmark of the Huang pieces: the far-field expectation per ω_o and per ω_i, and per
 // renderer hit prepare, f (one Cycles eval), Cycles' sampler and a per-strand control variate's
-// correction, for default, rough and smooth roughness and aspect 1, 0.85, 0.5.
+// correction, for default, rough and smooth roughness and aspect 1, 0.85, 0.5; and the f a
+// render shades with from a baked table, for the node's strands and for strands of their own
+// colour (the absorption part).
 #include <benchmark/benchmark.h>
 
+#include <memory>
 #include <vector>
 
 #include "core/frame.h"
 #include "core/scratch.h"
+#include "fiber/hair_inputs.h"
 #include "fiber/huang.h"
+#include "fiber/huang_strands.h"
+#include "fiber/principled_hair.h"
+#include "sampling/huang_absorption_table.h"
+#include "sampling/huang_tabulated_fiber.h"
+#include "tables/huang_bake.h"
 
 namespace hairis {
 namespace {
@@ -110,6 +119,47 @@ void BM_StrandCorrectionOnePass(benchmark::State &state) {
     for (auto _ : state) benchmark::DoNotOptimize(strand_point.f_estimate_difference(dirs[i++ % dirs.size()], lcg, node));
 }
 
+// Blender's default Huang node under Melanin, its table baked with the default options and the
+// absorption part, once for every run of BM_TabulatedF.
+struct Tabulated {
+    std::shared_ptr<const HuangFiber> fiber;
+    std::shared_ptr<const HuangTabulatedFiber> model;
+    PrincipledHairNode node;
+};
+
+const Tabulated &tabulated() {
+    static const Tabulated t = [] {
+        Tabulated out;
+        out.node.parametrization = HairParametrization::Melanin;
+        out.fiber = std::make_shared<const HuangFiber>(HuangFiber::create(to_huang_params(out.node).value()).value());
+        auto strands = std::make_shared<const HuangStrands>(HuangStrands::create(out.node, out.fiber).value());
+        HuangBakeOptions o;
+        o.absorption_nodes = huang_absorption_nodes();
+        auto table = std::make_shared<const HuangSamplingTable>(
+            HuangSamplingTable::from(bake_huang_table(*out.fiber, o).value()).value());
+        out.model = std::make_shared<const HuangTabulatedFiber>(
+            HuangTabulatedFiber::create(out.fiber, table, strands).value());
+        return out;
+    }();
+    return t;
+}
+
+// f at a prepared hit, per ω_i: range(0) 0 for a strand of the node's colour, 1 for one of
+// another melanin (read from the absorption part).
+void BM_TabulatedF(benchmark::State &state) {
+    const Tabulated &t = tabulated();
+    float melanin = t.node.melanin * 0.75f;
+    HairInputValues inputs;
+    inputs.set(HairInput::Melanin, &melanin);
+    FiberHit hit = hit_of();
+    if (state.range(0) == 1) hit.inputs = &inputs;
+    const std::vector<Vec3> dirs = directions();
+    ScratchBuffer scratch;
+    const FiberPoint &p = t.model->prepare(hit, scratch);
+    std::size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(p.f(dirs[i++ % dirs.size()]));
+}
+
 void roughness_aspect(benchmark::internal::Benchmark *b) {
     for (int r : {30, 80, 5})
         for (int a : {100, 85, 50}) b->Args({r, a, 4, 3});
@@ -121,6 +171,7 @@ BENCHMARK(BM_PrepareAndTwoEvals)->Apply(roughness_aspect)->Unit(benchmark::kMicr
 BENCHMARK(BM_CyclesSampler)->Apply(roughness_aspect)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StrandCorrectionTwoEvals)->Apply(roughness_aspect)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StrandCorrectionOnePass)->Apply(roughness_aspect)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TabulatedF)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace hairis

@@ -34,23 +34,41 @@ bool HuangAbsorptionTable::reads(const std::array<double, 3> &strand, const std:
     return true;
 }
 
-void HuangAbsorptionTable::gather(const HuangGridRead &r, float *g) const {
-    const std::size_t k_count = nodes_.size();
-    std::fill(g, g + k_count, 0.0f);
+int HuangAbsorptionTable::segment(double x) const {
+    const int n = int(axis_.size());
+    int j = 0;
+    while (j + 2 < n && x >= axis_[std::size_t(j + 1)]) ++j;
+    return j;
+}
+
+double HuangAbsorptionTable::axis_of(double sigma) const {
+    return std::log(std::max(sigma, double(nodes_.front())) + kHuangAbsorptionShift);
+}
+
+HuangAbsorptionTable::Nodes HuangAbsorptionTable::nodes_read(double sigma) const {
+    const int n = int(axis_.size());
+    const int j = segment(axis_of(sigma));
+    return {std::max(j - 1, 0), std::min(j + 2, n - 1)};
+}
+
+void HuangAbsorptionTable::gather(const HuangGridRead &r, Nodes nodes, float *g) const {
+    // Only the nodes interpolation reads: a read covers up to 128 cells, and each cell holds
+    // every node, so the rest would be most of a shading call's work.
+    const std::size_t k_count = nodes_.size(), first = std::size_t(nodes.first), last = std::size_t(nodes.last);
+    std::fill(g + first, g + last + 1, 0.0f);
     for (int n = 0; n < r.count; ++n) {
         const float *v = values_.data() + k_count * std::size_t(r.cell[std::size_t(n)]);
         const float w = r.weight[std::size_t(n)];
-        for (std::size_t k = 0; k < k_count; ++k) g[k] += w * v[k];
+        for (std::size_t k = first; k <= last; ++k) g[k] += w * v[k];
     }
     // The cubic overshoots a little next to sharp features; f is never negative.
-    for (std::size_t k = 0; k < k_count; ++k) g[k] = std::max(g[k], 0.0f);
+    for (std::size_t k = first; k <= last; ++k) g[k] = std::max(g[k], 0.0f);
 }
 
 double HuangAbsorptionTable::interpolate(const float *g, double sigma) const {
     const int n = int(axis_.size());
-    const double x = std::log(std::max(sigma, double(nodes_.front())) + kHuangAbsorptionShift);
-    int j = 0;
-    while (j + 2 < n && x >= axis_[std::size_t(j + 1)]) ++j;
+    const double x = axis_of(sigma);
+    const int j = segment(x);
     const double x0 = axis_[std::size_t(j)], x1 = axis_[std::size_t(j + 1)];
     const double g0 = g[j], g1 = g[j + 1];
     if (x > x1) {  // beyond the last node: log-linear, never rising (more absorption, less light)
@@ -74,14 +92,28 @@ double HuangAbsorptionTable::interpolate(const float *g, double sigma) const {
 
 Rgb HuangAbsorptionTable::f_cos(const HuangTableQuery &q, Vec3 wi, const std::array<double, 3> &sigma) const {
     float g[kMaxHuangAbsorptionNodes];
-    gather(grid_.read(q, wi), g);
+    Nodes nodes = nodes_read(sigma[0]);
+    for (std::size_t c = 1; c < 3; ++c) {
+        const Nodes more = nodes_read(sigma[c]);
+        nodes = {std::min(nodes.first, more.first), std::max(nodes.last, more.last)};
+    }
+    gather(grid_.read(q, wi), nodes, g);
     return {float(interpolate(g, sigma[0])), float(interpolate(g, sigma[1])), float(interpolate(g, sigma[2]))};
 }
 
 Rgb HuangAbsorptionTable::difference(const HuangGridRead &read, const std::array<double, 3> &strand,
                                      const std::array<double, 3> &fiber) const {
+    Nodes nodes{int(nodes_.size()), -1};  // none
+    for (std::size_t c = 0; c < 3; ++c) {
+        if (strand[c] == fiber[c]) continue;
+        for (double sigma : {strand[c], fiber[c]}) {
+            const Nodes more = nodes_read(sigma);
+            nodes = {std::min(nodes.first, more.first), std::max(nodes.last, more.last)};
+        }
+    }
+    if (nodes.first > nodes.last) return {0.0f, 0.0f, 0.0f};
     float g[kMaxHuangAbsorptionNodes];
-    gather(read, g);
+    gather(read, nodes, g);
     float out[3];
     for (int c = 0; c < 3; ++c)
         out[c] = strand[std::size_t(c)] == fiber[std::size_t(c)]

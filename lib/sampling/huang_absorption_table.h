@@ -58,10 +58,19 @@ class HuangAbsorptionTable {
     }
 
   private:
+    // The nodes [first, last] that interpolate() reads for some absorptions.
+    struct Nodes {
+        int first, last;
+    };
     HuangAbsorptionTable() = default;
-    // The K node values of G at a read, each clamped at 0.
-    void gather(const HuangGridRead &read, float *g) const;
-    // G(σ) from its node values.
+    // The segment [j, j + 1] of the node axis that holds x = log(σ + shift), or the last one.
+    int segment(double x) const;
+    // log(σ + shift), σ raised to the first node.
+    double axis_of(double sigma) const;
+    Nodes nodes_read(double sigma) const;
+    // The node values of G at a read in `nodes`, each clamped at 0; the others are not set.
+    void gather(const HuangGridRead &read, Nodes nodes, float *g) const;
+    // G(σ) from its node values (those of nodes_read(σ)).
     double interpolate(const float *g, double sigma) const;
 
     HuangFGrid grid_;
