@@ -30,7 +30,8 @@ at the time Cycles took for each of its sample counts, divided by Cycles' RMSE t
 Writes render_study_huang.json and render_study_huang.md into HAIRIS_STUDY_OUT
 (default: this folder). Environment: HAIRIS_STUDY_RESOLUTION (64x48), HAIRIS_STUDY_REF_SPP (2048),
 HAIRIS_STUDY_SPPS (4,16,64,256), HAIRIS_STUDY_SEEDS (3), HAIRIS_STUDY_SCENE (compare: the
-scene above; default, rough01, random: three more, see SCENES).
+scene above; default, rough01, random: three more, see SCENES), HAIRIS_STUDY_PROFILE (a method:
+profile its renders at SPPS instead of the study).
 """
 
 import json
@@ -274,8 +275,32 @@ def study():
     }
 
 
+def profile(method):
+    """Where the time of ``method``'s renders goes: cProfile over SEEDS renders at each of
+    SPPS after a warm-up, the functions by their own and cumulative time, printed."""
+    import cProfile
+    import pstats
+    scene = make_scene()
+    render(scene, method, 1, 1)  # warm-up: auto-bake, kernels, the decoded tables
+    for samples in SPPS:
+        profiler = cProfile.Profile()
+        seconds = []
+        for index in range(SEEDS):
+            profiler.enable()
+            seconds.append(render(scene, method, samples, 1 + index)[1])
+            profiler.disable()
+        log("%s %d spp: render seconds %s" % (method, samples, ", ".join(
+            "%.3f" % t for t in seconds)))
+        stats = pstats.Stats(profiler).sort_stats("cumulative")
+        stats.print_stats(25)
+
+
 def main():
-    """Runs the study and writes the results."""
+    """Runs the study and writes the results (HAIRIS_STUDY_PROFILE=<method>: profiles that
+    method's renders instead)."""
+    if os.environ.get("HAIRIS_STUDY_PROFILE"):
+        profile(os.environ["HAIRIS_STUDY_PROFILE"])
+        return
     results = study()
     os.makedirs(OUT, exist_ok=True)
     with open(os.path.join(OUT, "render_study_huang.json"), "w") as out:
