@@ -57,9 +57,9 @@ hairis_tables *make_tables(TableSet set) {
     return tables.release();
 }
 
-// Decoded table files by a fingerprint of their bytes: a renderer that loads the same file for every
-// render (the add-on does) decodes and validates it once. A changed byte is a new key, so a
-// damaged file is decoded, and refused, like any other.
+// Decoded table files by a fingerprint of their bytes: a renderer that loads the same file for
+// every render (the add-on does) decodes and validates it once. A changed byte is a new key, so
+// a damaged file is decoded, and refused, like any other.
 class DecodedCache {
   public:
     hairis_tables *load(const void *data, size_t size, const std::string &where) {

@@ -52,8 +52,8 @@ HuangAbsorptionTable::Nodes HuangAbsorptionTable::nodes_read(double sigma) const
 }
 
 void HuangAbsorptionTable::gather(const HuangGridRead &r, Nodes nodes, float *g) const {
-    // Only the nodes interpolation reads: a read covers up to 128 cells, and each cell holds
-    // every node, so the rest would be most of a shading call's work.
+    // Only the nodes interpolation reads: each of a read's cells holds every node, and each
+    // channel's interpolation reads at most four of them.
     const std::size_t k_count = nodes_.size(), first = std::size_t(nodes.first), last = std::size_t(nodes.last);
     std::fill(g + first, g + last + 1, 0.0f);
     for (int n = 0; n < r.count; ++n) {

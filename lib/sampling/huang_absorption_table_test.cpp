@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -211,6 +212,36 @@ TEST(HuangAbsorptionTable, AStrandOfTheFibersAbsorptionDiffersByExactlyZero) {
     EXPECT_FALSE(b.absorption.reads({below, 0.6, 1.2}, own));
     EXPECT_FALSE(b.absorption.reads(own, {below, 0.6, 1.2}));
     EXPECT_TRUE(b.absorption.reads({below, 0.9, 1.2}, {below, 0.6, 1.2}));
+}
+
+// difference() reads only the nodes its absorptions need; it must give what reading every
+// value apart gives, also for absorptions whose nodes lie far apart and one channel alone.
+TEST(HuangAbsorptionTable, ItsDifferenceIsTheDifferenceOfItsValues) {
+    const HuangFiber fiber = fiber_of({0.3f, 0.6f, 1.2f});
+    const Baked b = bake(fiber, options(huang_absorption_nodes()));
+    const std::array<std::array<double, 3>, 4> strands = {{{0.3, 0.6, 1.2}, {0.02, 0.6, 1.2},
+                                                          {0.3, 9.0, 1.2}, {0.05, 3.0, 20.0}}};
+    const std::array<std::array<double, 3>, 2> fibers = {{{0.3, 0.6, 1.2}, {6.0, 0.03, 1.2}}};
+    int compared = 0;
+    for (int v = 0; v < 5; ++v) {
+        const HuangTableQuery query = b.table.locate(direction_of(-0.6f + 0.3f * v, 0.4f + 0.5f * v));
+        const Vec3 wi = direction_of(0.5f - 0.25f * v, -2.0f + 0.9f * v);
+        for (const auto &fiber_sigma : fibers)
+            for (const auto &strand : strands) {
+                const Rgb got = b.absorption.difference(query, wi, strand, fiber_sigma);
+                const Rgb a = b.absorption.f_cos(query, wi, strand), c = b.absorption.f_cos(query, wi, fiber_sigma);
+                for (int k = 0; k < 3; ++k) {
+                    const double want = double(a[k]) - double(c[k]);
+                    EXPECT_NEAR(got[k], want, 1e-6 * std::max({1.0, double(a[k]), double(c[k])}))
+                        << "view " << v << ", channel " << k;
+                    if (strand[std::size_t(k)] == fiber_sigma[std::size_t(k)]) {
+                        EXPECT_EQ(got[k], 0.0f);
+                    }
+                    compared += want != 0.0;
+                }
+            }
+    }
+    EXPECT_GT(compared, 40);  // the views reach the fiber's scattering, not only zeros
 }
 
 TEST(HuangAbsorptionTable, RefusesASetWithoutTheAbsorptionPart) {

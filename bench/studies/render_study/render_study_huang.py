@@ -298,8 +298,12 @@ def profile(method):
 def main():
     """Runs the study and writes the results (HAIRIS_STUDY_PROFILE=<method>: profiles that
     method's renders instead)."""
-    if os.environ.get("HAIRIS_STUDY_PROFILE"):
-        profile(os.environ["HAIRIS_STUDY_PROFILE"])
+    method = os.environ.get("HAIRIS_STUDY_PROFILE")
+    if method:
+        if method not in METHODS:
+            raise SystemExit("HAIRIS_STUDY_PROFILE must be one of %s (got %r)"
+                             % (", ".join(METHODS), method))
+        profile(method)
         return
     results = study()
     os.makedirs(OUT, exist_ok=True)
