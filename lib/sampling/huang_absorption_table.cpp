@@ -34,21 +34,17 @@ bool HuangAbsorptionTable::reads(const std::array<double, 3> &strand, const std:
     return true;
 }
 
-int HuangAbsorptionTable::segment(double x) const {
+HuangAbsorptionTable::Place HuangAbsorptionTable::place(double sigma) const {
     const int n = int(axis_.size());
+    const double x = std::log(std::max(sigma, double(nodes_.front())) + kHuangAbsorptionShift);
     int j = 0;
     while (j + 2 < n && x >= axis_[std::size_t(j + 1)]) ++j;
-    return j;
+    return {x, j};
 }
 
-double HuangAbsorptionTable::axis_of(double sigma) const {
-    return std::log(std::max(sigma, double(nodes_.front())) + kHuangAbsorptionShift);
-}
-
-HuangAbsorptionTable::Nodes HuangAbsorptionTable::nodes_read(double sigma) const {
+HuangAbsorptionTable::Nodes HuangAbsorptionTable::nodes_read(Place p, Nodes nodes) const {
     const int n = int(axis_.size());
-    const int j = segment(axis_of(sigma));
-    return {std::max(j - 1, 0), std::min(j + 2, n - 1)};
+    return {std::min(nodes.first, std::max(p.j - 1, 0)), std::max(nodes.last, std::min(p.j + 2, n - 1))};
 }
 
 void HuangAbsorptionTable::gather(const HuangGridRead &r, Nodes nodes, float *g) const {
@@ -65,10 +61,10 @@ void HuangAbsorptionTable::gather(const HuangGridRead &r, Nodes nodes, float *g)
     for (std::size_t k = first; k <= last; ++k) g[k] = std::max(g[k], 0.0f);
 }
 
-double HuangAbsorptionTable::interpolate(const float *g, double sigma) const {
+double HuangAbsorptionTable::interpolate(const float *g, Place p) const {
     const int n = int(axis_.size());
-    const double x = axis_of(sigma);
-    const int j = segment(x);
+    const double x = p.x;
+    const int j = p.j;
     const double x0 = axis_[std::size_t(j)], x1 = axis_[std::size_t(j + 1)];
     const double g0 = g[j], g1 = g[j + 1];
     if (x > x1) {  // beyond the last node: log-linear, never rising (more absorption, less light)
@@ -91,34 +87,31 @@ double HuangAbsorptionTable::interpolate(const float *g, double sigma) const {
 }
 
 Rgb HuangAbsorptionTable::f_cos(const HuangTableQuery &q, Vec3 wi, const std::array<double, 3> &sigma) const {
+    const Place p[3] = {place(sigma[0]), place(sigma[1]), place(sigma[2])};
+    Nodes nodes{int(nodes_.size()), -1};  // none
+    for (const Place &c : p) nodes = nodes_read(c, nodes);
     float g[kMaxHuangAbsorptionNodes];
-    Nodes nodes = nodes_read(sigma[0]);
-    for (std::size_t c = 1; c < 3; ++c) {
-        const Nodes more = nodes_read(sigma[c]);
-        nodes = {std::min(nodes.first, more.first), std::max(nodes.last, more.last)};
-    }
     gather(grid_.read(q, wi), nodes, g);
-    return {float(interpolate(g, sigma[0])), float(interpolate(g, sigma[1])), float(interpolate(g, sigma[2]))};
+    return {float(interpolate(g, p[0])), float(interpolate(g, p[1])), float(interpolate(g, p[2]))};
 }
 
 Rgb HuangAbsorptionTable::difference(const HuangGridRead &read, const std::array<double, 3> &strand,
                                      const std::array<double, 3> &fiber) const {
+    // Each absorption is placed on the node axis once, for the nodes to read and to interpolate.
+    Place to[3] = {}, from[3] = {};
     Nodes nodes{int(nodes_.size()), -1};  // none
     for (std::size_t c = 0; c < 3; ++c) {
         if (strand[c] == fiber[c]) continue;
-        for (double sigma : {strand[c], fiber[c]}) {
-            const Nodes more = nodes_read(sigma);
-            nodes = {std::min(nodes.first, more.first), std::max(nodes.last, more.last)};
-        }
+        to[c] = place(strand[c]);
+        from[c] = place(fiber[c]);
+        nodes = nodes_read(from[c], nodes_read(to[c], nodes));
     }
     if (nodes.first > nodes.last) return {0.0f, 0.0f, 0.0f};
     float g[kMaxHuangAbsorptionNodes];
     gather(read, nodes, g);
     float out[3];
-    for (int c = 0; c < 3; ++c)
-        out[c] = strand[std::size_t(c)] == fiber[std::size_t(c)]
-                     ? 0.0f
-                     : float(interpolate(g, strand[std::size_t(c)]) - interpolate(g, fiber[std::size_t(c)]));
+    for (std::size_t c = 0; c < 3; ++c)
+        out[c] = strand[c] == fiber[c] ? 0.0f : float(interpolate(g, to[c]) - interpolate(g, from[c]));
     return {out[0], out[1], out[2]};
 }
 

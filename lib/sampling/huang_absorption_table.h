@@ -63,15 +63,19 @@ class HuangAbsorptionTable {
         int first, last;
     };
     HuangAbsorptionTable() = default;
-    // The segment [j, j + 1] of the node axis that holds x = log(σ + shift), or the last one.
-    int segment(double x) const;
-    // log(σ + shift), σ raised to the first node.
-    double axis_of(double sigma) const;
-    Nodes nodes_read(double sigma) const;
+    // An absorption on the node axis: x = log(σ + shift), σ raised to the first node, and the
+    // segment [j, j + 1] that holds x, or the last one.
+    struct Place {
+        double x;
+        int j;
+    };
+    Place place(double sigma) const;
+    // The nodes interpolate() reads at `p`, joined with `nodes`.
+    Nodes nodes_read(Place p, Nodes nodes) const;
     // The node values of G at a read in `nodes`, each clamped at 0; the others are not set.
     void gather(const HuangGridRead &read, Nodes nodes, float *g) const;
-    // G(σ) from its node values (those of nodes_read(σ)).
-    double interpolate(const float *g, double sigma) const;
+    // G at `p` from its node values (those of nodes_read(p)).
+    double interpolate(const float *g, Place p) const;
 
     HuangFGrid grid_;
     std::vector<float> nodes_;
