@@ -103,7 +103,7 @@ def render_settings(settings):
             "curve_shape": compat.curve_shape(scene)[0],
             "bvh_quality": bvh_quality(scene),
             "film_transparent": bool(getattr(render, "film_transparent", False)),
-            **cycles_bounce_limits(scene)}
+            **cycles_bounce_limits(scene), **cycles_biased_settings(scene)}
 
 
 def viewport_settings(settings):
@@ -128,6 +128,25 @@ def cycles_bounce_limits(scene):
     return {"max_diffuse_bounces": int(cycles.diffuse_bounces),
             "max_glossy_bounces": int(cycles.glossy_bounces),
             "max_transmission_bounces": int(cycles.transmission_bounces)}
+
+
+PIXEL_FILTERS = {"BOX": "box", "GAUSSIAN": "gaussian", "BLACKMAN_HARRIS": "blackman_harris"}
+"""Cycles' Film > Pixel Filter types and the library's names for them."""
+
+
+def cycles_biased_settings(scene):
+    """The scene's Cycles settings that shape its image beyond the light transport, as Cycles'
+    sync reads them: Filter Glossy, Clamping Direct and Indirect, and the Pixel Filter (a Box
+    is always 1 px wide, whatever the hidden width says); none without Cycles' settings."""
+    cycles = getattr(scene, "cycles", None)
+    if cycles is None:
+        return {}
+    kind = PIXEL_FILTERS.get(str(cycles.pixel_filter_type), "blackman_harris")
+    return {"filter_glossy": float(cycles.blur_glossy),
+            "clamp_direct": float(cycles.sample_clamp_direct),
+            "clamp_indirect": float(cycles.sample_clamp_indirect),
+            "pixel_filter": kind,
+            "pixel_filter_width": 1.0 if kind == "box" else float(cycles.filter_width)}
 
 
 def adaptive_threshold(settings):

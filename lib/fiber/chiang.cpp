@@ -242,6 +242,19 @@ ChiangLobes ChiangLobes::derive(const ChiangLobes &base, const ChiangParams &p) 
     return lobes;
 }
 
+std::optional<ChiangLobes> ChiangLobes::blurred(double roughness) const {
+    if (!(roughness > v_ || roughness > v_m0_ || roughness > s_)) return std::nullopt;
+    ChiangLobes lobes = *this;
+    lobes.v_ = std::max(roughness, v_);
+    lobes.v_m0_ = std::max(roughness, v_m0_);
+    if (roughness > s_) {
+        lobes.s_ = roughness;
+        lobes.azimuthal_ = chiang::TrimmedLogistic(lobes.s_);
+    }
+    lobes.set_longitudinal_constants();
+    return lobes;
+}
+
 bool ChiangLobes::same_longitudinal(int p, const ChiangLobes &other) const {
     if (p < 0 || p > 3) return false;
     if (lobe_variance(p) != other.lobe_variance(p)) return false;
@@ -338,8 +351,15 @@ double chord_scale(SinCos o, double eta) { return 2.0 / cos_from_sin(o.sin / eta
 
 ChiangPoint::ChiangPoint(const ChiangFiber &fiber, const FiberHit &hit) : ChiangPoint(fiber.lobes(), hit) {}
 
-ChiangPoint::ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit)
-    : FiberPoint(hit), lobes_(&lobes), o_(sin_cos_of(double(hit.wo.x))) {
+const FiberPoint &ChiangFiber::prepare(const FiberHit &hit, ScratchBuffer &scratch) const {
+    if (hit.blur_roughness > 0.0f)
+        if (std::optional<ChiangLobes> wide = lobes_.blurred(hit.blur_roughness))
+            return scratch.make<ChiangPoint>(scratch.make<ChiangLobes>(*wide), hit, true);
+    return scratch.make<ChiangPoint>(*this, hit);
+}
+
+ChiangPoint::ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit, bool blurred)
+    : FiberPoint(hit), lobes_(&lobes), o_(sin_cos_of(double(hit.wo.x))), blurred_(blurred) {
     const double r = std::sqrt(double(hit.wo.y) * hit.wo.y + double(hit.wo.z) * hit.wo.z);
     cos_phi_o_ = r > 0 ? hit.wo.y / r : 0.0;
     sin_phi_o_ = r > 0 ? hit.wo.z / r : -1.0;

@@ -158,6 +158,11 @@ class ChiangLobes {
     /// the constants of the parameters that equal `base`'s are copied from it, the others
     /// computed, so the result equals create(params)'s.
     static ChiangLobes derive(const ChiangLobes &base, const ChiangParams &params);
+    /// Cycles' bsdf_hair_chiang_blur (Filter Glossy): the mapped variances v and v_m0 and the
+    /// logistic scale s each raised to `roughness` where below it, the mapped values compared
+    /// with the roughness as Cycles compares them; nullopt when none rises. params() still
+    /// names the inputs the lobes were made from.
+    std::optional<ChiangLobes> blurred(double roughness) const;
 
     const ChiangParams &params() const { return params_; }
     /// The mapped longitudinal variance of lobe p (R: coat-reduced v_m0, TT: v/4, TRT and
@@ -210,8 +215,10 @@ class ChiangLobes {
 class ChiangPoint final : public FiberPoint {
   public:
     ChiangPoint(const ChiangFiber &fiber, const FiberHit &hit);
-    /// The fiber of `lobes` at the hit; `lobes` must outlive the point.
-    ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit);
+    /// The fiber of `lobes` at the hit; `lobes` must outlive the point. `blurred`: the lobes
+    /// are a material's widened by Filter Glossy (ChiangLobes::blurred), which samplers baked
+    /// for the material do not follow.
+    ChiangPoint(const ChiangLobes &lobes, const FiberHit &hit, bool blurred = false);
 
     /// f·|cos θ_i| (near field, as Cycles' bsdf_principled_hair_eval).
     Rgb f(Vec3 wi) const override;
@@ -251,6 +258,9 @@ class ChiangPoint final : public FiberPoint {
     double cos_theta_o() const { return o_.cos; }
     /// The parameters' constants this point reads.
     const ChiangLobes &lobes() const { return *lobes_; }
+    const ChiangPoint *chiang_point() const override { return this; }
+    /// Whether the lobes are Filter Glossy's widening of the material's.
+    bool blurred() const { return blurred_; }
 
   private:
     double longitudinal(int p, double sin_i, double cos_i) const;
@@ -264,6 +274,7 @@ class ChiangPoint final : public FiberPoint {
     std::array<double, 3> shift_{};
     std::array<double, 4> weight_{};
     std::array<chiang::SinCos, 4> cone_{};
+    bool blurred_ = false;
 };
 
 /// The far field at one θ_o, factored per lobe: f_p·|cos θ_i| = M_p(θ_i | θ_o) · N̄_p(φ) with
@@ -307,9 +318,9 @@ class ChiangFiber final : public FiberModel, public ShadingModel {
 
     /// The fiber at a hit.
     ChiangPoint at(const FiberHit &hit) const { return ChiangPoint(*this, hit); }
-    const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
-        return scratch.make<ChiangPoint>(*this, hit);
-    }
+    /// The fiber at `hit`, widened by its Filter Glossy blur (FiberHit::blur_roughness) where
+    /// that raises a roughness.
+    const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override;
     /// f_cos of the near field at (ω_o, h): at({wo, h}).f(wi).
     Rgb f_cos_near(Vec3 wi, Vec3 wo, float h) const { return at({wo, h}).f(wi); }
 

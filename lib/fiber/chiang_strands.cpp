@@ -25,7 +25,11 @@ const ChiangLobes &ChiangStrands::lobes(const HairInputValues *inputs, ScratchBu
 }
 
 const ChiangPoint &ChiangStrands::point(const FiberHit &hit, ScratchBuffer &scratch) const {
-    return scratch.make<ChiangPoint>(lobes(hit.inputs, scratch), hit);
+    const ChiangLobes &own = lobes(hit.inputs, scratch);
+    if (hit.blur_roughness > 0.0f)
+        if (std::optional<ChiangLobes> wide = own.blurred(hit.blur_roughness))
+            return scratch.make<ChiangPoint>(scratch.make<ChiangLobes>(*wide), hit, true);
+    return scratch.make<ChiangPoint>(own, hit);
 }
 
 }  // namespace hairis

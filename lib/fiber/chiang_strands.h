@@ -26,7 +26,8 @@ class ChiangStrands final : public ShadingModel, public StrandInputReader {
     const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
         return point(hit, scratch);
     }
-    /// The fiber at `hit`, with the hit's inputs when it has some.
+    /// The fiber at `hit`, with the hit's inputs when it has some, widened by its Filter Glossy
+    /// blur (FiberHit::blur_roughness) where that raises a roughness.
     const ChiangPoint &point(const FiberHit &hit, ScratchBuffer &scratch) const;
     /// The constants for `inputs`: the node's own fiber's for null (or no input given), else
     /// made in `scratch`. Inputs outside their ranges (check_hair_input) are never handed to a

@@ -16,6 +16,7 @@
 #include "chi2.h"
 #include "core/frame.h"
 #include "core/quadrature.h"
+#include "core/scratch.h"
 #include "fiber/fresnel.h"
 
 namespace hairis {
@@ -201,6 +202,50 @@ TEST(ChiangParams, RoughnessMappingsAreCycles) {
     // A full coat leaves R at Cycles' minimum roughness 0.001.
     p.coat = 1.0f;
     EXPECT_NEAR(make_fiber(p).lobe_variance(kLobeR), cycles_v(0.001), 1e-15);
+}
+
+// Cycles' bsdf_hair_chiang_blur: v, v_m0 and s each become max(blur, value), the mapped values
+// compared with the blur itself; below all three nothing changes.
+TEST(ChiangFiber, BlurRaisesEachMappedRoughnessToTheBlur) {
+    ChiangParams p;
+    p.roughness = 0.4f;
+    p.radial_roughness = 0.25f;
+    p.coat = 0.5f;
+    const ChiangFiber fiber = make_fiber(p);
+    const double v = cycles_v(0.4f), v_m0 = cycles_v(0.5 * double(0.4f)), s = cycles_s(0.25f);
+    ASSERT_LT(v_m0, s);
+    ASSERT_LT(s, v);
+    EXPECT_FALSE(fiber.lobes().blurred(0.5 * v_m0).has_value());
+    const double between = 0.5 * (s + v);  // above v_m0 and s, below v
+    const std::optional<ChiangLobes> wide = fiber.lobes().blurred(between);
+    ASSERT_TRUE(wide.has_value());
+    EXPECT_DOUBLE_EQ(wide->lobe_variance(kLobeR), between);
+    EXPECT_DOUBLE_EQ(wide->lobe_variance(kLobeTT), 0.25 * v);
+    EXPECT_DOUBLE_EQ(wide->logistic_scale(), between);
+    EXPECT_DOUBLE_EQ(wide->azimuthal().scale(), between);
+    const std::optional<ChiangLobes> all = fiber.lobes().blurred(0.5);
+    ASSERT_TRUE(all.has_value());
+    EXPECT_DOUBLE_EQ(all->lobe_variance(kLobeTRT), 4.0 * 0.5);
+    // A point of the widened lobes says so, and its density is still a density: the
+    // analytic sampler's pdf integrates to 1 over the sphere.
+    ScratchBuffer scratch;
+    FiberHit hit{safe_normalize(Vec3{0.3f, 0.5f, 0.8f}), 0.2f};
+    hit.blur_roughness = 0.3f;
+    const FiberPoint &point = fiber.prepare(hit, scratch);
+    ASSERT_NE(point.chiang_point(), nullptr);
+    EXPECT_TRUE(point.chiang_point()->blurred());
+    double integral = 0;
+    const int n = 400;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < 2 * n; ++j) {
+            const double sin_t = -1.0 + 2.0 * (i + 0.5) / n, cos_t = std::sqrt(1.0 - sin_t * sin_t);
+            const double phi = kPi * (-1.0 + (j + 0.5) / n);
+            const Vec3 wi{float(sin_t), float(cos_t * std::cos(phi)), float(cos_t * std::sin(phi))};
+            integral += point.chiang_point()->pdf(wi) * (2.0 / n) * (kPi / n);
+        }
+    EXPECT_NEAR(integral, 1.0, 2e-3);
+    hit.blur_roughness = 0.0f;
+    EXPECT_FALSE(fiber.prepare(hit, scratch).chiang_point()->blurred());
 }
 
 TEST(ChiangParams, LobeShapeFollowsWhereTheLobePeaks) {

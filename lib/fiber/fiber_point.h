@@ -13,6 +13,7 @@ namespace hairis {
 struct HairInputValues;
 class HuangFiber;
 class HuangPoint;
+class ChiangPoint;
 class StrandInputReader;
 
 /// Where a ray met a fiber, in the fiber frame of frame.h (x = tangent).
@@ -32,6 +33,10 @@ struct FiberHit {
     /// The material's node inputs that vary per strand, at this hit (hair_inputs.h), or null:
     /// the material's own values. Must outlive what is prepared from the hit.
     const HairInputValues *inputs = nullptr;
+    /// Cycles' Filter Glossy at this hit: the roughness its bsdf_blur raises the closure's
+    /// roughness parameters to (render/filter_glossy.h); 0: none. Read by the Principled Hair
+    /// models (ChiangStrands, HuangStrands).
+    float blur_roughness = 0;
 };
 
 /// A sampled incident direction and the density it was drawn from.
@@ -58,6 +63,8 @@ class FiberPoint {
     /// Cycles' Huang closure of this hit's own fiber, or null: a renderer that samples Huang
     /// with Cycles' sampler samples and shades with it.
     virtual const HuangPoint *huang_point() const { return nullptr; }
+    /// The Chiang fiber of this hit, or null: Cycles' pdf of a Chiang closure is its density.
+    virtual const ChiangPoint *chiang_point() const { return nullptr; }
     const FiberHit &hit() const { return hit_; }
 
   protected:

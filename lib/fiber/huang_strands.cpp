@@ -16,7 +16,19 @@ Expected<HuangStrands> HuangStrands::create(const PrincipledHairNode &node, std:
     return strands;
 }
 
-const HuangFiber &HuangStrands::fiber_at(const HairInputValues *inputs, ScratchBuffer &scratch) const {
+const HuangFiber &HuangStrands::fiber_at(const HairInputValues *inputs, ScratchBuffer &scratch,
+                                         float blur_roughness) const {
+    const HuangFiber &own = inputs_fiber(inputs, scratch);
+    // Cycles' bsdf_hair_huang_blur: the closure's roughness raised to the blur's.
+    if (!(double(blur_roughness) > own.roughness())) return own;
+    HuangParams params = own.params();
+    params.roughness = blur_roughness;
+    Expected<HuangFiber> wide = HuangFiber::create(params);
+    if (!wide) return own;
+    return scratch.make_polymorphic<HuangFiber>(std::move(wide).value());
+}
+
+const HuangFiber &HuangStrands::inputs_fiber(const HairInputValues *inputs, ScratchBuffer &scratch) const {
     if (!inputs || inputs->given == 0) return *fiber_;
     const Expected<HuangParams> params = to_huang_params(with_inputs(node_, *inputs));
     if (!params) return *fiber_;

@@ -24,12 +24,14 @@ class HuangStrands final : public ShadingModel, public StrandInputReader {
 
     /// The strand's HuangPoint: Cycles' one-sample eval of the strand's own fiber.
     const FiberPoint &prepare(const FiberHit &hit, ScratchBuffer &scratch) const override {
-        return scratch.make<HuangPoint>(fiber_at(hit.inputs, scratch), hit);
+        return scratch.make<HuangPoint>(fiber_at(hit.inputs, scratch, hit.blur_roughness), hit);
     }
     /// The fiber of a hit with `inputs`: the node's own for null (or no input given), else
-    /// made in `scratch`. Inputs the scene refused never reach here; should one, the node's
-    /// own fiber is used.
-    const HuangFiber &fiber_at(const HairInputValues *inputs, ScratchBuffer &scratch) const;
+    /// made in `scratch`; its roughness raised to `blur_roughness` (Filter Glossy,
+    /// FiberHit::blur_roughness) where below it. Inputs the scene refused never reach here;
+    /// should one, the node's own fiber is used.
+    const HuangFiber &fiber_at(const HairInputValues *inputs, ScratchBuffer &scratch,
+                               float blur_roughness = 0) const;
 
     /// Huang reads what Chiang reads under the node's parametrization but for Radial
     /// Roughness and Coat, which the model does not have.
@@ -43,6 +45,7 @@ class HuangStrands final : public ShadingModel, public StrandInputReader {
 
   private:
     HuangStrands() = default;
+    const HuangFiber &inputs_fiber(const HairInputValues *inputs, ScratchBuffer &scratch) const;
     PrincipledHairNode node_;
     std::shared_ptr<const HuangFiber> fiber_;
 };

@@ -54,6 +54,26 @@ TEST(HuangStrands, AHitWithInputsIsTheFiberOfTheNodeWithThem) {
     EXPECT_EQ(point.huang_point()->f_reflection(wi).g, made.at(hit).f_reflection(wi).g);
 }
 
+// Cycles' bsdf_hair_huang_blur: the closure's roughness raised to Filter Glossy's, the rest of
+// the strand's fiber kept; a blur below it leaves the fiber alone.
+TEST(HuangStrands, FilterGlossyRaisesTheRoughnessOnly) {
+    const PrincipledHairNode node = melanin_node();
+    const HuangStrands strands = HuangStrands::create(node).value();
+    ScratchBuffer scratch;
+    const HuangFiber &own = *strands.fiber();
+    ASSERT_LT(own.roughness(), 0.45);
+    const HuangFiber &wide = strands.fiber_at(nullptr, scratch, 0.45f);
+    EXPECT_FLOAT_EQ(float(wide.roughness()), 0.45f);
+    EXPECT_EQ(wide.params().sigma_a.g, own.params().sigma_a.g);
+    EXPECT_EQ(wide.params().ior, own.params().ior);
+    EXPECT_EQ(&strands.fiber_at(nullptr, scratch, float(own.roughness()) * 0.5f), &own);
+    FiberHit hit = hit_at(0.4);
+    hit.blur_roughness = 0.45f;
+    const FiberPoint &point = strands.prepare(hit, scratch);
+    ASSERT_NE(point.huang_point(), nullptr);
+    EXPECT_FLOAT_EQ(float(point.huang_point()->fiber().roughness()), 0.45f);
+}
+
 TEST(HuangStrands, AHitWithoutInputsIsTheNodesOwnFiber) {
     const HuangStrands strands = HuangStrands::create(melanin_node()).value();
     ScratchBuffer scratch;

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <variant>
 
+#include "fiber/chiang.h"
+#include "sampling/analytic_sampler.h"
+
 namespace hairis {
 
 float cycles_pixel_coverage(float footprint, float curve_radius) {
@@ -14,6 +17,7 @@ FiberHit fiber_hit(const SurfacePoint &sp, Vec3 wo, const FiberFrame &frame, con
                    bool oriented) {
     FiberHit hit;
     hit.wo = frame.to_local(wo);
+    hit.blur_roughness = context.blur_roughness;
     const bool back = back_facing(sp, wo);
     const Vec3 ng = back ? -sp.normal : sp.normal, tangent = back ? -sp.tangent : sp.tangent;
     // Cycles: ribbons take h from the hit's place across the strip, round curves from Ng.
@@ -72,10 +76,16 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
             huang_f_ = &model->prepare(hit, scratch);
             huang_ = huang_f_->huang_point();
         }
-        if (huang_)
+        if (huang_) {
             lcg_.state = hit.seed ^ 0x9e3779b9u;
-        else
-            hair_.emplace(hair->shading.at(hit, scratch));
+            return;
+        }
+        // HairShading::at, except that lobes Filter Glossy widened take the analytic sampler:
+        // the material's tables were baked for its own lobes.
+        const FiberPoint *fiber = model ? &model->prepare(hit, scratch) : nullptr;
+        const ChiangPoint *chiang = fiber ? fiber->chiang_point() : nullptr;
+        hair_.emplace(fiber, chiang && chiang->blurred() ? analytic_point(*chiang, scratch)
+                                                        : hair->shading.sampler().at(hit, fiber, scratch));
         return;
     }
     const bool back = back_facing(sp, wo);
@@ -83,6 +93,7 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
     if (const auto *surface = std::get_if<SurfaceMaterial>(&material)) {
         const Vec3 n = back ? -sp.shading_normal : sp.shading_normal;
         surface_ = surface->prepare({wo, n, ng, sp.u, sp.v, context.camera_ray});
+        if (context.blur_roughness > 0.0f) surface_.blur(context.blur_roughness);
     } else {
         const auto &d = std::get<DiffuseMaterial>(material);
         surface_ = SurfaceBsdf(ng, ng, wo);
@@ -94,13 +105,30 @@ Bsdf::Bsdf(const Material &material, const SurfacePoint &sp, Vec3 wo, const HitC
     }
 }
 
-bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy) const {
+namespace {
+
+// The density Cycles records for a hair closure's sample at local ω_i: a Chiang closure's
+// F_energy (the analytic sampler's density; with 3.4's tilt on θ_i Cycles' F_energy tilts θ_i
+// where the sampler tilts θ_o, a difference of the cuticle angle), 1 for Huang, else the
+// sample's own.
+float cycles_hair_pdf(const HairBsdf &hair, Vec3 local_wi, float pdf) {
+    const FiberPoint *fiber = hair.fiber();
+    if (!fiber) return pdf;
+    if (const ChiangPoint *chiang = fiber->chiang_point()) return chiang->pdf(local_wi);
+    return fiber->huang_point() ? 1.0f : pdf;
+}
+
+}  // namespace
+
+bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy,
+                  float *cycles_pdf) const {
     glossy = false;
     if (huang_) {
         const std::optional<HuangCyclesSample> s = huang_->sample_cycles(u0, u1, u2, lcg_);
         if (!s) return false;
         wi = safe_normalize(frame_.to_world(s->wi));
         pdf = 1.0f;
+        if (cycles_pdf) *cycles_pdf = 1.0f;
         weight = s->weight;
         return dot(wi, wi) > 0.0f;
     }
@@ -110,9 +138,22 @@ bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pd
         wi = safe_normalize(frame_.to_world(s->wi));
         pdf = s->pdf;
         weight = s->f / pdf;
+        if (cycles_pdf) {
+            if (hair_) {
+                *cycles_pdf = cycles_hair_pdf(*hair_, s->wi, pdf);
+            } else {
+                float sum = 0.0f, total = 0.0f;
+                for (int k = 0; k < mixture_->size(); ++k) {
+                    const float w = std::fabs(mixture_->weight(k));
+                    sum += w * cycles_hair_pdf(mixture_->part(k), s->wi, mixture_->part(k).pdf(s->wi));
+                    total += w;
+                }
+                *cycles_pdf = total > 0.0f ? sum / total : pdf;
+            }
+        }
         return dot(wi, wi) > 0.0f;
     }
-    return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy);
+    return surface_.sample(u0, u1, u2, wi, weight, pdf, &glossy, cycles_pdf);
 }
 
 DenoisingFeatures Bsdf::denoising_features() const {

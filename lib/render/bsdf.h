@@ -45,6 +45,8 @@ struct HitContext {
     float footprint = 0;
     std::uint32_t seed = 0;
     bool cycles_huang = false;  ///< RenderSettings::huang_sampling == Cycles
+    /// Filter Glossy's roughness at this vertex (render/filter_glossy.h); 0: none.
+    float blur_roughness = 0;
 };
 
 /// Cycles turns Ng, N and dP/du towards ω_o at a back-facing hit (shader_setup_from_ray; on a
@@ -110,7 +112,12 @@ class Bsdf {
 
     /// Draws wi; returns false when there is none. weight = f·|cos|/pdf (Cycles' Huang: its
     /// sampler's weight, with pdf 1); `glossy`: drawn from a surface's glossy lobe.
-    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy) const;
+    /// `cycles_pdf` (may be null) receives the density Cycles records for the same bounce, which
+    /// its Filter Glossy reads: a Chiang closure's own density (its eval's energy-weighted
+    /// lobes), 1 for Huang, a surface's reported density, the sample's density otherwise; a
+    /// mixture's closure-weighted mean.
+    bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf, bool &glossy,
+                float *cycles_pdf = nullptr) const;
 
     /// The denoising features of this vertex (Cycles' closures seen from ω_o).
     DenoisingFeatures denoising_features() const;

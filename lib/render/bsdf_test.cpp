@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/scratch.h"
 #include "fiber/chiang_strands.h"
 #include "fiber/principled_hair.h"
 #include "sampling/uniform_sampler.h"
@@ -65,6 +66,73 @@ TEST(Bsdf, RibbonsAndTubesGiveTheSameOffsetAcrossTheStrand) {
                 EXPECT_NEAR(fh.h, -s, scene == &ribbons ? 1e-4f : 2e-3f)
                     << (scene == &ribbons ? "ribbons" : "tubes") << " s=" << s;
             }
+        }
+    }
+}
+
+// The roughness β in [0.001, 1] whose mapping `map` gives `target` (the mappings rise with β).
+double invert_mapping(double (*map)(double), double target) {
+    double lo = 0.001, hi = 1.0;
+    for (int i = 0; i < 100; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (map(mid) < target ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// Filter Glossy at a Chiang hit: the BSDF is the fiber whose inputs map to Cycles' widened
+// v, s and coat variance (found here by inverting Cycles' mappings), sampled by the analytic
+// sampler whatever the material's sampler; a blur below every roughness changes nothing.
+TEST(Bsdf, FilterGlossyWidensChiangToTheFiberOfTheWidenedRoughness) {
+    PrincipledHairNode node;
+    node.coat = 0.4f;
+    const ChiangParams own = to_chiang_params(node).value();
+    auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(own).value());
+    SceneDesc d;
+    d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
+    HairCurves c;
+    c.points = {{-1.5f, 0, 0}, {-0.5f, 0, 0}, {0.5f, 0, 0}, {1.5f, 0, 0}};
+    c.radii = {0.1f, 0.1f, 0.1f, 0.1f};
+    c.first = {0, 4};
+    d.curves = {c};
+    d.camera.camera_to_world = Mat4::translation({0, 0, 5});
+    d.camera.width = d.camera.height = 4;
+    const Scene scene = std::move(Scene::build(std::move(d))).value();
+    const Vec3 dir = safe_normalize(Vec3{0.2f, -0.5f, -0.8f}), origin = Vec3{0.1f, 0.03f, 0} - dir * 3.0f;
+    const auto hit = scene.intersect(origin, dir, 0.0f, INFINITY);
+    ASSERT_TRUE(hit.has_value());
+    const SurfacePoint sp = scene.surface_point(origin, dir, *hit);
+    const double v = chiang::longitudinal_variance(own.roughness);
+    const double v_m0 = chiang::longitudinal_variance((1.0 - own.coat) * own.roughness);
+    const double s = chiang::logistic_scale(own.radial_roughness);
+    ASSERT_LT(v_m0, v);
+    const Vec3 wis[] = {safe_normalize(Vec3{0.3f, 0.2f, 0.9f}), safe_normalize(Vec3{-0.6f, 0.7f, -0.2f}),
+                        safe_normalize(Vec3{0.1f, -0.9f, 0.3f}), safe_normalize(Vec3{0.8f, 0.1f, -0.5f})};
+    // One blur above all three, one between the coat's variance and the others, one below all.
+    for (const double blur : {0.35, 0.5 * (v_m0 + std::min(v, s)), 0.5 * v_m0}) {
+        ScratchBuffer scratch;
+        HitContext context;
+        context.blur_roughness = float(blur);
+        const Bsdf bsdf(scene.materials()[sp.material], sp, -dir, context, nullptr, scratch);
+        ChiangParams widened = own;
+        widened.roughness = float(invert_mapping(chiang::longitudinal_variance, std::max(blur, v)));
+        widened.coat = float(1.0 - invert_mapping(chiang::longitudinal_variance, std::max(blur, v_m0)) /
+                                       double(widened.roughness));
+        widened.radial_roughness = float(invert_mapping(chiang::logistic_scale, std::max(blur, s)));
+        const ChiangFiber reference = ChiangFiber::create(widened).value();
+        const FiberHit fh = fiber_hit(sp, -dir, bsdf.frame(), HitContext{});
+        const ChiangPoint point = reference.at(fh);
+        const bool widens = blur > v_m0;
+        for (const Vec3 wi : wis) {
+            float pdf = 0;
+            const Rgb f = bsdf.eval(wi, pdf);
+            const Rgb want = point.f(bsdf.frame().to_local(wi));
+            for (int ch = 0; ch < 3; ++ch)
+                EXPECT_NEAR(f[ch], want[ch], 2e-4 * std::max(1.0f, want[ch])) << "blur " << blur;
+            if (widens)
+                EXPECT_NEAR(pdf, point.pdf(bsdf.frame().to_local(wi)), 2e-4 * std::max(1.0f, pdf)) << "blur " << blur;
+            else
+                EXPECT_NEAR(pdf, 1.0 / (4.0 * kPi), 1e-6) << "the material's own (uniform) sampler";
         }
     }
 }

@@ -19,8 +19,8 @@
 // image written by render() is too. The raster point (x + u, y + v), (u, v) ∈ [0, 1)², maps
 // linearly onto the frame: raster (0, 0) is the bottom-left corner of the frame and
 // (width, height) the top-right one. The pixel centre is (x + 0.5, y + 0.5), as in Cycles.
-// Drawing (u, v) uniformly is a 1-pixel box filter (Cycles' default is Blackman-Harris of
-// width 1.5 px; set Cycles' filter to Box, width 1 px, for a like-for-like comparison).
+// Drawing (u, v) uniformly in [0, 1)² is a 1-pixel box filter; the path tracer draws them
+// from Cycles' pixel filter (render/pixel_filter.h), which may reach beyond the pixel.
 //
 // Clipping as in Cycles (kernel/camera/camera.h): perspective rays start on the plane
 // z = −clip_start and end on z = −clip_end (t is scaled by 1/cos of the angle to the view

@@ -15,7 +15,8 @@ PathIntegrator::PathIntegrator(const Scene &scene, const RenderSettings &setting
     : scene_(scene),
       settings_(settings),
       transparent_crossings_(transparent_crossings(TransparentLimit(settings.transparent_limit),
-                                                   settings.max_transparent_bounces)) {}
+                                                   settings.max_transparent_bounces)),
+      pixel_filter_(PixelFilterType(settings.pixel_filter), settings.pixel_filter_width) {}
 
 namespace {
 
@@ -43,12 +44,13 @@ bool write_denoising_features(const Bsdf &bsdf, FirstHit &first, Rgb &throughput
 }  // namespace
 
 Bsdf PathIntegrator::bsdf_at(const SurfacePoint &sp, const Material &material, Vec3 wo, int vertex,
-                             float footprint, std::uint64_t seed, const DualScatteringIntegrator &dual,
-                             ScratchBuffer &scratch) const {
+                             float footprint, std::uint64_t seed, float blur_roughness,
+                             const DualScatteringIntegrator &dual, ScratchBuffer &scratch) const {
     HitContext context;
     context.camera_ray = vertex == 0;
     context.footprint = footprint;
     context.seed = seed;
+    context.blur_roughness = blur_roughness;
     // A vertex dual scattering may shade needs the strategy's sampler (its MIS needs a
     // density); the exact bounces before it are path-traced as integrator=path traces them.
     context.cycles_huang = settings_.huang_sampling == int(HuangSampling::Cycles) && !dual.may_shade(vertex);
@@ -97,9 +99,12 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
     const SobolSampleRng rng(settings_.seed, pixel, sample);
     const SampleRng seeds(settings_.seed, pixel, sample);
 
-    const CameraRay cr = camera.generate_ray(x, y, rng.get(kDimJitterU), rng.get(kDimJitterV));
+    const CameraRay cr = camera.generate_ray(x, y, pixel_filter_.position(rng.get(kDimJitterU)),
+                                             pixel_filter_.position(rng.get(kDimJitterV)));
     PathRay ray{cr.origin, cr.direction, cr.origin, cr.tmin, cr.tmax, PrimRef{}};
     PathState path(counters);
+    path.clamp_direct = settings_.clamp_direct;
+    path.clamp_indirect = settings_.clamp_indirect;
     DualScatteringIntegrator dual(scene_, settings_);
     alpha = 1.0f;
     // Cycles' PATH_RAY_DENOISING_FEATURES and denoising_feature_throughput: until the features
@@ -155,7 +160,8 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
 
         scratch.reset();  // the previous vertex's BSDF is done with
         const Bsdf bsdf = bsdf_at(sp, material, wo, path.vertex, cr.footprint_at(hit->t),
-                                  vertex_seed(seeds, path.vertex), dual, scratch);
+                                  vertex_seed(seeds, path.vertex),
+                                  glossy_blur_roughness(settings_.filter_glossy, path.min_ray_pdf), dual, scratch);
         if (bsdf.transparent()) {
             // The same ray goes on beyond this curve.
             path.last_segment = ++path.transparent_bounces >= transparent_crossings_;
@@ -194,11 +200,13 @@ Rgb PathIntegrator::li(int x, int y, std::uint64_t sample, float &alpha, PathCou
                     u2 = rng.get(dim(path.vertex, kDimBsdf2));
         Vec3 wi;
         Rgb weight;
-        float scatter_pdf = 0.0f;
+        float scatter_pdf = 0.0f, cycles_pdf = INFINITY;
         bool glossy = false;
+        float *filter = settings_.filter_glossy > 0.0f ? &cycles_pdf : nullptr;
         if (!(closes ? dual.sample_continuation(path, bsdf, wo, rng, u0, u1, u2, wi, weight, scatter_pdf, glossy)
-                     : bsdf.sample(u0, u1, u2, wi, weight, scatter_pdf, glossy)))
+                     : bsdf.sample(u0, u1, u2, wi, weight, scatter_pdf, glossy, filter)))
             break;
+        if (filter) path.min_ray_pdf = std::min(path.min_ray_pdf, closes ? scatter_pdf : cycles_pdf);
         dual.leave(path, sp, bsdf, wo, wi);
         path.last_segment = count_bounce(path, bsdf.is_hair(), glossy);
         path.beta *= weight;

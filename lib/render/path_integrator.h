@@ -14,8 +14,10 @@
 //    contributes.
 //  - Diffuse, glossy and transmission limits the same way, per kind of bounce (see
 //    RenderSettings).
-//    Cycles' "Filter Glossy" (Blender's default 1.0) blurs hair seen after a diffuse or
-//    glossy bounce; hairis never blurs: compare against Cycles with Filter Glossy 0.
+//  - Filter Glossy and Clamping as Cycles applies them (render/filter_glossy.h): a vertex
+//    widens its glossy closures by the least density Cycles would have recorded for the
+//    path's BSDF samples (Bsdf::sample's cycles_pdf), and every contribution is clamped by
+//    the bounce it belongs to.
 //  - Max bounces as Cycles' "Max Bounces: Total" (scene/integrator.cpp stores max_bounce + 1
 //    "so that a bounce of 0 indicates no global illumination, only direct illumination"):
 //    vertices ≤ max_bounces are shaded (next-event estimation + a BSDF-sampled
@@ -56,6 +58,9 @@
 //  - A contribution that is NaN or infinite is dropped (counted in PathCounters), never
 //    accumulated; a non-finite throughput ends the path (counted too).
 //
+// Camera samples land in and around their pixel as Cycles' pixel filter places them
+// (render/pixel_filter.h).
+//
 // Random numbers: render/sample_dims.h's dimensions of a SobolSampleRng per camera sample.
 #pragma once
 
@@ -65,6 +70,8 @@
 #include "core/rng.h"
 #include "core/scratch.h"
 #include "render/dual_scattering_integrator.h"
+#include "render/filter_glossy.h"
+#include "render/pixel_filter.h"
 #include "render/render_settings.h"
 #include "render/scene.h"
 
@@ -101,18 +108,29 @@ struct PathState {
     bool use_mis = false;  ///< false for the camera ray: emission at full weight
     int diffuse_bounces = 0, glossy_bounces = 0, transmission_bounces = 0, transparent_bounces = 0;
     bool last_segment = false;  ///< a bounce limit was reached: only emission at the next hit
+
+    /// Cycles' Clamping: Direct and Indirect (RenderSettings; 0: off).
+    float clamp_direct = 0, clamp_indirect = 0;
+    /// The least density Cycles records for the path's BSDF samples so far (Filter Glossy).
+    float min_ray_pdf = INFINITY;
     PathCounters *counters;
 
-    /// Adds `contribution` to the radiance; a NaN or infinite one is dropped and counted.
-    void add(Rgb contribution) {
+    /// Adds light scattered at the current vertex (next-event estimation there), clamped as
+    /// Cycles clamps light at that bounce; a NaN or infinite one is dropped and counted.
+    void add(Rgb contribution) { add_at_bounce(contribution, vertex); }
+    /// Adds the light the ray meets, times the throughput (nothing when it is black), clamped
+    /// as light at the bounce the ray left.
+    void add_reached(Rgb light) {
+        if (!light.is_black()) add_at_bounce(beta * light, vertex - 1);
+    }
+
+  private:
+    // Cycles' film_clamp_light: Direct up to bounce 0 (the camera's vertex), Indirect beyond.
+    void add_at_bounce(Rgb contribution, int bounce) {
         if (finite(contribution))
-            radiance += contribution;
+            radiance += clamp_contribution(contribution, bounce > 0 ? clamp_indirect : clamp_direct);
         else
             ++counters->dropped;
-    }
-    /// Adds the light the ray meets, times the throughput (nothing when it is black).
-    void add_reached(Rgb light) {
-        if (!light.is_black()) add(beta * light);
     }
 };
 
@@ -140,9 +158,11 @@ class PathIntegrator {
            ScratchBuffer &scratch, FirstHit *first = nullptr) const;
 
   private:
-    /// The BSDF at a path vertex, with the strand's inputs and closure weights, made in scratch.
+    /// The BSDF at a path vertex, with the strand's inputs and closure weights and Filter
+    /// Glossy's widening, made in scratch.
     Bsdf bsdf_at(const SurfacePoint &sp, const Material &material, Vec3 wo, int vertex, float footprint,
-                 std::uint64_t seed, const DualScatteringIntegrator &dual, ScratchBuffer &scratch) const;
+                 std::uint64_t seed, float blur_roughness, const DualScatteringIntegrator &dual,
+                 ScratchBuffer &scratch) const;
     /// Next-event estimation at a vertex (pbrt's SampleLd): one light sample, MIS-weighted
     /// against the BSDF's density, without the path's throughput.
     Rgb sample_ld(const SurfacePoint &sp, const Bsdf &bsdf, const SobolSampleRng &rng, int vertex,
@@ -154,6 +174,7 @@ class PathIntegrator {
     const Scene &scene_;
     const RenderSettings &settings_;
     int transparent_crossings_;  ///< transparent_crossings() of the settings
+    PixelFilter pixel_filter_;   ///< where in its pixel a camera sample lands
 };
 
 }  // namespace hairis

@@ -43,7 +43,12 @@ Status validate(const RenderSettings &s) {
                        check::count_in_range("huang_sampling", s.huang_sampling, 0, 1),
                        check::count_in_range("dual_hair_volume", s.dual_hair_volume, 0, 1),
                        check::count_in_range("dual_exact_bounces", s.dual_exact_bounces, 0, 1024),
-                       check::count_in_range("dual_bounce_limit", s.dual_bounce_limit, 0, 1));
+                       check::count_in_range("dual_bounce_limit", s.dual_bounce_limit, 0, 1),
+                       check::in_range("filter_glossy", s.filter_glossy, 0.0, 10.0),
+                       check::in_range("clamp_direct", s.clamp_direct, 0.0, 3.4e38),
+                       check::in_range("clamp_indirect", s.clamp_indirect, 0.0, 3.4e38),
+                       check::count_in_range("pixel_filter", s.pixel_filter, 0, 2),
+                       check::in_range("pixel_filter_width", s.pixel_filter_width, 0.001, 10.0));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.

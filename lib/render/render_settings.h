@@ -61,6 +61,9 @@ inline int transparent_crossings(TransparentLimit limit, int setting) {
     return limit == TransparentLimit::Setting ? std::max(setting, 1) : setting + 1;
 }
 
+/// Cycles' Film > Pixel Filter: the shape a camera sample's position in its pixel is drawn from.
+enum class PixelFilterType { Box = 0, Gaussian = 1, BlackmanHarris = 2 };
+
 /// How to render.
 struct RenderSettings {
     /// An Integrator: "path" or "dual_scattering".
@@ -126,6 +129,18 @@ struct RenderSettings {
     std::vector<int> region{0, 0, 0, 0};
     /// The passes render_progressive writes beside rgba, names separated by ',' (render.h).
     std::string passes;
+    /// Cycles' Light Paths > Caustics > Filter Glossy, in [0, 10]; 0: off (render/filter_glossy.h).
+    /// Blender's default is 1; the library's is off, so an unset option renders unbiased.
+    float filter_glossy = 0;
+    /// Cycles' Light Paths > Clamping: Direct and Indirect, in [0, 3.4e38]; 0: off. A sample's
+    /// contribution whose |R| + |G| + |B| exceeds 3× the limit is scaled down to it, as Cycles'
+    /// film_clamp_light does (Blender's defaults: 0 and 10).
+    float clamp_direct = 0;
+    float clamp_indirect = 0;
+    /// A PixelFilterType: "box", "gaussian" or "blackman_harris" (Blender's default).
+    int pixel_filter = int(PixelFilterType::Box);
+    /// Cycles' Film > Pixel Filter width in pixels, in [0.001, 10] (Blender's default 1.5).
+    float pixel_filter_width = 1.0f;
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -153,6 +168,11 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("adaptive_min_samples", s.adaptive_min_samples, 0, 1 << 24);
     f.field("region", s.region, 4, 0, 65536);
     f.field("passes", s.passes);
+    f.field("filter_glossy", s.filter_glossy, 0.0, 10.0);
+    f.field("clamp_direct", s.clamp_direct, 0.0, 3.4e38);
+    f.field("clamp_indirect", s.clamp_indirect, 0.0, 3.4e38);
+    f.choice("pixel_filter", s.pixel_filter, {"box", "gaussian", "blackman_harris"});
+    f.field("pixel_filter_width", s.pixel_filter_width, 0.001, 10.0);
 }
 
 /// What a render did.

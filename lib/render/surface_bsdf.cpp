@@ -218,7 +218,7 @@ Rgb SurfaceBsdf::eval(Vec3 wi, float &pdf, float *reported) const {
 }
 
 bool SurfaceBsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
-                         bool *glossy) const {
+                         bool *glossy, float *reported_pdf) const {
     if (black()) return false;
     // The lobe whose cumulative selection weight first exceeds u2 · total.
     const float target = u2 * select_total_;
@@ -242,7 +242,18 @@ bool SurfaceBsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, fl
     if (!(pdf > 0.0f) || !(reported > 0.0f)) return false;
     weight = f / reported;
     if (glossy) *glossy = lobes_[std::size_t(chosen)].kind == SurfaceLobeKind::Microfacet;
+    if (reported_pdf) *reported_pdf = reported;
     return true;
+}
+
+void SurfaceBsdf::blur(float roughness) {
+    for (int k = 0; k < count_; ++k) {
+        SurfaceLobe &l = lobes_[std::size_t(k)];
+        if (l.kind != SurfaceLobeKind::Microfacet || !(roughness > l.alpha)) continue;
+        // GGX's shadowing follows α; GTR1 (3.4's clearcoat) keeps its fixed one.
+        if (l.distribution == MicrofacetDistribution::Ggx) l.shadowing_alpha2 = roughness * roughness;
+        l.alpha = roughness;
+    }
 }
 
 }  // namespace hairis

@@ -162,9 +162,13 @@ class SurfaceBsdf {
     Rgb eval(Vec3 wi, float &pdf, float *reported = nullptr) const;
     /// Draws ω_i (world) with density pdf = Q(ω_i); weight = f·|cos θ_i| / P(ω_i). False
     /// when there is no sample. `glossy` (may be null) says whether the lobe drawn from is a
-    /// microfacet one (Cycles' glossy bounce) or a diffuse one.
+    /// microfacet one (Cycles' glossy bounce) or a diffuse one; `reported_pdf` (may be null)
+    /// receives P(ω_i), the density Cycles records for the bounce.
     bool sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pdf,
-                bool *glossy = nullptr) const;
+                bool *glossy = nullptr, float *reported_pdf = nullptr) const;
+    /// Cycles' bsdf_blur of the microfacet closures (Filter Glossy): each lobe's α raised to
+    /// `roughness` where below it, with the shadowing's α² where that follows α.
+    void blur(float roughness);
 
   private:
     Rgb eval_local(Vec3 wi, float ng_cos, float &pdf, float *reported) const;

@@ -229,6 +229,45 @@ TEST(SurfaceBsdf, CyclesClearcoatWeightsByTheDensityItReports) {
     }
 }
 
+// Cycles' bsdf_blur (Filter Glossy): a microfacet lobe below the blur becomes the same lobe at
+// the blur's α (its GGX shadowing with it; 3.4's GTR1 clearcoat keeps its fixed one); lobes at
+// or above it and diffuse lobes are untouched.
+TEST(SurfaceBsdf, BlurRaisesMicrofacetRoughnessAsCycles) {
+    const Vec3 wo = testing::polar_direction(0.6, 0.3), ng{0, 0, 1};
+    SurfaceBsdf b = make_bsdf(lobes_34(), wo, ng);
+    b.blur(0.2f);
+    EXPECT_EQ(b.lobe(0).roughness, 0.6f);  // the diffuse lobe
+    EXPECT_EQ(b.lobe(2).alpha, 0.25f);     // above the blur
+    EXPECT_EQ(b.lobe(3).alpha, 0.2f);      // the clearcoat, raised
+    EXPECT_EQ(b.lobe(3).shadowing_alpha2, 0.0625f);
+    std::vector<SurfaceLobe> wider = lobes_34();
+    wider[3].alpha = 0.2f;
+    const SurfaceBsdf want = make_bsdf(wider, wo, ng);
+    SurfaceBsdf ggx = make_bsdf(lobes_4(), wo, ng);
+    ggx.blur(0.4f);
+    std::vector<SurfaceLobe> ggx_wider = lobes_4();
+    for (SurfaceLobe &l : ggx_wider)
+        if (l.kind == SurfaceLobeKind::Microfacet && l.alpha < 0.4f) {
+            l.alpha = 0.4f;
+            l.shadowing_alpha2 = 0.16f;
+        }
+    const SurfaceBsdf ggx_want = make_bsdf(ggx_wider, wo, ng);
+    for (const Vec3 wi : {testing::polar_direction(0.5, 3.0), testing::polar_direction(0.2, 1.0)}) {
+        float p = 0, q = 0;
+        const Rgb f = b.eval(wi, p), g = want.eval(wi, q);
+        EXPECT_NEAR(f.r, g.r, 1e-6f * std::max(1.0f, g.r));
+        EXPECT_NEAR(p, q, 1e-6f * std::max(1.0f, q));
+        const Rgb f4 = ggx.eval(wi, p), g4 = ggx_want.eval(wi, q);
+        EXPECT_NEAR(f4.g, g4.g, 1e-6f * std::max(1.0f, g4.g));
+        EXPECT_NEAR(p, q, 1e-6f * std::max(1.0f, q));
+    }
+    // The blur did change the image: the raised lobe is not the original one.
+    const SurfaceBsdf before = make_bsdf(lobes_4(), wo, ng);
+    float p = 0, q = 0;
+    const Vec3 mirror{-wo.x, -wo.y, wo.z};
+    EXPECT_GT(std::fabs(before.eval(mirror, p).r - ggx.eval(mirror, q).r), 1e-3f);
+}
+
 TEST(SurfaceBsdf, DefensiveSelectionRaisesSmallLobes) {
     SurfaceBsdf b = make_bsdf(lobes_34(), testing::polar_direction(0.5, 0.0), Vec3{0, 0, 1});
     const float total = 0.4f + 0.05f + 0.1f + 0.05f;

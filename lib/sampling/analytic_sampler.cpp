@@ -28,7 +28,11 @@ class AnalyticPoint final : public SamplerPoint {
 
 const SamplerPoint &AnalyticSampler::at(const FiberHit &, const FiberPoint *fiber, ScratchBuffer &scratch) const {
     // model() is a ChiangFiber or ChiangStrands, so `fiber` is one of its ChiangPoints.
-    return scratch.make<AnalyticPoint>(static_cast<const ChiangPoint &>(*fiber));
+    return analytic_point(static_cast<const ChiangPoint &>(*fiber), scratch);
+}
+
+const SamplerPoint &analytic_point(const ChiangPoint &fiber, ScratchBuffer &scratch) {
+    return scratch.make<AnalyticPoint>(fiber);
 }
 
 }  // namespace hairis

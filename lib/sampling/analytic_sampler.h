@@ -22,4 +22,8 @@ class AnalyticSampler final : public Sampler {
     std::shared_ptr<const ShadingModel> model_;  // a ChiangFiber or ChiangStrands: ChiangPoints
 };
 
+/// The analytic sampler of one Chiang point, made in `scratch`: what a point no table fits
+/// (Filter Glossy's widened lobes) samples with.
+const SamplerPoint &analytic_point(const ChiangPoint &fiber, ScratchBuffer &scratch);
+
 }  // namespace hairis

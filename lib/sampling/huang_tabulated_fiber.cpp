@@ -53,7 +53,7 @@ Rgb HuangTabulatedPoint::f(Vec3 wi) const {
 }
 
 const FiberPoint &HuangTabulatedFiber::prepare(const FiberHit &hit, ScratchBuffer &scratch) const {
-    const HuangFiber *strand = strands_ ? &strands_->fiber_at(hit.inputs, scratch) : nullptr;
+    const HuangFiber *strand = strands_ ? &strands_->fiber_at(hit.inputs, scratch, hit.blur_roughness) : nullptr;
     return scratch.make<HuangTabulatedPoint>(*this, hit, strand);
 }
 

@@ -112,7 +112,8 @@ static const char *const kinds[][2] = {
                "seed=0;threads=0;tile_size=16;rr_start_bounce=2;film_transparent=0;"
                "huang_sampling=strategy;dual_hair_volume=layer;dual_exact_bounces=3;"
                "dual_bounce_limit=bounces;time_limit=0;adaptive_threshold=0;"
-               "adaptive_min_samples=0;region=0,0,0,0;passes=;strategy=table;"
+               "adaptive_min_samples=0;region=0,0,0,0;passes=;filter_glossy=0;clamp_direct=0;"
+               "clamp_indirect=0;pixel_filter=box;pixel_filter_width=1;strategy=table;"
                "multiple_weight=0;n_h=2;"
                "curve_backfaces=ignore;curve_shape=thick;bvh_quality=medium"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -1414,6 +1415,8 @@ typedef struct render_settings {
     int integrator, strategy, film_transparent, curve_backfaces, curve_shape, bvh_quality, huang_sampling,
         transparent_limit, dual_hair_volume, dual_bounce_limit;
     double multiple_weight, time_limit, adaptive_threshold;
+    double filter_glossy, clamp_direct, clamp_indirect, pixel_filter_width;
+    int pixel_filter;
     long long adaptive_min_samples;
     double region[4];
     /* The passes asked for (0 depth, 1 normal, 2 denoising_albedo, 3 denoising_normal). */
@@ -1455,6 +1458,7 @@ static int read_render_settings(const char *text, render_settings *r)
     const char *qualities[3] = {"low", "medium", "high"};
     const char *integrators[2] = {"path", "dual_scattering"};
     const char *transparent_limits[2] = {"plus_one", "setting"};
+    const char *pixel_filters[3] = {"box", "gaussian", "blackman_harris"};
     if (read_options(text, "render", "render settings", NULL, &o) != HAIRIS_OK ||
         word(&o, "integrator", integrators, 2, &r->integrator) != HAIRIS_OK ||
         integer_in(&o, "samples", 1, 1 << 24, &r->samples) != HAIRIS_OK ||
@@ -1479,6 +1483,11 @@ static int read_render_settings(const char *text, render_settings *r)
         number_in(&o, "adaptive_threshold", 0.0, 1.0, &r->adaptive_threshold) != HAIRIS_OK ||
         integer_in(&o, "adaptive_min_samples", 0, 1 << 24, &r->adaptive_min_samples) != HAIRIS_OK ||
         numbers(&o, "region", r->region, 4) != HAIRIS_OK ||
+        number_in(&o, "filter_glossy", 0.0, 10.0, &r->filter_glossy) != HAIRIS_OK ||
+        number_in(&o, "clamp_direct", 0.0, 3.4e38, &r->clamp_direct) != HAIRIS_OK ||
+        number_in(&o, "clamp_indirect", 0.0, 3.4e38, &r->clamp_indirect) != HAIRIS_OK ||
+        word(&o, "pixel_filter", pixel_filters, 3, &r->pixel_filter) != HAIRIS_OK ||
+        number_in(&o, "pixel_filter_width", 0.001, 10.0, &r->pixel_filter_width) != HAIRIS_OK ||
         read_passes(value_of(&o, "passes"), r) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
@@ -1497,6 +1506,8 @@ static int read_render_settings(const char *text, render_settings *r)
     return HAIRIS_OK;
 }
 
+static const char *const pixel_filters_of[3] = {"box", "gaussian", "blackman_harris"};
+
 static void write_summary(const hairis_scene *s, const render_settings *r)
 {
     const char *path = getenv("HAIRIS_FAKE_SUMMARY");
@@ -1507,7 +1518,9 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
                "threads=%lld max_diffuse_bounces=%lld max_glossy_bounces=%lld max_transmission_bounces=%lld "
                "max_transparent_bounces=%lld tile_size=%lld film_transparent=%d curve_backfaces=%s "
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
-               "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s bvh_quality=%s\n",
+               "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s bvh_quality=%s "
+               "filter_glossy=%.6g clamp_direct=%.6g clamp_indirect=%.6g pixel_filter=%s "
+               "pixel_filter_width=%.6g\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_glossy_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
@@ -1515,7 +1528,8 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
             r->transparent_limit ? "setting" : "plus_one", r->dual_hair_volume ? "unbounded" : "layer",
             r->dual_exact_bounces, r->dual_bounce_limit ? "none" : "bounces",
             r->curve_shape == 2 ? "thick_linear" : r->curve_shape ? "ribbons" : "thick",
-            r->bvh_quality == 2 ? "high" : r->bvh_quality ? "medium" : "low");
+            r->bvh_quality == 2 ? "high" : r->bvh_quality ? "medium" : "low", r->filter_glossy,
+            r->clamp_direct, r->clamp_indirect, pixel_filters_of[r->pixel_filter], r->pixel_filter_width);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

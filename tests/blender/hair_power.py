@@ -39,6 +39,36 @@ def head_scene(samples, model="CHIANG"):
     return scene
 
 
+def cycles_defaults(scene):
+    """Gives ``scene`` back the Cycles settings helpers.match_cycles turns off, at Blender's
+    defaults, as a scene set up for Cycles has them: Filter Glossy 1, Clamping Indirect 10,
+    Light Threshold 0.01 and a Blackman-Harris pixel filter of 1.5 px."""
+    cycles = scene.cycles
+    cycles.blur_glossy = 1.0
+    cycles.sample_clamp_indirect = 10.0
+    cycles.light_sampling_threshold = 0.01
+    cycles.pixel_filter_type = "BLACKMAN_HARRIS"
+    cycles.filter_width = 1.5
+    return scene
+
+
+def defaults_head_scene(samples):
+    """head_scene with Cycles' default Filter Glossy, clamping, light threshold and pixel
+    filter (:func:`cycles_defaults`)."""
+    return cycles_defaults(head_scene(samples))
+
+
+def no_filter_glossy(scene):
+    """Filter Glossy off for the render that follows (Hairis' side of a control); returns the
+    function that undoes it."""
+    before = scene.cycles.blur_glossy
+    scene.cycles.blur_glossy = 0.0
+
+    def undo():
+        scene.cycles.blur_glossy = before
+    return undo
+
+
 def huang_head_scene(samples):
     """head_scene with Huang fibers at Blender's defaults for them (aspect 0.85, lobes at 1)."""
     return head_scene(samples, "HUANG")
@@ -93,6 +123,9 @@ def brighter_light(scene):
 
 
 CONTROLS = (("light x1.02", brighter_light),)
+DEFAULTS_CONTROLS = CONTROLS + (("Filter Glossy off", no_filter_glossy),)
+"""The controls of a scene with Cycles' defaults: Hairis without the Filter Glossy Cycles
+applies must be found too."""
 
 
 def check(make_scene, hair, samples, seeds, workdir, controls=CONTROLS):

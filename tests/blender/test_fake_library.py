@@ -219,6 +219,24 @@ def test_engine_renders_scene():
     scene.cycles.debug_use_spatial_splits = True
     assert summary_value(render(scene)[1], "bvh_quality") == "high"
     scene.cycles.debug_use_spatial_splits = False
+    # Cycles' Filter Glossy, Clamping and Pixel Filter at Blender's defaults reach the library;
+    # a Box filter is always 1 px wide, as Cycles' sync makes it.
+    assert float(summary_value(summary, "filter_glossy")) == 1.0, summary
+    assert float(summary_value(summary, "clamp_direct")) == 0.0, summary
+    assert float(summary_value(summary, "clamp_indirect")) == 10.0, summary
+    assert summary_value(summary, "pixel_filter") == "blackman_harris", summary
+    assert float(summary_value(summary, "pixel_filter_width")) == 1.5, summary
+    scene.cycles.blur_glossy, scene.cycles.sample_clamp_direct = 0.25, 3.0
+    scene.cycles.pixel_filter_type, scene.cycles.filter_width = "BOX", 2.5
+    changed = render(scene)[1]
+    assert float(summary_value(changed, "filter_glossy")) == 0.25, changed
+    assert float(summary_value(changed, "clamp_direct")) == 3.0, changed
+    assert summary_value(changed, "pixel_filter") == "box", changed
+    assert float(summary_value(changed, "pixel_filter_width")) == 1.0, changed
+    scene.cycles.pixel_filter_type = "GAUSSIAN"
+    gaussian = render(scene)[1]
+    assert summary_value(gaussian, "pixel_filter") == "gaussian", gaussian
+    assert float(summary_value(gaussian, "pixel_filter_width")) == 2.5, gaussian
     data = export.export_scene(bpy.context.evaluated_depsgraph_get())
     assert int(summary_value(summary, "curve_sets")) == 2
     curves = {c.source: c for c in data.curves}

@@ -326,6 +326,10 @@ static void test_defaults(void)
     expect_default("render", "curve_backfaces", "ignore");
     expect_default("render", "curve_shape", "thick");
     expect_default("render", "bvh_quality", "medium");
+    expect_default("render", "filter_glossy", "0");
+    expect_default("render", "clamp_indirect", "0");
+    expect_default("render", "pixel_filter", "box");
+    expect_default("render", "pixel_filter_width", "1");
     expect_default("render", "strategy", "table");
     expect_default("render", "seed", "0");
     expect_default("render", "threads", "0");
@@ -499,6 +503,9 @@ static void test_option_strings(void)
         {"render", "curve_backfaces=cull", "curve_backfaces", "hit"},
         {"render", "curve_shape=RIBBONS", "curve_shape", "thick_linear"},
         {"render", "bvh_quality=fast", "bvh_quality", "high"},
+        {"render", "pixel_filter=mitchell", "pixel_filter", "blackman_harris"},
+        {"render", "pixel_filter_width=0", "pixel_filter_width", "0.001"},
+        {"render", "filter_glossy=-1", "filter_glossy", "10"},
         {"camera", "orthographic=yes", "orthographic", "false"},
     };
     for (size_t i = 0; i < sizeof words / sizeof words[0]; ++i) {

@@ -217,7 +217,13 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * (default) | high: the work Embree spends on the BVH, as Cycles asks for it in the viewport, in
  * a final render and with Use Spatial Splits (the image is the same), transparent_limit = plus_one (default) | setting: a path crosses
  * at most max_transparent_bounces + 1 transparent surfaces, as Cycles up to 4.5 (it stores the
- * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. progress may be NULL; non-zero from it cancels
+ * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. filter_glossy (in [0, 10],
+ * default 0 = off), clamp_direct and clamp_indirect (>= 0, default 0 = off): Cycles' Filter Glossy
+ * and Clamping, applied as Cycles applies them (Blender's defaults are 1, 0 and 10); pixel_filter
+ * = box (default) | gaussian | blackman_harris and pixel_filter_width (pixels, in [0.001, 10],
+ * default 1): Cycles' Film > Pixel Filter, whose importance table places each camera sample
+ * (Blender's default: blackman_harris, 1.5; Cycles renders a box at 1 px whatever its width).
+ * progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
  * called on the calling thread. integrator=dual_scattering shades hair by dual scattering
  * (lib/render/dual_scattering_integrator.h) and needs every hair material's tables
