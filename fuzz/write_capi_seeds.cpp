@@ -372,6 +372,17 @@ int main(int argc, char **argv) {
         b.op(kCamera).text(camera(4, 4, ";clip_start=3;clip_end=1"));
         add("render_new_settings", b);
     }
+    // Cycles' Filter Glossy, Clamping and Pixel Filter, in range and out of it.
+    {
+        Blob b = scene({0, 4}, kStrand);
+        b.op(kRender).text("samples=1;max_bounces=3;strategy=analytic;filter_glossy=1;clamp_indirect=10;"
+                           "pixel_filter=blackman_harris;pixel_filter_width=1.5");
+        b.op(kRender).text("samples=1;max_bounces=3;strategy=analytic;filter_glossy=10;clamp_direct=0.001;"
+                           "pixel_filter=gaussian;pixel_filter_width=0.001");
+        b.op(kRender).text("samples=1;max_bounces=3;strategy=analytic;pixel_filter=box;pixel_filter_width=10");
+        b.op(kRender).text("samples=1;strategy=analytic;pixel_filter_width=0;filter_glossy=11;clamp_indirect=-1");
+        add("render_cycles_biased_settings", b);
+    }
     {  // Every getter, on handles and on NULL; hairis_defaults of every kind and of garbage.
         Blob b;
         chiang(b, "");
