@@ -82,10 +82,11 @@ def light_options(light):
 
 def render_settings(settings):
     """The C API's render settings from ``scene.hairis``, the scene's Film > Transparent and
-    Cycles bounce limits per kind (:func:`cycles_bounce_limits`), and how the running Blender's
-    Cycles traces curves (:func:`compat.curve_backfaces`, the scene's Curves > Shape:
-    :func:`compat.curve_shape`), builds its BVH (:func:`bvh_quality`) and limits transparent
-    crossings (:func:`compat.transparent_limit`)."""
+    Cycles bounce limits per kind (:func:`cycles_bounce_limits`), its biased Cycles settings
+    (:func:`cycles_biased_settings`), and how the running Blender's Cycles traces curves
+    (:func:`compat.curve_backfaces`, the scene's Curves > Shape: :func:`compat.curve_shape`,
+    and Subdivisions: :func:`curve_subdivisions`), builds its BVH (:func:`bvh_quality`) and
+    limits transparent crossings (:func:`compat.transparent_limit`)."""
     scene = getattr(settings, "id_data", None)
     render = getattr(scene, "render", None)
     return {"integrator": settings.integrator.lower(),
@@ -101,6 +102,7 @@ def render_settings(settings):
             "seed": int(settings.seed), "threads": int(settings.threads),
             "curve_backfaces": compat.curve_backfaces(),
             "curve_shape": compat.curve_shape(scene)[0],
+            "curve_subdivisions": curve_subdivisions(scene),
             "bvh_quality": bvh_quality(scene),
             "film_transparent": bool(getattr(render, "film_transparent", False)),
             **cycles_bounce_limits(scene), **cycles_biased_settings(scene)}
@@ -109,6 +111,13 @@ def render_settings(settings):
 def viewport_settings(settings):
     """:func:`render_settings` for the viewport: a Low BVH, as Cycles' viewport asks Embree for."""
     return dict(render_settings(settings), bvh_quality="low")
+
+
+def curve_subdivisions(scene):
+    """Cycles' Curves > Subdivisions (its default 2 without Cycles' settings), which sets how
+    finely Embree intersects ribbons."""
+    curves = getattr(scene, "cycles_curves", None) if scene is not None else None
+    return min(max(int(getattr(curves, "subdivisions", 2)), 0), 24)
 
 
 def bvh_quality(scene):

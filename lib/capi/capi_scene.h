@@ -359,13 +359,14 @@ void describe(Fields &f, CameraOptions &o) {
 /// Everything hairis_render reads: the renderer's settings, the hair sampler's and how the
 /// scene it builds traces curves (curve_backfaces=ignore|hit, scene.h's CurveBackfaces;
 /// curve_shape=thick|ribbons|thick_linear, scene.h's CurveShape; bvh_quality=low|medium|high,
-/// scene.h's BvhQuality).
+/// scene.h's BvhQuality; curve_subdivisions, SceneDesc's).
 struct RenderOptions {
     RenderSettings render;
     SamplerOptions sampler;
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
     BvhQuality bvh_quality = BvhQuality::Medium;
+    int curve_subdivisions = 2;
 };
 template <typename Fields>
 void describe(Fields &f, RenderOptions &o) {
@@ -380,6 +381,7 @@ void describe(Fields &f, RenderOptions &o) {
     int quality = int(o.bvh_quality);
     f.choice("bvh_quality", quality, {"low", "medium", "high"});
     o.bvh_quality = BvhQuality(quality);
+    f.field("curve_subdivisions", o.curve_subdivisions, 0, 24);
 }
 
 }  // namespace hairis::capi

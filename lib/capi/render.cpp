@@ -162,11 +162,12 @@ using namespace hairis::capi;
 
 namespace {
 
-// What a built scene's BVH depends on among the render settings: the curves' backfaces and
-// shape, and the BVH's build quality.
+// What a built scene's BVH depends on among the render settings: the curves' backfaces, shape
+// and subdivisions, and the BVH's build quality.
 std::string geometry_key(const RenderOptions &o) {
     return "curve_backfaces=" + std::to_string(int(o.curve_backfaces)) + ";curve_shape=" +
-           std::to_string(int(o.curve_shape)) + ";bvh_quality=" + std::to_string(int(o.bvh_quality));
+           std::to_string(int(o.curve_shape)) + ";bvh_quality=" + std::to_string(int(o.bvh_quality)) +
+           ";curve_subdivisions=" + std::to_string(o.curve_subdivisions);
 }
 
 // What its shading depends on besides: the sampler (the materials), the integrator and Huang
@@ -260,6 +261,7 @@ BuiltScene built_scene(hairis_scene &scene, const RenderOptions &o) {
         desc.curve_backfaces = o.curve_backfaces;
         desc.curve_shape = o.curve_shape;
         desc.bvh_quality = o.bvh_quality;
+        desc.curve_subdivisions = o.curve_subdivisions;
         Expected<Scene> made = Scene::build(std::move(desc));
         if (!made) invalid("scene: " + made.error().message);
         built = std::make_shared<Scene>(std::move(made).value());

@@ -109,12 +109,12 @@ namespace {
 
 // The density Cycles records for a hair closure's sample at local ω_i: a Chiang closure's
 // F_energy (the analytic sampler's density; with 3.4's tilt on θ_i Cycles' F_energy tilts θ_i
-// where the sampler tilts θ_o, a difference of the cuticle angle), 1 for Huang, else the
-// sample's own.
-float cycles_hair_pdf(const HairBsdf &hair, Vec3 local_wi, float pdf) {
+// where the sampler tilts θ_o, a difference of the cuticle angle), 1 for Huang, else `pdf`.
+// `analytic`: `pdf` is already the analytic density (the closure's widened point drew ω_i).
+float cycles_hair_pdf(const HairBsdf &hair, Vec3 local_wi, float pdf, bool analytic) {
     const FiberPoint *fiber = hair.fiber();
     if (!fiber) return pdf;
-    if (const ChiangPoint *chiang = fiber->chiang_point()) return chiang->pdf(local_wi);
+    if (const ChiangPoint *chiang = fiber->chiang_point()) return analytic ? pdf : chiang->pdf(local_wi);
     return fiber->huang_point() ? 1.0f : pdf;
 }
 
@@ -140,12 +140,13 @@ bool Bsdf::sample(float u0, float u1, float u2, Vec3 &wi, Rgb &weight, float &pd
         weight = s->f / pdf;
         if (cycles_pdf) {
             if (hair_) {
-                *cycles_pdf = cycles_hair_pdf(*hair_, s->wi, pdf);
+                const ChiangPoint *chiang = hair_->fiber() ? hair_->fiber()->chiang_point() : nullptr;
+                *cycles_pdf = cycles_hair_pdf(*hair_, s->wi, pdf, chiang && chiang->blurred());
             } else {
                 float sum = 0.0f, total = 0.0f;
                 for (int k = 0; k < mixture_->size(); ++k) {
                     const float w = std::fabs(mixture_->weight(k));
-                    sum += w * cycles_hair_pdf(mixture_->part(k), s->wi, mixture_->part(k).pdf(s->wi));
+                    sum += w * cycles_hair_pdf(mixture_->part(k), s->wi, mixture_->part(k).pdf(s->wi), false);
                     total += w;
                 }
                 *cycles_pdf = total > 0.0f ? sum / total : pdf;

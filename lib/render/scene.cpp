@@ -360,6 +360,7 @@ struct Scene::Impl {
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
     BvhQuality bvh_quality = BvhQuality::Medium;
+    int curve_subdivisions = 2;
 
     std::vector<std::string> geometry_warnings;  // the build's, before the lights'
     std::size_t geometry_bytes = 0;              // stats.scene_bytes without the lights
@@ -618,7 +619,7 @@ Status Scene::Impl::build_bvh() {
     for (std::size_t i = 0; i < curves.size(); ++i) {
         CurveGeometry &geo = curves[i];
         RTCGeometry g = rtcNewGeometry(device, curve_type);
-        rtcSetGeometryTessellationRate(g, 5.0f);
+        rtcSetGeometryTessellationRate(g, float(std::clamp(1 << curve_subdivisions, 1, 16) + 1));
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, geo.cvs.data(),
                                    skip * sizeof(Float4), sizeof(Float4), geo.cvs.size() - skip);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
@@ -686,6 +687,9 @@ Expected<Scene> Scene::build(SceneDesc desc) {
         return Error{"bvh_quality must be low (0), medium (1) or high (2) (got " +
                      std::to_string(int(desc.bvh_quality)) + ")"};
     impl->bvh_quality = desc.bvh_quality;
+    if (desc.curve_subdivisions < 0 || desc.curve_subdivisions > 24)
+        return Error{"curve_subdivisions must be in [0, 24] (got " + std::to_string(desc.curve_subdivisions) + ")"};
+    impl->curve_subdivisions = desc.curve_subdivisions;
 
     if (auto e = check_materials(desc.materials)) return *e;
 

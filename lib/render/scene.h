@@ -175,6 +175,10 @@ struct SceneDesc {
     CurveBackfaces curve_backfaces = CurveBackfaces::Ignore;
     CurveShape curve_shape = CurveShape::Thick;
     BvhQuality bvh_quality = BvhQuality::Medium;
+    /// Cycles' Curves > Subdivisions, in [0, 24] (Blender's default 2): Embree's tessellation
+    /// rate clamp(2^s, 1, 16) + 1, as Cycles sets it; ribbons are intersected as that many
+    /// flat pieces per segment.
+    int curve_subdivisions = 2;
 };
 
 /// What the build did and what it costs.

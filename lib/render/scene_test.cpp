@@ -806,6 +806,62 @@ TEST(Scene, EveryBvhQualityGivesTheSameHits) {
     EXPECT_NE(e.find("bvh_quality must be low (0), medium (1) or high (2) (got 3)"), std::string::npos) << e;
 }
 
+// Cycles' Curves > Subdivisions sets Embree's tessellation rate: the default (2) is what a
+// scene without the setting gets, and another value changes where rays meet bent ribbons
+// (Embree intersects flat curves as that many pieces per segment); out of Blender's range it
+// is refused.
+TEST(Scene, CurveSubdivisionsSetEmbreesTessellation) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    HairCurves c;
+    c.first = {0};
+    for (int strand = 0; strand < 200; ++strand) {
+        Vec3 p{u(rng), u(rng), u(rng)};
+        for (int k = 0; k < 5; ++k) {
+            c.points.push_back(p);
+            c.radii.push_back(0.03f);
+            p = p + Vec3{0.3f, 0.4f * u(rng), 0.4f * u(rng)};  // strongly bent
+        }
+        c.first.push_back(std::uint32_t(c.points.size()));
+    }
+    auto scene_with = [&](std::optional<int> subdivisions) {
+        SceneDesc d;
+        d.materials = {hair_material()};
+        d.curves = {c};
+        d.camera = small_camera();
+        d.curve_shape = CurveShape::Ribbons;
+        if (subdivisions) d.curve_subdivisions = *subdivisions;
+        return build_ok(std::move(d));
+    };
+    const Scene by_default = scene_with(std::nullopt), two = scene_with(2), coarse = scene_with(0),
+                fine = scene_with(4);
+    int hits = 0, differ = 0;
+    for (int ray = 0; ray < 4000; ++ray) {
+        const Vec3 from{u(rng) - 3.0f, 1.5f * u(rng), 1.5f * u(rng)};
+        const Vec3 dir = safe_normalize(Vec3{1.0f, 0.3f * u(rng), 0.3f * u(rng)});
+        const std::optional<Hit> a = by_default.intersect(from, dir, 0.0f, INFINITY);
+        const std::optional<Hit> b = two.intersect(from, dir, 0.0f, INFINITY);
+        ASSERT_EQ(a.has_value(), b.has_value());
+        if (a) {
+            EXPECT_EQ(a->t, b->t);
+        }
+        hits += a.has_value();
+        const std::optional<Hit> p = coarse.intersect(from, dir, 0.0f, INFINITY);
+        const std::optional<Hit> q = fine.intersect(from, dir, 0.0f, INFINITY);
+        if (p.has_value() != q.has_value() || (p && q && p->t != q->t)) ++differ;
+    }
+    EXPECT_GT(hits, 400);
+    EXPECT_GT(differ, 0);
+
+    SceneDesc bad;
+    bad.materials = {hair_material()};
+    bad.curves = {straight_hair()};
+    bad.camera = small_camera();
+    bad.curve_subdivisions = 25;
+    const std::string e = build_error(std::move(bad));
+    EXPECT_NE(e.find("curve_subdivisions must be in [0, 24] (got 25)"), std::string::npos) << e;
+}
+
 // Linear 3D curves: segment k is the straight round cone from point k to point k + 1; a
 // Catmull-Rom curve through the same points bends away from it.
 TEST(Scene, LinearCurvesRunStraightBetweenTheirPoints) {

@@ -115,7 +115,7 @@ static const char *const kinds[][2] = {
                "adaptive_min_samples=0;region=0,0,0,0;passes=;filter_glossy=0;clamp_direct=0;"
                "clamp_indirect=0;pixel_filter=box;pixel_filter_width=1;strategy=table;"
                "multiple_weight=0;n_h=2;"
-               "curve_backfaces=ignore;curve_shape=thick;bvh_quality=medium"},
+               "curve_backfaces=ignore;curve_shape=thick;bvh_quality=medium;curve_subdivisions=2"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
                      "absorption=material;roughness=material;radial_roughness=material;"
                      "coat=material;ior=material;offset=material;random_color=material;"
@@ -1410,7 +1410,7 @@ int hairis_scene_set_camera(hairis_scene *s, const char *text)
 typedef struct render_settings {
     long long samples, max_bounces, max_diffuse_bounces, max_glossy_bounces,
         max_transmission_bounces, max_transparent_bounces, threads, tile_size, rr_start_bounce, n_h,
-        dual_exact_bounces;
+        dual_exact_bounces, curve_subdivisions;
     unsigned long long seed;
     int integrator, strategy, film_transparent, curve_backfaces, curve_shape, bvh_quality, huang_sampling,
         transparent_limit, dual_hair_volume, dual_bounce_limit;
@@ -1475,6 +1475,7 @@ static int read_render_settings(const char *text, render_settings *r)
         word(&o, "curve_backfaces", backfaces, 2, &r->curve_backfaces) != HAIRIS_OK ||
         word(&o, "curve_shape", shapes, 3, &r->curve_shape) != HAIRIS_OK ||
         word(&o, "bvh_quality", qualities, 3, &r->bvh_quality) != HAIRIS_OK ||
+        integer_in(&o, "curve_subdivisions", 0, 24, &r->curve_subdivisions) != HAIRIS_OK ||
         word(&o, "huang_sampling", huang_samplings, 2, &r->huang_sampling) != HAIRIS_OK ||
         word(&o, "dual_hair_volume", volumes, 2, &r->dual_hair_volume) != HAIRIS_OK ||
         integer_in(&o, "dual_exact_bounces", 0, 1024, &r->dual_exact_bounces) != HAIRIS_OK ||
@@ -1520,7 +1521,7 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
                "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s bvh_quality=%s "
                "filter_glossy=%.6g clamp_direct=%.6g clamp_indirect=%.6g pixel_filter=%s "
-               "pixel_filter_width=%.6g\n",
+               "pixel_filter_width=%.6g curve_subdivisions=%lld\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_glossy_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
@@ -1529,7 +1530,8 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
             r->dual_exact_bounces, r->dual_bounce_limit ? "none" : "bounces",
             r->curve_shape == 2 ? "thick_linear" : r->curve_shape ? "ribbons" : "thick",
             r->bvh_quality == 2 ? "high" : r->bvh_quality ? "medium" : "low", r->filter_glossy,
-            r->clamp_direct, r->clamp_indirect, pixel_filters_of[r->pixel_filter], r->pixel_filter_width);
+            r->clamp_direct, r->clamp_indirect, pixel_filters_of[r->pixel_filter], r->pixel_filter_width,
+            r->curve_subdivisions);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

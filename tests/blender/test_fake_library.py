@@ -233,6 +233,10 @@ def test_engine_renders_scene():
     assert float(summary_value(changed, "clamp_direct")) == 3.0, changed
     assert summary_value(changed, "pixel_filter") == "box", changed
     assert float(summary_value(changed, "pixel_filter_width")) == 1.0, changed
+    assert summary_value(summary, "curve_subdivisions") == "2", summary  # Cycles' default
+    scene.cycles_curves.subdivisions = 5
+    assert summary_value(render(scene)[1], "curve_subdivisions") == "5"
+    scene.cycles_curves.subdivisions = 2
     scene.cycles.pixel_filter_type = "GAUSSIAN"
     gaussian = render(scene)[1]
     assert summary_value(gaussian, "pixel_filter") == "gaussian", gaussian

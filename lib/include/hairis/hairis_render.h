@@ -215,7 +215,10 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * builds from 3.6: 4.5, 5.0), curve_shape = thick (default) | ribbons | thick_linear: Cycles'
  * Curves > Shape (3D Curves, Rounded Ribbons, 5.0's Linear 3D Curves), bvh_quality = low | medium
  * (default) | high: the work Embree spends on the BVH, as Cycles asks for it in the viewport, in
- * a final render and with Use Spatial Splits (the image is the same), transparent_limit = plus_one (default) | setting: a path crosses
+ * a final render and with Use Spatial Splits (the image is the same), curve_subdivisions (in
+ * [0, 24], default 2): Cycles' Curves > Subdivisions, Embree's tessellation rate
+ * clamp(2^s, 1, 16) + 1 as Cycles sets it (ribbons are intersected as that many pieces per
+ * segment), transparent_limit = plus_one (default) | setting: a path crosses
  * at most max_transparent_bounces + 1 transparent surfaces, as Cycles up to 4.5 (it stores the
  * setting + 1), or max(max_transparent_bounces, 1), as Cycles 5.0. filter_glossy (in [0, 10],
  * default 0 = off), clamp_direct and clamp_indirect (>= 0, default 0 = off): Cycles' Filter Glossy
@@ -242,11 +245,11 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * refused; one without geometry renders the world (every ray misses). A scene can be rendered
  * again with other settings, also from several threads at once. The scene keeps the last
  * render's build (BVH, lights, materials) while nothing but its camera changes: a render whose
- * sampler, integrator, huang_sampling, curve_backfaces, curve_shape and bvh_quality are the last render's
+ * sampler, integrator, huang_sampling, curve_backfaces, curve_shape, curve_subdivisions and bvh_quality are the last render's
  * reuses it with the current camera (build_seconds 0, scene_reused 1), so a new view costs no
  * new BVH. While its curves and meshes stay and no other render uses it, its BVH is kept for a
  * render with other materials, textures, lights or world (hairis_scene_reset_shading) or other
- * settings with the same curve_backfaces, curve_shape and bvh_quality (geometry_reused 1); adding curves,
+ * settings with the same curve_backfaces, curve_shape, curve_subdivisions and bvh_quality (geometry_reused 1); adding curves,
  * meshes or mesh attributes frees it. hairis_scene_destroy frees it too.
  */
 HAIRIS_API int hairis_render(hairis_scene *scene, const char *settings, float *rgba,
