@@ -145,13 +145,15 @@ PIXEL_FILTERS = {"BOX": "box", "GAUSSIAN": "gaussian", "BLACKMAN_HARRIS": "black
 
 def cycles_biased_settings(scene):
     """The scene's Cycles settings that shape its image beyond the light transport, as Cycles'
-    sync reads them: Filter Glossy, Clamping Direct and Indirect, and the Pixel Filter (a Box
-    is always 1 px wide, whatever the hidden width says); none without Cycles' settings."""
+    sync reads them: Film > Exposure, Filter Glossy, Clamping Direct and Indirect, and the
+    Pixel Filter (a Box is always 1 px wide, whatever the hidden width says); none without
+    Cycles' settings."""
     cycles = getattr(scene, "cycles", None)
     if cycles is None:
         return {}
     kind = PIXEL_FILTERS.get(str(cycles.pixel_filter_type), "blackman_harris")
-    return {"filter_glossy": float(cycles.blur_glossy),
+    return {"exposure": float(cycles.film_exposure),
+            "filter_glossy": float(cycles.blur_glossy),
             "clamp_direct": float(cycles.sample_clamp_direct),
             "clamp_indirect": float(cycles.sample_clamp_indirect),
             "pixel_filter": kind,

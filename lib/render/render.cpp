@@ -48,7 +48,8 @@ Status validate(const RenderSettings &s) {
                        check::in_range("clamp_direct", s.clamp_direct, 0.0, 3.4e38),
                        check::in_range("clamp_indirect", s.clamp_indirect, 0.0, 3.4e38),
                        check::count_in_range("pixel_filter", s.pixel_filter, 0, 2),
-                       check::in_range("pixel_filter_width", s.pixel_filter_width, 0.001, 10.0));
+                       check::in_range("pixel_filter_width", s.pixel_filter_width, 0.001, 10.0),
+                       check::in_range("exposure", s.exposure, 0.0, 10.0));
 }
 
 // Dual scattering needs every hair material's dual-scattering data and multiple table.
@@ -169,6 +170,7 @@ struct Film {
     std::vector<PassKind> kinds;
     int pass_floats = 0;  // per pixel
     bool adaptive = false;
+    double exposure = 1.0;        // Cycles' Film > Exposure, applied when the image is read
     std::vector<double> sum;      // RGBA
     std::vector<float> half;      // RGB of the class-A samples, doubled (adaptive only)
     std::vector<double> pass;     // pass_floats per pixel
@@ -286,7 +288,8 @@ struct Film {
                 if (count[i] == 0) continue;
                 const std::size_t o = (std::size_t(region.y0) + r) * std::size_t(width) + std::size_t(region.x0 + x);
                 const double inv = 1.0 / double(count[i]);
-                for (int c = 0; c < 4; ++c) rgba[o * 4 + c] = float(sum[i * 4 + c] * inv);
+                // Cycles' Film > Exposure scales the light, not the coverage.
+                for (int c = 0; c < 4; ++c) rgba[o * 4 + c] = float(sum[i * 4 + c] * (c < 3 ? inv * exposure : inv));
                 const double *q = pass.data() + i * std::size_t(pass_floats);
                 float *block = out;
                 for (PassKind k : kinds) {
@@ -350,6 +353,7 @@ Status render_progressive(const Scene &scene, const RenderSettings &settings, fl
     const Region region = region_or.value();
     const Adaptive adaptive(settings);
     Film film(region, kinds.value(), adaptive.use);
+    film.exposure = settings.exposure;
     const std::size_t image = std::size_t(width) * std::size_t(height);
     std::fill(rgba, rgba + image * 4, 0.0f);
     if (passes) std::fill(passes, passes + image * std::size_t(film.pass_floats), 0.0f);

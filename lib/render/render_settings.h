@@ -141,6 +141,10 @@ struct RenderSettings {
     int pixel_filter = int(PixelFilterType::Box);
     /// Cycles' Film > Pixel Filter width in pixels, in [0.001, 10] (Blender's default 1.5).
     float pixel_filter_width = 1.0f;
+    /// Cycles' Film > Exposure, in [0, 10] (Blender's default 1): the image's light is scaled by
+    /// it when read out (after adaptive sampling's decisions, as in Cycles); alpha and the data
+    /// passes are not.
+    float exposure = 1.0f;
 };
 
 /// The option names of RenderSettings (core/options.h's field descriptions).
@@ -173,6 +177,7 @@ void describe(Fields &f, RenderSettings &s) {
     f.field("clamp_indirect", s.clamp_indirect, 0.0, 3.4e38);
     f.choice("pixel_filter", s.pixel_filter, {"box", "gaussian", "blackman_harris"});
     f.field("pixel_filter_width", s.pixel_filter_width, 0.001, 10.0);
+    f.field("exposure", s.exposure, 0.0, 10.0);
 }
 
 /// What a render did.

@@ -1109,6 +1109,30 @@ TEST(Render, MaxBouncesCountLikeCycles) {
                 4.5 * std::sqrt((no_rr.sigma * no_rr.sigma + rr.sigma * rr.sigma) / 6000.0));
 }
 
+// Cycles' Film > Exposure scales the image's light when it is read out; alpha stays coverage.
+TEST(Render, ExposureScalesTheLightAndNotTheAlpha) {
+    SceneDesc d;
+    d.materials = {DiffuseMaterial{Rgb(0.7f), Rgb(0.0f)}};
+    d.meshes = {sphere(1.0f, 12, 24, 0)};
+    d.world = {Rgb(0.4f, 0.5f, 0.6f), 1.0f};
+    d.camera = perspective({0, 0, 4}, 0.35f, 8, 8);
+    const Scene scene = build(std::move(d));
+    RenderSettings s;
+    s.samples = 4;
+    s.film_transparent = true;
+    const auto plain = render_ok(scene, s);
+    s.exposure = 2.5f;
+    const auto bright = render_ok(scene, s);
+    int covered = 0, empty = 0;
+    for (std::size_t i = 0; i < plain.size(); i += 4) {
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(bright[i + c], 2.5f * plain[i + c], 1e-6f * (1.0f + plain[i + c]));
+        EXPECT_EQ(bright[i + 3], plain[i + 3]);
+        (plain[i + 3] > 0.0f ? covered : empty) += 1;
+    }
+    EXPECT_GT(covered, 0);
+    EXPECT_GT(empty, 0);
+}
+
 TEST(Render, ImageIsWrittenBottomRowFirst) {
     // An emitter covering only the upper half of an orthographic view (camera space y > 0).
     SceneDesc d;

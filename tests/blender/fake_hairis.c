@@ -113,7 +113,7 @@ static const char *const kinds[][2] = {
                "huang_sampling=strategy;dual_hair_volume=layer;dual_exact_bounces=3;"
                "dual_bounce_limit=bounces;time_limit=0;adaptive_threshold=0;"
                "adaptive_min_samples=0;region=0,0,0,0;passes=;filter_glossy=0;clamp_direct=0;"
-               "clamp_indirect=0;pixel_filter=box;pixel_filter_width=1;strategy=table;"
+               "clamp_indirect=0;pixel_filter=box;pixel_filter_width=1;exposure=1;strategy=table;"
                "multiple_weight=0;n_h=2;"
                "curve_backfaces=ignore;curve_shape=thick;bvh_quality=medium;curve_subdivisions=2"},
     {"curve_inputs", "color=material;melanin=material;melanin_redness=material;tint=material;"
@@ -1415,7 +1415,7 @@ typedef struct render_settings {
     int integrator, strategy, film_transparent, curve_backfaces, curve_shape, bvh_quality, huang_sampling,
         transparent_limit, dual_hair_volume, dual_bounce_limit;
     double multiple_weight, time_limit, adaptive_threshold;
-    double filter_glossy, clamp_direct, clamp_indirect, pixel_filter_width;
+    double filter_glossy, clamp_direct, clamp_indirect, pixel_filter_width, exposure;
     int pixel_filter;
     long long adaptive_min_samples;
     double region[4];
@@ -1489,6 +1489,7 @@ static int read_render_settings(const char *text, render_settings *r)
         number_in(&o, "clamp_indirect", 0.0, 3.4e38, &r->clamp_indirect) != HAIRIS_OK ||
         word(&o, "pixel_filter", pixel_filters, 3, &r->pixel_filter) != HAIRIS_OK ||
         number_in(&o, "pixel_filter_width", 0.001, 10.0, &r->pixel_filter_width) != HAIRIS_OK ||
+        number_in(&o, "exposure", 0.0, 10.0, &r->exposure) != HAIRIS_OK ||
         read_passes(value_of(&o, "passes"), r) != HAIRIS_OK ||
         read_strategy(&o, &r->strategy) != HAIRIS_OK)
         return HAIRIS_ERROR_INVALID_ARGUMENT;
@@ -1521,7 +1522,7 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
                "integrator=%d huang_sampling=%d transparent_limit=%s dual_hair_volume=%s "
                "dual_exact_bounces=%lld dual_bounce_limit=%s curve_shape=%s bvh_quality=%s "
                "filter_glossy=%.6g clamp_direct=%.6g clamp_indirect=%.6g pixel_filter=%s "
-               "pixel_filter_width=%.6g curve_subdivisions=%lld\n",
+               "pixel_filter_width=%.6g curve_subdivisions=%lld exposure=%.6g\n",
             r->samples, r->max_bounces, r->strategy, r->multiple_weight, r->n_h, r->seed,
             r->threads, r->max_diffuse_bounces, r->max_glossy_bounces, r->max_transmission_bounces,
             r->max_transparent_bounces, r->tile_size, r->film_transparent,
@@ -1531,7 +1532,7 @@ static void write_summary(const hairis_scene *s, const render_settings *r)
             r->curve_shape == 2 ? "thick_linear" : r->curve_shape ? "ribbons" : "thick",
             r->bvh_quality == 2 ? "high" : r->bvh_quality ? "medium" : "low", r->filter_glossy,
             r->clamp_direct, r->clamp_indirect, pixel_filters_of[r->pixel_filter], r->pixel_filter_width,
-            r->curve_subdivisions);
+            r->curve_subdivisions, r->exposure);
     fprintf(f, "materials=%d curve_sets=%zu curves=%zu points=%zu radius_sum=%.9g "
                "position_sum=%.9g,%.9g,%.9g curve_sets_with_normals=%zu\n",
             s->material_count, s->curve_sets, s->curve_count, s->curve_points, s->radius_sum,

@@ -234,6 +234,10 @@ def test_engine_renders_scene():
     assert summary_value(changed, "pixel_filter") == "box", changed
     assert float(summary_value(changed, "pixel_filter_width")) == 1.0, changed
     assert summary_value(summary, "curve_subdivisions") == "2", summary  # Cycles' default
+    assert float(summary_value(summary, "exposure")) == 1.0, summary
+    scene.cycles.film_exposure = 1.75
+    assert float(summary_value(render(scene)[1], "exposure")) == 1.75
+    scene.cycles.film_exposure = 1.0
     scene.cycles_curves.subdivisions = 5
     assert summary_value(render(scene)[1], "curve_subdivisions") == "5"
     scene.cycles_curves.subdivisions = 2

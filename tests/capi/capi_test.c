@@ -331,6 +331,7 @@ static void test_defaults(void)
     expect_default("render", "pixel_filter", "box");
     expect_default("render", "pixel_filter_width", "1");
     expect_default("render", "curve_subdivisions", "2");
+    expect_default("render", "exposure", "1");
     expect_default("render", "strategy", "table");
     expect_default("render", "seed", "0");
     expect_default("render", "threads", "0");

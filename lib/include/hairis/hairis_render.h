@@ -225,7 +225,9 @@ HAIRIS_API int hairis_scene_set_camera(hairis_scene *scene, const char *options)
  * and Clamping, applied as Cycles applies them (Blender's defaults are 1, 0 and 10); pixel_filter
  * = box (default) | gaussian | blackman_harris and pixel_filter_width (pixels, in [0.001, 10],
  * default 1): Cycles' Film > Pixel Filter, whose importance table places each camera sample
- * (Blender's default: blackman_harris, 1.5; Cycles renders a box at 1 px whatever its width).
+ * (Blender's default: blackman_harris, 1.5; Cycles renders a box at 1 px whatever its width);
+ * exposure (in [0, 10], default 1): Cycles' Film > Exposure, scaling the image's colour (not its
+ * alpha or data passes) when it is read out.
  * progress may be NULL; non-zero from it cancels
  * (HAIRIS_ERROR_CANCELLED, promptly; rgba then holds the samples finished so far); it is only
  * called on the calling thread. integrator=dual_scattering shades hair by dual scattering
