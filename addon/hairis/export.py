@@ -250,6 +250,11 @@ class _Exporter:
                         export_particle_hair(self, obj)
             elif kind in {"VOLUME", "POINTCLOUD", "GPENCIL", "GREASEPENCIL"}:
                 self.data.warn("object %r: %s objects are not supported" % (obj.name, kind.lower()))
+            if kind in GEOMETRY_TYPES or kind == "CURVES":
+                unsupported = ray_visibility_changes(obj)
+                if unsupported:
+                    self.data.warn("object %r: %s; Hairis renders it as if visible to every ray"
+                                   % (obj.name, " and ".join(unsupported)))
         problem = memory.memory_problem(self.data, memory.available_memory_bytes())
         if problem:
             raise ExportError(problem)
@@ -589,6 +594,24 @@ def export_shading(depsgraph, previous):
         lights=shading.lights, world_color=shading.world_color,
         world_strength=shading.world_strength, world_environment=shading.world_environment,
         warnings=warnings)
+
+
+RAY_VISIBILITY = (("visible_camera", "Camera"), ("visible_diffuse", "Diffuse"),
+                  ("visible_glossy", "Glossy"), ("visible_transmission", "Transmission"),
+                  ("visible_shadow", "Shadow"))
+"""Object Properties > Visibility > Ray Visibility: the property and its label."""
+
+
+def ray_visibility_changes(obj):
+    """What of Cycles' per-object visibility ``obj`` changes that Hairis does not follow: Ray
+    Visibility switched off, Holdout or Shadow Catcher (Blender 3.0+ properties)."""
+    changes = ["Ray Visibility %s off" % label for name, label in RAY_VISIBILITY
+               if not getattr(obj, name, True)]
+    if getattr(obj, "is_holdout", False):
+        changes.append("Holdout on")
+    if getattr(obj, "is_shadow_catcher", False):
+        changes.append("Shadow Catcher on")
+    return changes
 
 
 def export_scene(depsgraph, camera=None):

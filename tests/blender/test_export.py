@@ -1066,7 +1066,25 @@ def test_groom_memory_estimate():
         memory.available_memory_bytes = original
 
 
+def test_ray_visibility_warns():
+    """Ray Visibility switched off, Holdout or Shadow Catcher on an object is named in a
+    warning (Hairis renders every object visible to every ray); a scene at the defaults has
+    no such warning."""
+    helpers.make_test_scene()
+    assert not any("Ray Visibility" in w for w in export.export_context().warnings)
+    mesh = next(o for o in bpy.data.objects if o.type == "MESH")
+    mesh.visible_camera = False
+    mesh.visible_shadow = False
+    mesh.is_holdout = True
+    bpy.context.view_layer.update()
+    warnings = [w for w in export.export_context().warnings if repr(mesh.name) in w]
+    assert len(warnings) == 1, warnings
+    assert ("Ray Visibility Camera off and Ray Visibility Shadow off and Holdout on"
+            in warnings[0]), warnings
+
+
 helpers.run([
+    test_ray_visibility_warns,
     test_particle_hair_viewport,
     test_curves_object,
     test_curves_without_radius,
