@@ -35,22 +35,26 @@ TEST(Bsdf, ModelsSayWhatTheyAre) {
 
 // Cycles' h at a hit across a strand, seen from ω_o: −s at the point s·r along X × ω_o from
 // the axis, for a round tube (from Ng) and a ribbon (h = −v) alike, whatever the direction.
+// One straight strand of radius 0.1 along x through the origin, of a Chiang fiber of `params`
+// sampled uniformly, traced as `shape`.
+Scene one_strand(const ChiangParams &params, CurveShape shape = CurveShape::Thick) {
+    auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(params).value());
+    SceneDesc d;
+    d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
+    HairCurves c;
+    c.points = {{-1.5f, 0, 0}, {-0.5f, 0, 0}, {0.5f, 0, 0}, {1.5f, 0, 0}};
+    c.radii = {0.1f, 0.1f, 0.1f, 0.1f};
+    c.first = {0, 4};
+    d.curves = {c};
+    d.camera.camera_to_world = Mat4::translation({0, 0, 5});
+    d.camera.width = d.camera.height = 4;
+    d.curve_shape = shape;
+    return std::move(Scene::build(std::move(d))).value();
+}
+
 TEST(Bsdf, RibbonsAndTubesGiveTheSameOffsetAcrossTheStrand) {
-    auto scene_of = [](CurveShape shape) {
-        PrincipledHairNode node;
-        auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(to_chiang_params(node).value()).value());
-        SceneDesc d;
-        d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
-        HairCurves c;
-        c.points = {{-1.5f, 0, 0}, {-0.5f, 0, 0}, {0.5f, 0, 0}, {1.5f, 0, 0}};
-        c.radii = {0.1f, 0.1f, 0.1f, 0.1f};
-        c.first = {0, 4};
-        d.curves = {c};
-        d.camera.camera_to_world = Mat4::translation({0, 0, 5});
-        d.camera.width = d.camera.height = 4;
-        d.curve_shape = shape;
-        return std::move(Scene::build(std::move(d))).value();
-    };
+    const ChiangParams params = to_chiang_params(PrincipledHairNode{}).value();
+    auto scene_of = [&](CurveShape shape) { return one_strand(params, shape); };
     const Scene ribbons = scene_of(CurveShape::Ribbons), tubes = scene_of(CurveShape::Thick);
     for (const Vec3 d : {Vec3{0, 0, -1}, Vec3{0.4f, -0.6f, -0.7f}, Vec3{-0.5f, 0.3f, 0.6f}}) {
         const Vec3 dir = safe_normalize(d), wo = -dir;
@@ -87,17 +91,7 @@ TEST(Bsdf, FilterGlossyWidensChiangToTheFiberOfTheWidenedRoughness) {
     PrincipledHairNode node;
     node.coat = 0.4f;
     const ChiangParams own = to_chiang_params(node).value();
-    auto fiber = std::make_shared<const ChiangFiber>(ChiangFiber::create(own).value());
-    SceneDesc d;
-    d.materials = {HairMaterial{HairShading::create(fiber, std::make_shared<const UniformSampler>()).value()}};
-    HairCurves c;
-    c.points = {{-1.5f, 0, 0}, {-0.5f, 0, 0}, {0.5f, 0, 0}, {1.5f, 0, 0}};
-    c.radii = {0.1f, 0.1f, 0.1f, 0.1f};
-    c.first = {0, 4};
-    d.curves = {c};
-    d.camera.camera_to_world = Mat4::translation({0, 0, 5});
-    d.camera.width = d.camera.height = 4;
-    const Scene scene = std::move(Scene::build(std::move(d))).value();
+    const Scene scene = one_strand(own);
     const Vec3 dir = safe_normalize(Vec3{0.2f, -0.5f, -0.8f}), origin = Vec3{0.1f, 0.03f, 0} - dir * 3.0f;
     const auto hit = scene.intersect(origin, dir, 0.0f, INFINITY);
     ASSERT_TRUE(hit.has_value());
