@@ -41,6 +41,10 @@ def make_scene():
     scene.hairis.use_adaptive_sampling = False
     # Round tubes (3D Curves): the dual-scattering ratios below were measured on them.
     scene.cycles_curves.shape = "THICK"
+    # Unbiased estimates, so that every strategy converges to the same image: Cycles' Clamping
+    # cuts each strategy's heavy tail differently, and Filter Glossy widens the lobes.
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.blur_glossy = 0.0
     settings = scene.hairis
     settings.samples = SAMPLES
     settings.threads = 0

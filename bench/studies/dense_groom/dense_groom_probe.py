@@ -7,7 +7,9 @@ Knobs (environment): PROBE_LEN hair length, PROBE_RS radius scale, PROBE_MEL mel
 PROBE_OFFSET cuticle tilt in degrees, PROBE_TIP tip radius (of
 the root's), PROBE_CLOSE Close Tip (1 or 0), PROBE_SHAPE the radius shape, PROBE_EMITTER 0
 to hide the sphere, PROBE_BOUNCES bounce limit, PROBE_SPP samples,
-PROBE_CHILDREN rendered children per parent (1000 parents), PROBE_ORDER a comma-separated list
+PROBE_CHILDREN rendered children per parent (1000 parents), PROBE_DEFAULTS 1 to keep Cycles'
+Filter Glossy, Clamping and Pixel Filter at Blender's defaults (else all off), PROBE_ORDER a
+comma-separated list
 of CYCLES, HAIRIS, HAIRIS:<strategy>, HAIRIS:hit / HAIRIS:ignore (the rule for the insides of
 tubes) and X:curves (replace the particles by a Curves object of the same strands).
 
@@ -87,6 +89,9 @@ def make_scene():
     sphere.show_instancer_for_render = env("PROBE_EMITTER", "1") != 0.0
     bounces = int(env("PROBE_BOUNCES", "8"))
     helpers.match_cycles(scene, int(env("PROBE_SPP", "16")), bounces)
+    if env("PROBE_DEFAULTS", "0") != 0.0:
+        scene.cycles.blur_glossy, scene.cycles.sample_clamp_indirect = 1.0, 10.0
+        scene.cycles.pixel_filter_type, scene.cycles.filter_width = "BLACKMAN_HARRIS", 1.5
     scene.hairis.samples = scene.cycles.samples
     helpers.use_table(scene, bounces, threads=2)
     bpy.context.view_layer.update()
